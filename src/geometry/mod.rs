@@ -1,0 +1,1 @@
+//! Geometry preparation: mesh adjacency, possible silhouettes, loops, shadow volumes.

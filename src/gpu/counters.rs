@@ -1,0 +1,79 @@
+//! Memory-traffic and work counters (DESIGN.md "Counters"; Paper II §7 counts depth reads and
+//! stencil/LI writes per tile size, Paper III §5.2 counts depth and V-buffer/stencil bytes).
+//!
+//! Every buffer access goes through the typed buffers in [`super::buffers`], which add to a
+//! tile-local `Counters`; tiles' counters are summed after a pass. Integer sums do not depend
+//! on the order tiles finish in, so counters are as deterministic as the images.
+//! Counting is always on: it is one integer add per access into a tile-local struct that
+//! lives in L1, which costs little next to the edge-function and depth work of a fragment.
+
+use serde::Serialize;
+use std::ops::AddAssign;
+
+/// Counters of one pass (or of a whole frame, once summed). Bytes are counted at the
+/// storage size of the emulated format (D24 = 3 bytes, stencil = 1, LI16 = 2, …).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct Counters {
+    /// Triangles submitted to setup.
+    pub triangles_submitted: u64,
+    /// Triangles dropped by setup: zero area, culled by facing, or clipped away entirely.
+    pub triangles_dropped: u64,
+    /// Triangles produced by clipping that reached rasterization.
+    pub triangles_rasterized: u64,
+    /// (triangle, tile) pairs visited by traversal.
+    pub tiles_visited: u64,
+    /// Tiles rejected by a hierarchical-Z (zmin/zmax) test before any fragment was made.
+    pub tiles_culled_hiz: u64,
+    /// Samples that passed the coverage test (fragments generated).
+    pub fragments_rasterized: u64,
+    /// Fragments that ran a fragment shader (method-specific per-pixel work).
+    pub fragments_shaded: u64,
+    /// Fragments that passed the depth test.
+    pub depth_passed: u64,
+    /// Depth-buffer reads, in bytes.
+    pub depth_read_bytes: u64,
+    /// Depth-buffer writes, in bytes.
+    pub depth_write_bytes: u64,
+    /// Stencil-buffer reads, in bytes.
+    pub stencil_read_bytes: u64,
+    /// Stencil-buffer writes, in bytes.
+    pub stencil_write_bytes: u64,
+    /// Colour/LI/V-buffer reads, in bytes (blending reads the destination).
+    pub color_read_bytes: u64,
+    /// Colour/LI/V-buffer writes, in bytes.
+    pub color_write_bytes: u64,
+    /// Writes whose value over- or underflowed the storage format (wrapped or saturated).
+    pub overflow_events: u64,
+}
+
+impl Counters {
+    /// Total buffer traffic in bytes (depth + stencil + colour, reads and writes).
+    pub fn total_bytes(&self) -> u64 {
+        self.depth_read_bytes
+            + self.depth_write_bytes
+            + self.stencil_read_bytes
+            + self.stencil_write_bytes
+            + self.color_read_bytes
+            + self.color_write_bytes
+    }
+}
+
+impl AddAssign for Counters {
+    fn add_assign(&mut self, o: Counters) {
+        self.triangles_submitted += o.triangles_submitted;
+        self.triangles_dropped += o.triangles_dropped;
+        self.triangles_rasterized += o.triangles_rasterized;
+        self.tiles_visited += o.tiles_visited;
+        self.tiles_culled_hiz += o.tiles_culled_hiz;
+        self.fragments_rasterized += o.fragments_rasterized;
+        self.fragments_shaded += o.fragments_shaded;
+        self.depth_passed += o.depth_passed;
+        self.depth_read_bytes += o.depth_read_bytes;
+        self.depth_write_bytes += o.depth_write_bytes;
+        self.stencil_read_bytes += o.stencil_read_bytes;
+        self.stencil_write_bytes += o.stencil_write_bytes;
+        self.color_read_bytes += o.color_read_bytes;
+        self.color_write_bytes += o.color_write_bytes;
+        self.overflow_events += o.overflow_events;
+    }
+}

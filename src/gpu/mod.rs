@@ -1,0 +1,3 @@
+//! The emulated GPU pipeline (DESIGN.md "The emulated GPU: the bit-exactness contract").
+
+pub mod counters;

@@ -1,0 +1,23 @@
+//! penumbra — a deterministic, tile-based CPU rasterizer that reproduces the classic
+//! real-time soft-shadow algorithms with each paper's exact buffer arithmetic.
+//!
+//! The crate is layered; dependency arrows point down:
+//!
+//! ```text
+//! cli (main.rs) ─► render ─► methods ─► gpu, geometry, light ─► scene ─► limits
+//!                     └────► output, metrics
+//! ```
+//!
+//! See `../shared/DESIGN.md` for the bit-exactness contract the [`gpu`] module implements.
+
+pub mod error;
+pub mod geometry;
+pub mod gpu;
+pub mod light;
+pub mod limits;
+pub mod methods;
+pub mod metrics;
+pub mod output;
+pub mod plan;
+pub mod render;
+pub mod scene;

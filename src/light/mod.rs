@@ -1,0 +1,1 @@
+//! Light shapes and their sampling.

@@ -1,0 +1,21 @@
+//! The few constants the emulated GPU derives everything else from (after Mesa's
+//! `lp_limits.h`): sub-pixel precision, tile sizes, depth formats and the guard band.
+
+/// Fractional bits of the fixed-point window coordinates (DESIGN.md: 8 sub-pixel bits).
+pub const SUBPIXEL_BITS: u32 = 8;
+/// One pixel in fixed-point units.
+pub const FIXED_ONE: i64 = 1 << SUBPIXEL_BITS;
+/// Default tile edge in pixels (DESIGN.md: 8×8).
+pub const DEFAULT_TILE_SIZE: u32 = 8;
+/// Smallest tile edge the tile sweep allows (Paper II §7: 2×2).
+pub const MIN_TILE_SIZE: u32 = 2;
+/// Largest tile edge the tile sweep allows (Paper II §7: 256×256).
+pub const MAX_TILE_SIZE: u32 = 256;
+/// Largest accepted image edge in pixels: keeps every fixed-point edge function product
+/// well inside i64 (coordinates < 2^(14+3+8) after the guard band, products < 2^52).
+pub const MAX_IMAGE_SIZE: u32 = 16384;
+/// Guard band: clip-space x and y are clipped to |x| ≤ GUARD_BAND·w, so that primitives
+/// reaching infinity (w = 0) become finite without moving any edge that crosses the viewport.
+pub const GUARD_BAND: f64 = 4.0;
+/// Largest D24 value, 2^24 − 1.
+pub const D24_MAX: u32 = (1 << 24) - 1;

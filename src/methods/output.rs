@@ -1,0 +1,99 @@
+//! What every method hands back: a visibility buffer in [0,1] (DESIGN.md "Methods": all
+//! methods are compared on the same footing), optional raw buffers for inspection, and the
+//! stats that go into `stats.json`.
+
+use crate::gpu::counters::Counters;
+use serde::Serialize;
+
+/// Per-pixel visibility of the light, row 0 at the top, row-major.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Visibility {
+    /// One value per pixel in [0,1].
+    Gray(Vec<f32>),
+    /// One value per pixel and RGB channel in [0,1] (textured/coloured lights).
+    Rgb(Vec<[f32; 3]>),
+}
+
+impl Visibility {
+    /// Number of pixels.
+    pub fn len(&self) -> usize {
+        match self {
+            Visibility::Gray(v) => v.len(),
+            Visibility::Rgb(v) => v.len(),
+        }
+    }
+
+    /// True when there are no pixels.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The visibility of pixel `i` as RGB (gray replicated).
+    pub fn rgb(&self, i: usize) -> [f32; 3] {
+        match self {
+            Visibility::Gray(v) => [v[i]; 3],
+            Visibility::Rgb(v) => v[i],
+        }
+    }
+
+    /// The visibility of pixel `i` as one value (RGB averaged with equal weights).
+    pub fn gray(&self, i: usize) -> f32 {
+        match self {
+            Visibility::Gray(v) => v[i],
+            Visibility::Rgb(v) => (v[i][0] + v[i][1] + v[i][2]) / 3.0,
+        }
+    }
+}
+
+/// A raw 8-bit single-channel buffer a method exposes (e.g. `hard-sv`'s stencil counts),
+/// written as `DIR/METHOD/<name>.png`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RawImage8 {
+    /// File stem, e.g. `stencil`.
+    pub name: String,
+    /// Row-major values, row 0 at the top.
+    pub values: Vec<u8>,
+}
+
+/// Time and counters of one pass.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PassStats {
+    /// The pass name, e.g. `scene-depth`, `shadow-volume-zpass`, `sample-17` (summed per kind).
+    pub name: String,
+    /// Wall-clock seconds the pass took (informational; never decides a test).
+    pub wall_seconds: f64,
+    /// How many times the pass ran (e.g. N for the per-sample passes of `nsample`).
+    pub runs: u64,
+    /// Counters summed over all tiles and runs.
+    pub counters: Counters,
+}
+
+/// Everything `stats.json` holds for one method.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MethodStats {
+    /// The method name.
+    pub method: String,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Wall-clock seconds of the whole method (informational).
+    pub wall_seconds: f64,
+    /// The frame plan: passes and buffers used, as JSON.
+    pub plan: serde_json::Value,
+    /// Per-pass time and counters, in execution order.
+    pub passes: Vec<PassStats>,
+    /// Counters summed over all passes.
+    pub totals: Counters,
+}
+
+/// The result of running one method on one scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MethodOutput {
+    /// Visibility in [0,1].
+    pub visibility: Visibility,
+    /// Extra raw buffers (e.g. the stencil).
+    pub raw_images: Vec<RawImage8>,
+    /// Stats for `stats.json`.
+    pub stats: MethodStats,
+}

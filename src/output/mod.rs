@@ -1,0 +1,1 @@
+//! Writing a method's outputs to disk.

@@ -1,0 +1,1 @@
+//! Rendering one scene with a set of methods.

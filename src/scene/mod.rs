@@ -1,0 +1,160 @@
+//! Scenes: the validated, in-memory description of one frame — image size, camera, light,
+//! closed meshes in world space, the methods to run and their options.
+//!
+//! Files are TOML or JSON with one schema ([`file`]); built-in scenes are generated in code
+//! ([`builtin`]); OBJ meshes are loaded with `tobj` ([`obj`]). Everything that reaches a
+//! [`Scene`] has been validated ([`validate`]): finite numbers, non-degenerate light and
+//! camera, closed two-manifold meshes.
+
+
+use glam::{DVec3, Vec3};
+use std::collections::BTreeMap;
+
+/// The camera (DESIGN.md "Coordinates"): right-handed world, view matrix as gluLookAt,
+/// `vfov_deg` the full vertical angle. Kept in f64; clip coordinates are rounded to f32 once.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Camera {
+    /// Eye position in world space.
+    pub eye: DVec3,
+    /// Point the camera looks at.
+    pub target: DVec3,
+    /// Up vector (need not be orthogonal to the view direction, must not be parallel to it).
+    pub up: DVec3,
+    /// Full vertical field of view in degrees, in (0, 180).
+    pub vfov_deg: f64,
+    /// Near-plane distance; `None` picks the default derived from the scene bounds
+    /// (see [`crate::gpu::transform::default_near`]).
+    pub near: Option<f64>,
+}
+
+/// An RGB texture with linear f32 texels in [0,1], row 0 at the top (used by textured lights).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RgbTexture {
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// Row-major texels, `width * height` entries.
+    pub texels: Vec<[f32; 3]>,
+    /// Where the texture came from (file path or a description), for messages and stats.
+    pub source: String,
+}
+
+/// The shape of the area light (DESIGN.md "Methods": which method supports which shape).
+#[derive(Debug, Clone, PartialEq)]
+pub enum LightShape {
+    /// A point light at the light center (hard shadows only).
+    Point,
+    /// A sphere of `radius` (Papers I, II, IV §4.2.1).
+    Sphere { radius: f32 },
+    /// A one-sided circular disk of `radius` facing along `normal` (CGI 2004).
+    Disk { radius: f32, normal: Vec3 },
+    /// A rectangle spanned by the half-extent vectors `u` and `v` (Papers III, IV; Forest 2006).
+    Rect { u: Vec3, v: Vec3 },
+    /// A rectangle like [`LightShape::Rect`] whose emission is an RGB texture (Paper III §3.3);
+    /// texel (0,0) is at `center − u + v` (top-left), texel columns run along `u`.
+    TexturedRect { u: Vec3, v: Vec3, texture: RgbTexture },
+}
+
+impl LightShape {
+    /// The name used in scene files (`type = "..."`).
+    pub fn type_name(&self) -> &'static str {
+        match self {
+            LightShape::Point => "point",
+            LightShape::Sphere { .. } => "sphere",
+            LightShape::Disk { .. } => "disk",
+            LightShape::Rect { .. } => "rect",
+            LightShape::TexturedRect { .. } => "textured_rect",
+        }
+    }
+}
+
+/// The area light: a shape around `center`. Hard shadows always use `center`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Light {
+    /// The light center in world space.
+    pub center: Vec3,
+    /// The shape and its size.
+    pub shape: LightShape,
+}
+
+/// A closed, two-manifold triangle mesh in world space (transform already applied).
+/// Triangles are counter-clockwise seen from outside (outward normals by the right-hand rule).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mesh {
+    /// A name for messages: the OBJ path or the built-in part's name.
+    pub name: String,
+    /// Vertex positions, world space, f32 as a GPU would hold them.
+    pub positions: Vec<Vec3>,
+    /// Triangles as indices into `positions`; shared vertices are shared indices.
+    pub triangles: Vec<[u32; 3]>,
+    /// Diffuse albedo in linear RGB, used only for the shaded image.
+    pub color: [f32; 3],
+}
+
+/// Raw per-method options as written in `[options.METHOD]` or with `--opt METHOD.KEY=VALUE`.
+/// Values are kept as strings/numbers/bools; each method validates its own keys
+/// ([`crate::methods::MethodOptions`]).
+pub type RawOptions = BTreeMap<String, BTreeMap<String, OptionValue>>;
+
+/// One option value as written by the user.
+#[derive(Debug, Clone, PartialEq)]
+pub enum OptionValue {
+    /// `true` / `false`.
+    Bool(bool),
+    /// An integer.
+    Int(i64),
+    /// A float.
+    Float(f64),
+    /// A string (also every `--opt` value that is not a number or bool).
+    Str(String),
+}
+
+impl std::fmt::Display for OptionValue {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            OptionValue::Bool(b) => write!(f, "{b}"),
+            OptionValue::Int(i) => write!(f, "{i}"),
+            OptionValue::Float(x) => write!(f, "{x}"),
+            OptionValue::Str(s) => write!(f, "{s:?}"),
+        }
+    }
+}
+
+/// A validated scene, ready to render.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scene {
+    /// The scene file path or the built-in scene's name (used in every error message).
+    pub source: String,
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// The camera.
+    pub camera: Camera,
+    /// The single area light.
+    pub light: Light,
+    /// The shadow-casting and receiving meshes (every mesh does both).
+    pub meshes: Vec<Mesh>,
+    /// Methods to run; `None` = every method that supports the light shape.
+    pub methods: Option<Vec<String>>,
+    /// Per-method options, not yet validated against each method's keys.
+    pub options: RawOptions,
+    /// Ambient term of the shaded image, in [0,1].
+    pub ambient: f32,
+}
+
+impl Scene {
+    /// Axis-aligned bounds (min, max) of all mesh vertices and the light center.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let mut lo = self.light.center;
+        let mut hi = self.light.center;
+        for m in &self.meshes {
+            for p in &m.positions {
+                lo = lo.min(*p);
+                hi = hi.max(*p);
+            }
+        }
+        (lo, hi)
+    }
+}
