@@ -1,1 +1,3 @@
 //! Geometry preparation: mesh adjacency, possible silhouettes, loops, shadow volumes.
+
+pub mod adjacency;
