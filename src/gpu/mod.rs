@@ -1,3 +1,19 @@
 //! The emulated GPU pipeline (DESIGN.md "The emulated GPU: the bit-exactness contract").
+//!
+//! Each rule of the contract is defined once, here:
+//! [`transform`] (camera, infinite-far projection, viewport), [`clip`] (homogeneous clipping),
+//! [`fixed`] (sub-pixel snapping), [`setup`] (edge functions, fill rule, facing, depth plane),
+//! [`tiling`] and [`raster`] (tile traversal, parallel draw), [`depth`] and [`stencil`]
+//! (fixed-function tests and ops), [`buffers`] (typed, counted per-tile storage and
+//! hierarchical Z), [`counters`].
 
+pub mod buffers;
+pub mod clip;
 pub mod counters;
+pub mod depth;
+pub mod fixed;
+pub mod raster;
+pub mod setup;
+pub mod stencil;
+pub mod tiling;
+pub mod transform;

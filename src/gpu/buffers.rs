@@ -1,0 +1,131 @@
+//! Typed per-tile buffers (DESIGN.md "Buffers", "Counters", "Hierarchical Z"). Every access
+//! goes through these types, which add the bytes moved to the caller's [`Counters`].
+//!
+//! Storage is tile-major (see [`super::tiling`]): one value per sample of a T×T tile.
+
+use super::counters::Counters;
+use super::depth::{DepthFormat, DepthState};
+use super::raster::Fragment;
+use super::setup::RasterTriangle;
+use super::stencil::StencilState;
+use super::tiling::Tiling;
+
+/// The depth samples of one tile, plus its hierarchical-Z bounds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DepthTile {
+    /// Storage format.
+    pub format: DepthFormat,
+    /// Stored values (see [`DepthFormat::quantize`]).
+    pub values: Vec<u32>,
+    /// Smallest stored value over the tile's pixels inside the image (valid after
+    /// [`DepthTile::build_hiz`]).
+    pub zmin: u32,
+    /// Largest stored value over the tile's pixels inside the image.
+    pub zmax: u32,
+}
+
+impl DepthTile {
+    /// A tile of `len` samples cleared to depth 1.0.
+    pub fn cleared(format: DepthFormat, len: usize) -> Self {
+        let far = format.far();
+        Self {
+            format,
+            values: vec![far; len],
+            zmin: far,
+            zmax: far,
+        }
+    }
+
+    /// Read sample `i` (counted).
+    #[inline]
+    pub fn read(&self, i: usize, c: &mut Counters) -> u32 {
+        c.depth_read_bytes += self.format.bytes();
+        self.values[i]
+    }
+
+    /// Write sample `i` (counted).
+    #[inline]
+    pub fn write(&mut self, i: usize, v: u32, c: &mut Counters) {
+        c.depth_write_bytes += self.format.bytes();
+        self.values[i] = v;
+    }
+
+    /// Compute zmin/zmax over the pixels of tile `t` that lie inside the image (Paper II §4:
+    /// built once after the scene pass; wedges and shadow volumes never write depth).
+    pub fn build_hiz(&mut self, tiling: &Tiling, t: usize) {
+        let r = tiling.rect(t);
+        let mut lo = u32::MAX;
+        let mut hi = 0;
+        for y in r.y0..r.y1 {
+            for x in r.x0..r.x1 {
+                let v = self.values[tiling.local(x, y)];
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+        }
+        self.zmin = lo;
+        self.zmax = hi;
+    }
+
+    /// The depth test of fragment `f` against this tile (reads the stored value, counted).
+    /// Returns (passed, quantized fragment depth).
+    #[inline]
+    pub fn test(&self, state: &DepthState, f: &Fragment, c: &mut Counters) -> (bool, u32) {
+        let z = self.format.quantize(f.z);
+        let stored = self.read(f.local, c);
+        (state.func.test(z, stored), z)
+    }
+
+    /// Hierarchical-Z rejection for a LESS test against this tile: true when every sample of
+    /// the triangle is at or behind every stored sample (triangle zmin ≥ tile zmax), i.e. no
+    /// fragment of it can pass. Reads the tile's zmax (not counted as depth traffic: on-chip).
+    pub fn rejects_less(&self, tri: &RasterTriangle) -> bool {
+        self.format.quantize(tri.z_range[0]) >= self.zmax
+    }
+}
+
+/// The 8-bit stencil samples of one tile.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct StencilTile {
+    /// Stored values.
+    pub values: Vec<u8>,
+}
+
+impl StencilTile {
+    /// A tile of `len` samples cleared to `value`.
+    pub fn cleared(value: u8, len: usize) -> Self {
+        Self {
+            values: vec![value; len],
+        }
+    }
+
+    /// Apply the stencil state to fragment `f` of a triangle with the given facing, given the
+    /// depth-test outcome. Reads and (when the value changes or an op writes) writes are
+    /// counted; clamps and wraps are counted as overflow events.
+    #[inline]
+    pub fn apply(
+        &mut self,
+        state: &StencilState,
+        front_facing: bool,
+        f: &Fragment,
+        depth_pass: bool,
+        c: &mut Counters,
+    ) {
+        let face = state.face(front_facing);
+        c.stencil_read_bytes += 1;
+        let stored = self.values[f.local];
+        let stencil_pass = face.func.test(face.reference, stored, face.read_mask);
+        if let Some((v, overflow)) = face.update(stored, stencil_pass, depth_pass) {
+            c.stencil_write_bytes += 1;
+            c.overflow_events += overflow as u64;
+            self.values[f.local] = v;
+        }
+    }
+}
+
+/// Allocate one tile-storage value per tile with `make(tile_index, samples_per_tile)`.
+pub fn alloc_tiles<T>(tiling: &Tiling, make: impl Fn(usize, usize) -> T) -> Vec<T> {
+    (0..tiling.tile_count())
+        .map(|t| make(t, tiling.tile_len()))
+        .collect()
+}

@@ -1,0 +1,145 @@
+//! Homogeneous clipping (DESIGN.md "Projection": homogeneous clipping handles w = 0, far
+//! clipping stays on).
+//!
+//! Triangles are clipped in clip space against six planes: near `z + w ≥ 0`, far `w − z ≥ 0`
+//! (points at infinity have z = w and stay inside), and a guard band
+//! `|x|, |y| ≤ GUARD_BAND·w` instead of the viewport sides, like hardware guard-band clipping:
+//! edges that cross the viewport are never moved, while vertices at infinity (w = 0, which lie
+//! outside every guard plane unless x = y = 0) become finite.
+//!
+//! Watertightness: an intersection point is always computed from the edge's inside vertex
+//! toward its outside vertex, in f64, then rounded to f32. Two triangles sharing an edge
+//! therefore get bit-identical new vertices on it. The clipped polygon is fanned from its first
+//! vertex. Vertices that end with w ≤ 0 (only the degenerate direction x = y = 0, z = w = 0
+//! can) cause the polygon to be dropped.
+
+use super::transform::ClipVertex;
+use crate::limits::GUARD_BAND;
+
+/// Signed distances of a vertex to the six clip planes (inside ≥ 0).
+#[inline]
+fn plane_distance(plane: usize, v: &[f64; 4]) -> f64 {
+    let [x, y, z, w] = *v;
+    match plane {
+        0 => z + w,              // near
+        1 => w - z,              // far
+        2 => x + GUARD_BAND * w, // left guard band
+        3 => GUARD_BAND * w - x, // right guard band
+        4 => y + GUARD_BAND * w, // bottom guard band
+        _ => GUARD_BAND * w - y, // top guard band
+    }
+}
+
+fn to_f64(v: ClipVertex) -> [f64; 4] {
+    v.0.map(|c| c as f64)
+}
+
+/// Whether all three vertices are inside all planes (the fast path: no clipping needed).
+pub fn fully_inside(tri: &[ClipVertex; 3]) -> bool {
+    tri.iter().all(|v| {
+        let v = to_f64(*v);
+        (0..6).all(|p| plane_distance(p, &v) >= 0.0) && v[3] > 0.0
+    })
+}
+
+/// Clip a triangle; returns the clipped convex polygon (0, or 3 to 9 vertices), in order.
+pub fn clip_triangle(tri: &[ClipVertex; 3]) -> Vec<ClipVertex> {
+    let mut poly: Vec<ClipVertex> = tri.to_vec();
+    for plane in 0..6 {
+        if poly.is_empty() {
+            break;
+        }
+        let d: Vec<f64> = poly
+            .iter()
+            .map(|v| plane_distance(plane, &to_f64(*v)))
+            .collect();
+        if d.iter().all(|&x| x >= 0.0) {
+            continue;
+        }
+        let mut out = Vec::with_capacity(poly.len() + 1);
+        for i in 0..poly.len() {
+            let j = (i + 1) % poly.len();
+            let (a, b) = (poly[i], poly[j]);
+            let (da, db) = (d[i], d[j]);
+            if da >= 0.0 {
+                out.push(a);
+            }
+            if (da >= 0.0) != (db >= 0.0) {
+                out.push(if da >= 0.0 {
+                    intersect(a, da, b, db)
+                } else {
+                    intersect(b, db, a, da)
+                });
+            }
+        }
+        poly = out;
+    }
+    if poly.len() < 3 || poly.iter().any(|v| v.0[3] <= 0.0) {
+        return Vec::new();
+    }
+    poly
+}
+
+/// The point where the edge from `inside` (distance `di` ≥ 0) to `outside` (`do_` < 0) crosses
+/// the plane, computed from the inside vertex so shared edges clip identically.
+fn intersect(inside: ClipVertex, di: f64, outside: ClipVertex, do_: f64) -> ClipVertex {
+    let t = di / (di - do_);
+    let a = to_f64(inside);
+    let b = to_f64(outside);
+    ClipVertex(std::array::from_fn(|k| (a[k] + t * (b[k] - a[k])) as f32))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inside_triangle_is_unchanged() {
+        let t = [
+            ClipVertex([0.0, 0.0, 0.0, 1.0]),
+            ClipVertex([0.5, 0.0, 0.0, 1.0]),
+            ClipVertex([0.0, 0.5, 0.0, 1.0]),
+        ];
+        assert!(fully_inside(&t));
+        assert_eq!(clip_triangle(&t), t.to_vec());
+    }
+
+    #[test]
+    fn vertex_at_infinity_becomes_finite() {
+        let t = [
+            ClipVertex([0.0, 0.0, 0.0, 1.0]),
+            ClipVertex([0.5, 0.0, 0.0, 1.0]),
+            ClipVertex([1.0, 0.2, 1.0, 0.0]),
+        ];
+        let p = clip_triangle(&t);
+        assert!(p.len() >= 3);
+        for v in &p {
+            assert!(v.0[3] > 0.0);
+            assert!(v.0[0].abs() <= GUARD_BAND as f32 * v.0[3] * 1.0001);
+        }
+    }
+
+    #[test]
+    fn behind_near_plane_is_dropped() {
+        let t = [
+            ClipVertex([0.0, 0.0, -2.0, 1.0]),
+            ClipVertex([0.5, 0.0, -2.0, 1.0]),
+            ClipVertex([0.0, 0.5, -2.0, 1.0]),
+        ];
+        assert!(clip_triangle(&t).is_empty());
+    }
+
+    #[test]
+    fn shared_edge_clips_identically_from_both_sides() {
+        let a = ClipVertex([0.1, 0.1, -3.0, 1.0]);
+        let b = ClipVertex([0.3, -0.2, 0.5, 1.0]);
+        let t1 = [a, b, ClipVertex([0.9, 0.9, 0.5, 1.0])];
+        let t2 = [b, a, ClipVertex([-0.9, -0.9, 0.5, 1.0])];
+        let p1 = clip_triangle(&t1);
+        let p2 = clip_triangle(&t2);
+        // The only vertices both polygons share are b and the clipped point on edge a–b.
+        let common: Vec<_> = p1.iter().filter(|v| p2.contains(v)).collect();
+        assert_eq!(common.len(), 2, "{p1:?} {p2:?}");
+        assert!(common.contains(&&b));
+    }
+}

@@ -1,0 +1,173 @@
+//! Binning and tile traversal (after Mesa's `lp_rast_tri.c`), and the parallel draw loop.
+//!
+//! Triangles are binned to the tiles their bounding box touches, in submission order. Tiles run
+//! in parallel (rayon); inside a tile, triangles are processed strictly in submission order and
+//! samples in row-major order, so every buffer's final bits are independent of the number of
+//! threads. Per tile, each edge function is evaluated at the tile's four corner samples: a
+//! tile outside one edge is skipped, a tile inside all three is filled without per-sample
+//! tests (edge functions are linear, so corners bound the whole tile).
+
+use super::counters::Counters;
+use super::setup::RasterTriangle;
+use super::tiling::{TileRect, Tiling};
+use rayon::prelude::*;
+
+/// One covered sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fragment {
+    /// Pixel column.
+    pub x: u32,
+    /// Pixel row (0 at the top).
+    pub y: u32,
+    /// Index of the pixel inside its tile's storage.
+    pub local: usize,
+    /// Interpolated window depth (f32, unclamped).
+    pub z: f32,
+}
+
+/// Per-tile lists of triangle indices, in submission order.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Bins {
+    /// `tiles[t]` lists the triangles whose bounding box touches tile t.
+    pub tiles: Vec<Vec<u32>>,
+}
+
+/// Bin triangles to tiles by bounding box.
+pub fn bin(tiling: &Tiling, tris: &[RasterTriangle]) -> Bins {
+    let mut tiles = vec![Vec::new(); tiling.tile_count()];
+    for (k, t) in tris.iter().enumerate() {
+        let [x0, y0, x1, y1] = t.bbox;
+        for ty in y0 / tiling.tile..=y1 / tiling.tile {
+            for tx in x0 / tiling.tile..=x1 / tiling.tile {
+                tiles[(ty * tiling.tiles_x + tx) as usize].push(k as u32);
+            }
+        }
+    }
+    Bins { tiles }
+}
+
+/// How a triangle relates to a tile.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum TileCoverage {
+    Outside,
+    Partial,
+    Full,
+}
+
+fn classify(t: &RasterTriangle, r: &TileRect) -> TileCoverage {
+    let corners = [
+        (r.x0 as i64, r.y0 as i64),
+        (r.x1 as i64 - 1, r.y0 as i64),
+        (r.x0 as i64, r.y1 as i64 - 1),
+        (r.x1 as i64 - 1, r.y1 as i64 - 1),
+    ];
+    let mut full = true;
+    for e in &t.edges {
+        let vals = corners.map(|(i, j)| e.at(i, j));
+        if vals.iter().all(|&v| v < 0) {
+            return TileCoverage::Outside;
+        }
+        if vals.iter().any(|&v| v < 0) {
+            full = false;
+        }
+    }
+    if full {
+        TileCoverage::Full
+    } else {
+        TileCoverage::Partial
+    }
+}
+
+/// Visit the covered samples of triangle `t` inside tile rectangle `r`, in row-major order.
+/// Returns (whether the tile was visited, number of fragments generated).
+pub fn rasterize_in_tile(
+    tiling: &Tiling,
+    t: &RasterTriangle,
+    r: &TileRect,
+    mut visit: impl FnMut(Fragment),
+) -> (bool, u64) {
+    let [bx0, by0, bx1, by1] = t.bbox;
+    let x0 = r.x0.max(bx0);
+    let y0 = r.y0.max(by0);
+    let x1 = r.x1.min(bx1 + 1);
+    let y1 = r.y1.min(by1 + 1);
+    if x0 >= x1 || y0 >= y1 {
+        return (false, 0);
+    }
+    let sub = TileRect { x0, y0, x1, y1 };
+    let coverage = classify(t, &sub);
+    if coverage == TileCoverage::Outside {
+        return (true, 0);
+    }
+    let mut n = 0u64;
+    let [e0, e1, e2] = t.edges;
+    for y in y0..y1 {
+        let j = y as i64;
+        let mut v0 = e0.at(x0 as i64, j);
+        let mut v1 = e1.at(x0 as i64, j);
+        let mut v2 = e2.at(x0 as i64, j);
+        for x in x0..x1 {
+            if coverage == TileCoverage::Full || (v0 | v1 | v2) >= 0 {
+                n += 1;
+                visit(Fragment {
+                    x,
+                    y,
+                    local: tiling.local(x, y),
+                    z: t.depth_at(x, y),
+                });
+            }
+            v0 += e0.a;
+            v1 += e1.a;
+            v2 += e2.a;
+        }
+    }
+    (true, n)
+}
+
+/// Run `fragment` for every covered sample of every triangle, tiles in parallel, triangles in
+/// submission order within a tile. `tiles[t]` is the method's per-tile storage for tile t.
+/// `skip_tile(t, storage, tri)` may reject a (tile, triangle) pair before traversal (used for
+/// hierarchical-Z culling; count the rejection in the counters it is given).
+/// Returns the counters summed over tiles.
+pub fn draw<T, S, F>(
+    tiling: &Tiling,
+    tiles: &mut [T],
+    tris: &[RasterTriangle],
+    bins: &Bins,
+    skip_tile: S,
+    fragment: F,
+) -> Counters
+where
+    T: Send,
+    S: Fn(usize, &T, &RasterTriangle, &mut Counters) -> bool + Sync,
+    F: Fn(usize, &mut T, &RasterTriangle, Fragment, &mut Counters) + Sync,
+{
+    assert_eq!(tiles.len(), tiling.tile_count());
+    tiles
+        .par_iter_mut()
+        .enumerate()
+        .map(|(t, storage)| {
+            let mut c = Counters::default();
+            let rect = tiling.rect(t);
+            for &k in &bins.tiles[t] {
+                let tri = &tris[k as usize];
+                if skip_tile(t, storage, tri, &mut c) {
+                    continue;
+                }
+                let (visited, n) =
+                    rasterize_in_tile(tiling, tri, &rect, |f| fragment(t, storage, tri, f, &mut c));
+                c.tiles_visited += visited as u64;
+                c.fragments_rasterized += n;
+            }
+            c
+        })
+        .reduce(Counters::default, |mut a, b| {
+            a += b;
+            a
+        })
+}
+
+/// A `skip_tile` that never skips.
+pub fn no_tile_culling<T>(_: usize, _: &T, _: &RasterTriangle, _: &mut Counters) -> bool {
+    false
+}

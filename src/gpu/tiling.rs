@@ -1,0 +1,140 @@
+//! Screen tiling (DESIGN.md "Rasterization": triangles are traversed per tile; tile size is a
+//! power of two from 2 to 256, default 8×8).
+//!
+//! Every per-pixel buffer is stored tile-major: tile t owns the contiguous slice
+//! `[t·T², (t+1)·T²)`, row-major inside the tile, padded at the image's right and bottom
+//! borders. Tiles therefore hand out disjoint `&mut` storage to rayon workers without locks.
+
+use crate::limits::{MAX_TILE_SIZE, MIN_TILE_SIZE};
+
+/// How a `width`×`height` image is cut into `tile`×`tile` tiles.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct Tiling {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Tile edge in pixels (power of two in [MIN_TILE_SIZE, MAX_TILE_SIZE]).
+    pub tile: u32,
+    /// Tiles per row.
+    pub tiles_x: u32,
+    /// Tile rows.
+    pub tiles_y: u32,
+}
+
+/// The pixel rectangle `[x0, x1) × [y0, y1)` of one tile, clipped to the image.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TileRect {
+    /// First column.
+    pub x0: u32,
+    /// First row.
+    pub y0: u32,
+    /// One past the last column.
+    pub x1: u32,
+    /// One past the last row.
+    pub y1: u32,
+}
+
+impl Tiling {
+    /// A tiling; `tile` must be a power of two in [2, 256].
+    pub fn new(width: u32, height: u32, tile: u32) -> Result<Self, String> {
+        if !tile.is_power_of_two() || !(MIN_TILE_SIZE..=MAX_TILE_SIZE).contains(&tile) {
+            return Err(format!(
+                "tile size {tile} is not a power of two in {MIN_TILE_SIZE}..={MAX_TILE_SIZE}"
+            ));
+        }
+        Ok(Self {
+            width,
+            height,
+            tile,
+            tiles_x: width.div_ceil(tile),
+            tiles_y: height.div_ceil(tile),
+        })
+    }
+
+    /// Number of tiles.
+    pub fn tile_count(&self) -> usize {
+        (self.tiles_x * self.tiles_y) as usize
+    }
+
+    /// Samples stored per tile (T², padding included).
+    pub fn tile_len(&self) -> usize {
+        (self.tile * self.tile) as usize
+    }
+
+    /// Pixel rectangle of tile `t`.
+    pub fn rect(&self, t: usize) -> TileRect {
+        let tx = t as u32 % self.tiles_x;
+        let ty = t as u32 / self.tiles_x;
+        let x0 = tx * self.tile;
+        let y0 = ty * self.tile;
+        TileRect {
+            x0,
+            y0,
+            x1: (x0 + self.tile).min(self.width),
+            y1: (y0 + self.tile).min(self.height),
+        }
+    }
+
+    /// Index of the tile containing pixel (x, y).
+    pub fn tile_of(&self, x: u32, y: u32) -> usize {
+        ((y / self.tile) * self.tiles_x + x / self.tile) as usize
+    }
+
+    /// Index of pixel (x, y) inside its tile's storage.
+    #[inline]
+    pub fn local(&self, x: u32, y: u32) -> usize {
+        ((y % self.tile) * self.tile + x % self.tile) as usize
+    }
+
+    /// Reorder tile-major storage into a row-major image (row 0 at the top).
+    pub fn to_row_major<T: Copy>(&self, tiled: &[T]) -> Vec<T> {
+        let mut out = Vec::with_capacity((self.width * self.height) as usize);
+        for y in 0..self.height {
+            for x in 0..self.width {
+                out.push(tiled[self.tile_of(x, y) * self.tile_len() + self.local(x, y)]);
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rejects_bad_sizes() {
+        assert!(Tiling::new(10, 10, 3).is_err());
+        assert!(Tiling::new(10, 10, 1).is_err());
+        assert!(Tiling::new(10, 10, 512).is_err());
+        assert!(Tiling::new(10, 10, 256).is_ok());
+    }
+
+    #[test]
+    fn border_tiles_are_clipped() {
+        let t = Tiling::new(10, 6, 4).unwrap();
+        assert_eq!((t.tiles_x, t.tiles_y), (3, 2));
+        assert_eq!(
+            t.rect(5),
+            TileRect {
+                x0: 8,
+                y0: 4,
+                x1: 10,
+                y1: 6
+            }
+        );
+    }
+
+    #[test]
+    fn row_major_round_trip() {
+        let t = Tiling::new(5, 3, 2).unwrap();
+        let mut tiled = vec![u32::MAX; t.tile_count() * t.tile_len()];
+        for y in 0..3 {
+            for x in 0..5 {
+                tiled[t.tile_of(x, y) * t.tile_len() + t.local(x, y)] = y * 5 + x;
+            }
+        }
+        assert_eq!(t.to_row_major(&tiled), (0..15).collect::<Vec<_>>());
+    }
+}

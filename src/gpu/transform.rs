@@ -1,0 +1,166 @@
+//! Camera and projection (DESIGN.md "Coordinates", "Projection", "Viewport").
+//!
+//! * View matrix as `gluLookAt`, right-handed world.
+//! * Everitt–Kilgard infinite-far projection
+//!   `P = [[f/a,0,0,0],[0,f,0,0],[0,0,-1,-2n],[0,0,-1,0]]`, f = 1/tan(vfov/2), a = W/H.
+//!   A point extruded to infinity (w = 0) gets z_clip = w_clip, i.e. window depth exactly 1
+//!   (D24 0xFFFFFF).
+//! * Clip coordinates are computed as (P·V)·X in f64 and rounded once to f32 ([`ClipVertex`]).
+//! * Viewport: `x_w = (x/w + 1)·W/2` and `y_gl = (y/w + 1)·H/2` in f32, OpenGL's y pointing up;
+//!   image row j is GL row H−1−j (the flip is done exactly in fixed point, see [`super::fixed`]).
+//!   `z_w = (z/w)·0.5 + 0.5` in f32.
+
+use crate::scene::{Camera, Scene};
+use glam::{DMat4, DVec3, DVec4, Vec3};
+
+/// A vertex in homogeneous clip space, f32 as a GPU's vertex stage would output it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClipVertex(pub [f32; 4]);
+
+/// Default near distance when the scene gives none: 1/1000 of the distance from the eye to
+/// the farthest corner of the scene bounds (light included). Chosen so that D24 keeps
+/// ~10 bits of depth resolution across a scene of that size with the infinite far plane.
+pub fn default_near(camera: &Camera, bounds: (Vec3, Vec3)) -> f64 {
+    let (lo, hi) = (bounds.0.as_dvec3(), bounds.1.as_dvec3());
+    let mut far = 0.0f64;
+    for i in 0..8 {
+        let c = DVec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        );
+        far = far.max((c - camera.eye).length());
+    }
+    (far * 1e-3).max(1e-6)
+}
+
+/// The camera transform of one frame: view, projection and their product, in f64.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Projection {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Near-plane distance actually used.
+    pub near: f64,
+    /// P·V.
+    pub view_proj: DMat4,
+    /// (P·V)⁻¹, for un-projecting depth-buffer points.
+    pub inv_view_proj: DMat4,
+}
+
+impl Projection {
+    /// The projection of `scene`'s camera at the scene's image size.
+    pub fn for_scene(scene: &Scene) -> Self {
+        let near = scene
+            .camera
+            .near
+            .unwrap_or_else(|| default_near(&scene.camera, scene.bounds()));
+        Self::new(&scene.camera, scene.width, scene.height, near)
+    }
+
+    /// The projection of `camera` for a `width`×`height` image with near plane `near`.
+    pub fn new(camera: &Camera, width: u32, height: u32, near: f64) -> Self {
+        let view = DMat4::look_at_rh(camera.eye, camera.target, camera.up);
+        let f = 1.0 / (camera.vfov_deg.to_radians() * 0.5).tan();
+        let a = width as f64 / height as f64;
+        // Column-major: columns of P.
+        let proj = DMat4::from_cols(
+            DVec4::new(f / a, 0.0, 0.0, 0.0),
+            DVec4::new(0.0, f, 0.0, 0.0),
+            DVec4::new(0.0, 0.0, -1.0, -1.0),
+            DVec4::new(0.0, 0.0, -2.0 * near, 0.0),
+        );
+        let view_proj = proj * view;
+        Self {
+            width,
+            height,
+            near,
+            view_proj,
+            inv_view_proj: view_proj.inverse(),
+        }
+    }
+
+    /// Clip coordinates of the world point `p` (w = 1), rounded once to f32.
+    pub fn clip_point(&self, p: Vec3) -> ClipVertex {
+        round_clip(self.view_proj * p.as_dvec3().extend(1.0))
+    }
+
+    /// Clip coordinates of the point at infinity in direction `d` (w = 0), rounded once to f32.
+    pub fn clip_direction(&self, d: DVec3) -> ClipVertex {
+        round_clip(self.view_proj * d.extend(0.0))
+    }
+
+    /// The world point seen at the center of pixel (`x`, `y`) (row 0 at the top) at window depth
+    /// `z_w` in [0,1]: the inverse of the viewport and projection, in f64.
+    pub fn unproject(&self, x: u32, y: u32, z_w: f64) -> DVec3 {
+        let ndc_x = (x as f64 + 0.5) / self.width as f64 * 2.0 - 1.0;
+        let ndc_y = 1.0 - (y as f64 + 0.5) / self.height as f64 * 2.0;
+        let ndc_z = z_w * 2.0 - 1.0;
+        let h = self.inv_view_proj * DVec4::new(ndc_x, ndc_y, ndc_z, 1.0);
+        h.truncate() / h.w
+    }
+}
+
+fn round_clip(v: DVec4) -> ClipVertex {
+    ClipVertex([v.x as f32, v.y as f32, v.z as f32, v.w as f32])
+}
+
+/// Window coordinates of a clip vertex with w > 0, in f32 and OpenGL orientation (y up):
+/// `(x/w + 1)·W/2`, `(y/w + 1)·H/2`, `(z/w)·0.5 + 0.5`.
+pub fn viewport(v: ClipVertex, width: u32, height: u32) -> [f32; 3] {
+    let [x, y, z, w] = v.0;
+    let xn = x / w;
+    let yn = y / w;
+    let zn = z / w;
+    [
+        (xn + 1.0) * (width as f32 * 0.5),
+        (yn + 1.0) * (height as f32 * 0.5),
+        zn * 0.5 + 0.5,
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cam() -> Camera {
+        Camera {
+            eye: DVec3::new(0.0, 0.0, 5.0),
+            target: DVec3::ZERO,
+            up: DVec3::Y,
+            vfov_deg: 90.0,
+            near: Some(0.5),
+        }
+    }
+
+    #[test]
+    fn point_at_infinity_has_depth_exactly_one() {
+        let p = Projection::new(&cam(), 64, 64, 0.5);
+        for d in [DVec3::new(0.1, 0.2, -1.0), DVec3::new(-3.0, 1.0, -0.5)] {
+            let v = p.clip_direction(d);
+            assert_eq!(v.0[2], v.0[3]);
+            assert_eq!(viewport(v, 64, 64)[2], 1.0);
+        }
+    }
+
+    #[test]
+    fn near_plane_maps_to_depth_zero_and_center_to_middle() {
+        let p = Projection::new(&cam(), 64, 32, 0.5);
+        let v = p.clip_point(Vec3::new(0.0, 0.0, 4.5));
+        let w = viewport(v, 64, 32);
+        assert_eq!(w, [32.0, 16.0, 0.0]);
+    }
+
+    #[test]
+    fn unproject_inverts_projection() {
+        let p = Projection::new(&cam(), 64, 64, 0.5);
+        let x = Vec3::new(0.3, -0.7, 1.0);
+        let w = viewport(p.clip_point(x), 64, 64);
+        // Pixel containing the point, then un-project at its own depth: lands within a pixel.
+        let px = w[0].floor() as u32;
+        let py = 64 - 1 - w[1].floor() as u32;
+        let back = p.unproject(px, py, w[2] as f64);
+        assert!((back - x.as_dvec3()).length() < 0.1, "{back:?}");
+    }
+}
