@@ -1,1 +1,13 @@
-//! Light shapes and their sampling.
+//! Light shapes and their sampling (DESIGN.md "Layout": `light/`).
+//!
+//! The shapes themselves are defined with the scene ([`crate::scene::LightShape`]); this module
+//! holds what the methods compute *on* a light:
+//!
+//! - [`sampling`]: stratified point samples with per-channel weights — the light positions of
+//!   the papers' N-sample reference (Paper III §5.1) and of the ray-cast ground truth; sphere
+//!   lights are sampled as the disk through their center facing the receiver (Paper IV §4.2.1).
+//!
+//! Exact clipping, analytic coverage and the coverage lookup tables (Papers III, IV) belong
+//! here too as they are added.
+
+pub mod sampling;
