@@ -6,6 +6,7 @@
 //! [`Scene`] has been validated ([`validate`]): finite numbers, non-degenerate light and
 //! camera, closed two-manifold meshes.
 
+pub mod procedural;
 
 use glam::{DVec3, Vec3};
 use std::collections::BTreeMap;
@@ -53,7 +54,11 @@ pub enum LightShape {
     Rect { u: Vec3, v: Vec3 },
     /// A rectangle like [`LightShape::Rect`] whose emission is an RGB texture (Paper III §3.3);
     /// texel (0,0) is at `center − u + v` (top-left), texel columns run along `u`.
-    TexturedRect { u: Vec3, v: Vec3, texture: RgbTexture },
+    TexturedRect {
+        u: Vec3,
+        v: Vec3,
+        texture: RgbTexture,
+    },
 }
 
 impl LightShape {
