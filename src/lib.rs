@@ -12,6 +12,7 @@
 
 pub mod error;
 pub mod geometry;
+pub mod golden;
 pub mod gpu;
 pub mod light;
 pub mod limits;

@@ -1,1 +1,739 @@
-//! Writing a method's outputs to disk.
+//! Writing a method's outputs to disk (DESIGN.md "The flow of one frame", issue 2 "Outputs").
+//!
+//! One method's results go to `DIR/METHOD/`:
+//!
+//! | file | contents |
+//! |---|---|
+//! | `image.png` | the shaded image, linear RGB → 8-bit sRGB ([`linear_to_srgb8`]) |
+//! | `visibility.png` | 16-bit PNG, `round(v·65535)`: grayscale for [`Visibility::Gray`], RGB for [`Visibility::Rgb`] |
+//! | `visibility.exr` | OpenEXR, RGB f32 (gray replicated into the three channels) |
+//! | `visibility.pfm` | PFM with the exact f32 bits (`Pf` gray / `PF` RGB) — what goldens compare |
+//! | `<name>.png` | each [`RawImage8`] (e.g. `hard-sv`'s `stencil.png`), 8-bit grayscale, values as stored |
+//! | `stats.json` | [`MethodStats`] as pretty-printed JSON |
+//!
+//! **No partial output** (DESIGN.md "Bad input"): every file is encoded in memory first, so
+//! an encoding error writes nothing; then each file is written to a hidden temporary name in
+//! the destination directory and all are renamed into place only once every write succeeded
+//! (see [`write_files_all_or_nothing`]).
+//!
+//! All images are row-major with row 0 at the top, like [`Visibility`].
+
+use crate::methods::output::{MethodOutput, RawImage8, Visibility};
+use image::codecs::openexr::OpenExrEncoder;
+use image::codecs::png::PngEncoder;
+use image::{ExtendedColorType, ImageEncoder};
+use std::io::{self, Cursor};
+use std::path::{Path, PathBuf};
+
+/// Converts one linear-light value to an 8-bit sRGB code with the sRGB OETF
+/// (IEC 61966-2-1): `12.92·x` for `x ≤ 0.0031308`, else `1.055·x^(1/2.4) − 0.055`.
+///
+/// The input is clamped to [0,1] first (NaN maps to 0). The curve is evaluated in f64 and the
+/// code is `round_half_even(255·y)`: ties go to the even code, the same rounding rule the
+/// emulated GPU uses for its quantizations. `powf` comes from the platform's libm, so this is
+/// used only for viewing images (the shaded `image.png`, diff panels), never for goldens.
+pub fn linear_to_srgb8(x: f32) -> u8 {
+    let x = if x.is_nan() {
+        0.0
+    } else {
+        f64::from(x.clamp(0.0, 1.0))
+    };
+    let y = if x <= 0.003_130_8 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    };
+    (y * 255.0).round_ties_even().clamp(0.0, 255.0) as u8
+}
+
+/// Quantizes a visibility value to 16 bits: `round_half_even(clamp(v, 0, 1)·65535)`, NaN → 0.
+pub fn visibility_to_u16(v: f32) -> u16 {
+    let v = if v.is_nan() {
+        0.0
+    } else {
+        f64::from(v.clamp(0.0, 1.0))
+    };
+    (v * 65535.0).round_ties_even() as u16
+}
+
+/// Maps a visibility buffer to displayable 8-bit sRGB pixels (each channel through
+/// [`linear_to_srgb8`]; gray is replicated), e.g. for side-by-side comparisons.
+pub fn visibility_to_srgb8(vis: &Visibility) -> Vec<[u8; 3]> {
+    (0..vis.len())
+        .map(|i| vis.rgb(i).map(linear_to_srgb8))
+        .collect()
+}
+
+fn invalid(msg: String) -> io::Error {
+    io::Error::new(io::ErrorKind::InvalidInput, msg)
+}
+
+fn image_err(what: &str, e: image::ImageError) -> io::Error {
+    io::Error::other(format!("encoding {what}: {e}"))
+}
+
+fn pixel_count(width: u32, height: u32) -> io::Result<usize> {
+    usize::try_from(u64::from(width) * u64::from(height))
+        .map_err(|_| invalid(format!("image size {width}x{height} too large")))
+}
+
+fn check_len(what: &str, len: usize, width: u32, height: u32) -> io::Result<()> {
+    let n = pixel_count(width, height)?;
+    if len != n {
+        return Err(invalid(format!(
+            "{what} has {len} pixels, expected {width}x{height} = {n}"
+        )));
+    }
+    Ok(())
+}
+
+fn encode_png(
+    what: &str,
+    bytes: &[u8],
+    width: u32,
+    height: u32,
+    color: ExtendedColorType,
+) -> io::Result<Vec<u8>> {
+    let mut out = Vec::new();
+    PngEncoder::new(&mut out)
+        .write_image(bytes, width, height, color)
+        .map_err(|e| image_err(what, e))?;
+    Ok(out)
+}
+
+/// Encodes 8-bit RGB pixels (row 0 at the top) as a PNG file in memory.
+pub fn encode_rgb8_png(pixels: &[[u8; 3]], width: u32, height: u32) -> io::Result<Vec<u8>> {
+    check_len("RGB image", pixels.len(), width, height)?;
+    let bytes: Vec<u8> = pixels.iter().flatten().copied().collect();
+    encode_png("RGB PNG", &bytes, width, height, ExtendedColorType::Rgb8)
+}
+
+/// Encodes 8-bit grayscale values (row 0 at the top) as a PNG file in memory.
+pub fn encode_gray8_png(values: &[u8], width: u32, height: u32) -> io::Result<Vec<u8>> {
+    check_len("gray image", values.len(), width, height)?;
+    encode_png("gray PNG", values, width, height, ExtendedColorType::L8)
+}
+
+/// Decodes a PNG holding an 8-bit grayscale image into `(width, height, values)`; any other
+/// colour type or bit depth is an error (raw images are stored exactly, never converted).
+pub fn decode_gray8_png(bytes: &[u8]) -> Result<(u32, u32, Vec<u8>), String> {
+    let img = image::load_from_memory_with_format(bytes, image::ImageFormat::Png)
+        .map_err(|e| format!("decoding PNG: {e}"))?;
+    match img {
+        image::DynamicImage::ImageLuma8(g) => Ok((g.width(), g.height(), g.into_raw())),
+        other => Err(format!(
+            "expected an 8-bit grayscale PNG, found {:?}",
+            other.color()
+        )),
+    }
+}
+
+/// Encodes visibility as a 16-bit PNG ([`visibility_to_u16`]): grayscale for
+/// [`Visibility::Gray`], RGB for [`Visibility::Rgb`].
+pub fn encode_visibility_png16(vis: &Visibility, width: u32, height: u32) -> io::Result<Vec<u8>> {
+    check_len("visibility", vis.len(), width, height)?;
+    // `PngEncoder` takes 16-bit samples in native byte order and swaps them itself.
+    let (samples, color): (Vec<u16>, _) = match vis {
+        Visibility::Gray(v) => (
+            v.iter().map(|&x| visibility_to_u16(x)).collect(),
+            ExtendedColorType::L16,
+        ),
+        Visibility::Rgb(v) => (
+            v.iter().flat_map(|p| p.map(visibility_to_u16)).collect(),
+            ExtendedColorType::Rgb16,
+        ),
+    };
+    let bytes: Vec<u8> = samples.iter().flat_map(|s| s.to_ne_bytes()).collect();
+    encode_png("16-bit visibility PNG", &bytes, width, height, color)
+}
+
+/// Encodes visibility as an OpenEXR file (RGB, 32-bit float channels; gray is replicated)
+/// with `image`'s OpenEXR encoder.
+pub fn encode_visibility_exr(vis: &Visibility, width: u32, height: u32) -> io::Result<Vec<u8>> {
+    check_len("visibility", vis.len(), width, height)?;
+    let bytes: Vec<u8> = (0..vis.len())
+        .flat_map(|i| vis.rgb(i))
+        .flat_map(f32::to_ne_bytes)
+        .collect();
+    let mut out = Cursor::new(Vec::new());
+    OpenExrEncoder::new(&mut out)
+        .write_image(&bytes, width, height, ExtendedColorType::Rgb32F)
+        .map_err(|e| image_err("visibility EXR", e))?;
+    Ok(out.into_inner())
+}
+
+/// Encodes visibility as a Portable Float Map with the exact f32 bits.
+///
+/// The format: the header `Pf` (one channel, [`Visibility::Gray`]) or `PF` (three channels,
+/// [`Visibility::Rgb`]), then `WIDTH HEIGHT`, then the scale `-1.0` (negative means
+/// little-endian; its magnitude is unused here), each on its own line; then the raw samples,
+/// rows **bottom to top** as the format requires, each row left to right.
+///
+/// # Panics
+/// If `vis.len() != width·height`.
+pub fn encode_pfm(vis: &Visibility, width: u32, height: u32) -> Vec<u8> {
+    let w = width as usize;
+    let h = height as usize;
+    assert_eq!(
+        vis.len(),
+        w * h,
+        "visibility has {} pixels, expected {width}x{height}",
+        vis.len()
+    );
+    let (tag, channels) = match vis {
+        Visibility::Gray(_) => ("Pf", 1),
+        Visibility::Rgb(_) => ("PF", 3),
+    };
+    let header = format!("{tag}\n{width} {height}\n-1.0\n");
+    let mut out = Vec::with_capacity(header.len() + w * h * channels * 4);
+    out.extend_from_slice(header.as_bytes());
+    for y in (0..h).rev() {
+        let row = y * w..(y + 1) * w;
+        match vis {
+            Visibility::Gray(v) => {
+                for x in &v[row] {
+                    out.extend_from_slice(&x.to_le_bytes());
+                }
+            }
+            Visibility::Rgb(v) => {
+                for p in &v[row] {
+                    for c in p {
+                        out.extend_from_slice(&c.to_le_bytes());
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Decodes a Portable Float Map into `(width, height, visibility)`, row 0 at the top.
+///
+/// Accepts `Pf` (→ [`Visibility::Gray`]) and `PF` (→ [`Visibility::Rgb`]), header tokens
+/// separated by any ASCII whitespace, a negative scale (little-endian samples) or a positive
+/// one (big-endian samples), and exactly one whitespace byte before the samples. The samples'
+/// bits are kept as they are (no scaling, NaN payloads preserved). Trailing bytes are an
+/// error, as is a truncated file.
+pub fn read_pfm(bytes: &[u8]) -> Result<(u32, u32, Visibility), String> {
+    // Header: four whitespace-separated tokens, the last followed by one whitespace byte.
+    let mut pos = 0;
+    let mut tokens = Vec::with_capacity(4);
+    while tokens.len() < 4 {
+        while pos < bytes.len() && bytes[pos].is_ascii_whitespace() {
+            pos += 1;
+        }
+        let start = pos;
+        while pos < bytes.len() && !bytes[pos].is_ascii_whitespace() {
+            pos += 1;
+        }
+        if start == pos {
+            return Err("PFM: truncated header".to_string());
+        }
+        if pos - start > 32 {
+            return Err("PFM: header token too long".to_string());
+        }
+        tokens.push(String::from_utf8_lossy(&bytes[start..pos]).into_owned());
+    }
+    if pos >= bytes.len() {
+        // Zero-size images have no samples but still need the whitespace after the scale.
+        return Err("PFM: missing whitespace after the scale".to_string());
+    }
+    pos += 1;
+    let channels = match tokens[0].as_str() {
+        "Pf" => 1,
+        "PF" => 3,
+        t => {
+            return Err(format!(
+                "PFM: unknown magic {t:?} (expected \"Pf\" or \"PF\")"
+            ))
+        }
+    };
+    let width: u32 = tokens[1]
+        .parse()
+        .map_err(|_| format!("PFM: bad width {:?}", tokens[1]))?;
+    let height: u32 = tokens[2]
+        .parse()
+        .map_err(|_| format!("PFM: bad height {:?}", tokens[2]))?;
+    let scale: f64 = tokens[3]
+        .parse()
+        .map_err(|_| format!("PFM: bad scale {:?}", tokens[3]))?;
+    if !scale.is_finite() || scale == 0.0 {
+        return Err(format!(
+            "PFM: scale must be finite and non-zero, got {scale}"
+        ));
+    }
+    let little = scale < 0.0;
+    let w = width as usize;
+    let h = height as usize;
+    let expected = (w as u128) * (h as u128) * (channels as u128) * 4;
+    let data = &bytes[pos..];
+    if data.len() as u128 != expected {
+        return Err(format!(
+            "PFM: {width}x{height} with {channels} channel(s) needs {expected} bytes of samples, found {}",
+            data.len()
+        ));
+    }
+    let sample = |i: usize| {
+        let b = [
+            data[4 * i],
+            data[4 * i + 1],
+            data[4 * i + 2],
+            data[4 * i + 3],
+        ];
+        if little {
+            f32::from_le_bytes(b)
+        } else {
+            f32::from_be_bytes(b)
+        }
+    };
+    // File row r (from the bottom) is image row h − 1 − r.
+    let vis = if channels == 1 {
+        let mut v = vec![0.0f32; w * h];
+        for y in 0..h {
+            let r = h - 1 - y;
+            for x in 0..w {
+                v[y * w + x] = sample(r * w + x);
+            }
+        }
+        Visibility::Gray(v)
+    } else {
+        let mut v = vec![[0.0f32; 3]; w * h];
+        for y in 0..h {
+            let r = h - 1 - y;
+            for x in 0..w {
+                let s = 3 * (r * w + x);
+                v[y * w + x] = [sample(s), sample(s + 1), sample(s + 2)];
+            }
+        }
+        Visibility::Rgb(v)
+    };
+    Ok((width, height, vis))
+}
+
+/// Writes `files` (name, bytes) into `dir` with no partial output: `dir` is created if
+/// needed, every file is first written to a hidden temporary name in `dir`
+/// (`.NAME.tmp-PID`) and synced, and only when all writes succeeded are they renamed to their
+/// final names (a rename within one directory replaces the target atomically). On an error
+/// before the renames, the temporary files are removed and no final file is touched.
+pub fn write_files_all_or_nothing(dir: &Path, files: &[(String, Vec<u8>)]) -> io::Result<()> {
+    std::fs::create_dir_all(dir)?;
+    let pid = std::process::id();
+    let mut temps: Vec<(PathBuf, PathBuf)> = Vec::with_capacity(files.len());
+    let result = (|| -> io::Result<()> {
+        for (name, bytes) in files {
+            let fin = dir.join(name);
+            let tmp = dir.join(format!(".{name}.tmp-{pid}"));
+            temps.push((tmp.clone(), fin));
+            let mut f = std::fs::File::create(&tmp)?;
+            io::Write::write_all(&mut f, bytes)?;
+            f.sync_all()?;
+        }
+        Ok(())
+    })();
+    if let Err(e) = result {
+        for (tmp, _) in &temps {
+            let _ = std::fs::remove_file(tmp);
+        }
+        return Err(e);
+    }
+    for (tmp, fin) in &temps {
+        std::fs::rename(tmp, fin)?;
+    }
+    Ok(())
+}
+
+/// Encodes every output file of one method in memory: `(file name, bytes)` in a fixed order
+/// (see the module table). Nothing is written; errors (wrong buffer sizes, a raw image name
+/// that is not a plain file stem or collides with a standard output) come out here.
+pub fn encode_method_outputs(
+    out: &MethodOutput,
+    shaded: &[[f32; 3]],
+    width: u32,
+    height: u32,
+) -> io::Result<Vec<(String, Vec<u8>)>> {
+    check_len("shaded image", shaded.len(), width, height)?;
+    check_len("visibility", out.visibility.len(), width, height)?;
+    let srgb: Vec<[u8; 3]> = shaded.iter().map(|p| p.map(linear_to_srgb8)).collect();
+    let mut files = vec![
+        (
+            "image.png".to_string(),
+            encode_rgb8_png(&srgb, width, height)?,
+        ),
+        (
+            "visibility.png".to_string(),
+            encode_visibility_png16(&out.visibility, width, height)?,
+        ),
+        (
+            "visibility.exr".to_string(),
+            encode_visibility_exr(&out.visibility, width, height)?,
+        ),
+        (
+            "visibility.pfm".to_string(),
+            encode_pfm(&out.visibility, width, height),
+        ),
+    ];
+    for raw in &out.raw_images {
+        let name = raw_image_file_name(raw)?;
+        if files.iter().any(|(n, _)| *n == name) {
+            return Err(invalid(format!(
+                "raw image {:?} collides with another output file",
+                raw.name
+            )));
+        }
+        check_len(
+            &format!("raw image {:?}", raw.name),
+            raw.values.len(),
+            width,
+            height,
+        )?;
+        let png = encode_gray8_png(&raw.values, width, height)?;
+        files.push((name, png));
+    }
+    let mut json = serde_json::to_vec_pretty(&out.stats)
+        .map_err(|e| io::Error::other(format!("encoding stats.json: {e}")))?;
+    json.push(b'\n');
+    files.push(("stats.json".to_string(), json));
+    Ok(files)
+}
+
+/// The file name of a raw image, `<name>.png`; the name must be a plain, non-hidden file stem
+/// (ASCII letters, digits, `-`, `_`, not starting with `-`).
+pub fn raw_image_file_name(raw: &RawImage8) -> io::Result<String> {
+    let ok = !raw.name.is_empty()
+        && !raw.name.starts_with('-')
+        && raw
+            .name
+            .bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b == b'-' || b == b'_');
+    if !ok {
+        return Err(invalid(format!(
+            "raw image name {:?} is not a plain file stem",
+            raw.name
+        )));
+    }
+    Ok(format!("{}.png", raw.name))
+}
+
+/// Writes all outputs of one method to `dir/METHOD/` (see the module table): `image.png`
+/// from `shaded` (linear RGB, `width·height` pixels, row 0 at the top), `visibility.png`,
+/// `visibility.exr`, `visibility.pfm`, one `<name>.png` per raw image, and `stats.json`.
+///
+/// Everything is encoded before anything is written, and files appear under their final
+/// names only once all were written ([`write_files_all_or_nothing`]).
+pub fn write_method_outputs(
+    dir: &Path,
+    method: &str,
+    out: &MethodOutput,
+    shaded: &[[f32; 3]],
+    width: u32,
+    height: u32,
+) -> io::Result<()> {
+    if method.is_empty() || method.contains(['/', '\\']) || method.starts_with('.') {
+        return Err(invalid(format!(
+            "method name {method:?} is not a plain directory name"
+        )));
+    }
+    let files = encode_method_outputs(out, shaded, width, height)?;
+    write_files_all_or_nothing(&dir.join(method), &files)
+}
+
+/// Width in pixels of the separator between the panels of [`write_side_by_side_png`].
+pub const PANEL_GAP: u32 = 2;
+
+/// Colour of the separator between panels: a mid gray, so that black (e.g. an all-equal diff
+/// mask) and white panels both stand apart from it.
+pub const PANEL_GAP_COLOR: [u8; 3] = [128, 128, 128];
+
+/// Writes panels of `w×h` 8-bit sRGB pixels (row 0 at the top) side by side, left to right,
+/// separated by [`PANEL_GAP`] columns of [`PANEL_GAP_COLOR`], as one RGB PNG at `path`.
+/// Used for golden failures (expected | diff mask | actual) and the `compare` command.
+///
+/// The parent directory is created if needed; the file is written to a temporary name and
+/// renamed into place. An error if any panel does not have `w·h` pixels.
+pub fn write_side_by_side_png(
+    path: &Path,
+    w: u32,
+    h: u32,
+    panels: &[Vec<[u8; 3]>],
+) -> io::Result<()> {
+    let bytes = encode_side_by_side_png(w, h, panels)?;
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let name = path
+        .file_name()
+        .ok_or_else(|| invalid(format!("{} has no file name", path.display())))?
+        .to_string_lossy()
+        .into_owned();
+    write_files_all_or_nothing(&dir, &[(name, bytes)])
+}
+
+/// Encodes the side-by-side image of [`write_side_by_side_png`] in memory.
+pub fn encode_side_by_side_png(w: u32, h: u32, panels: &[Vec<[u8; 3]>]) -> io::Result<Vec<u8>> {
+    let n = pixel_count(w, h)?;
+    for (i, p) in panels.iter().enumerate() {
+        if p.len() != n {
+            return Err(invalid(format!(
+                "panel {i} has {} pixels, expected {w}x{h} = {n}",
+                p.len()
+            )));
+        }
+    }
+    let count = panels.len() as u64;
+    let total_w = count * u64::from(w) + count.saturating_sub(1) * u64::from(PANEL_GAP);
+    let total_w = u32::try_from(total_w)
+        .map_err(|_| invalid(format!("{count} panels of width {w} are too wide")))?;
+    let (w, h) = (w as usize, h as usize);
+    let mut pixels = Vec::with_capacity(total_w as usize * h);
+    for y in 0..h {
+        for (i, p) in panels.iter().enumerate() {
+            if i > 0 {
+                pixels.extend(std::iter::repeat_n(PANEL_GAP_COLOR, PANEL_GAP as usize));
+            }
+            pixels.extend_from_slice(&p[y * w..(y + 1) * w]);
+        }
+    }
+    encode_rgb8_png(&pixels, total_w, h as u32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::counters::Counters;
+    use crate::methods::output::MethodStats;
+
+    fn temp_dir(tag: &str) -> PathBuf {
+        use std::sync::atomic::{AtomicU32, Ordering};
+        static N: AtomicU32 = AtomicU32::new(0);
+        let d = std::env::temp_dir().join(format!(
+            "penumbra-output-{tag}-{}-{}",
+            std::process::id(),
+            N.fetch_add(1, Ordering::Relaxed)
+        ));
+        let _ = std::fs::remove_dir_all(&d);
+        d
+    }
+
+    fn sample_output(vis: Visibility) -> MethodOutput {
+        MethodOutput {
+            raw_images: vec![RawImage8 {
+                name: "stencil".into(),
+                values: (0..vis.len() as u32).map(|i| (i * 37) as u8).collect(),
+            }],
+            visibility: vis,
+            stats: MethodStats {
+                method: "hard-sv".into(),
+                width: 3,
+                height: 2,
+                wall_seconds: 0.25,
+                plan: serde_json::json!({"passes": ["scene-depth"]}),
+                passes: vec![],
+                totals: Counters::default(),
+            },
+        }
+    }
+
+    #[test]
+    fn srgb_endpoints_and_curve() {
+        assert_eq!(linear_to_srgb8(0.0), 0);
+        assert_eq!(linear_to_srgb8(1.0), 255);
+        assert_eq!(linear_to_srgb8(-3.0), 0);
+        assert_eq!(linear_to_srgb8(7.0), 255);
+        assert_eq!(linear_to_srgb8(f32::NAN), 0);
+        assert_eq!(linear_to_srgb8(f32::INFINITY), 255);
+        // Middle gray: 0.5 linear is 0.7354 sRGB → 187.5… → 188.
+        assert_eq!(linear_to_srgb8(0.5), 188);
+        // 0.18 linear → 0.4614 → 117.66 → 118.
+        assert_eq!(linear_to_srgb8(0.18), 118);
+        // Linear segment: 0.001 → 12.92e-3·255 = 3.29 → 3.
+        assert_eq!(linear_to_srgb8(0.001), 3);
+        // Monotonic.
+        let mut prev = 0;
+        for i in 0..=10_000 {
+            let c = linear_to_srgb8(i as f32 / 10_000.0);
+            assert!(c >= prev);
+            prev = c;
+        }
+    }
+
+    #[test]
+    fn u16_quantization() {
+        assert_eq!(visibility_to_u16(0.0), 0);
+        assert_eq!(visibility_to_u16(1.0), 65535);
+        assert_eq!(visibility_to_u16(0.5), 32768); // 32767.5 ties to even
+        assert_eq!(visibility_to_u16(f32::NAN), 0);
+        assert_eq!(visibility_to_u16(2.0), 65535);
+        assert_eq!(visibility_to_u16(-1.0), 0);
+    }
+
+    #[test]
+    fn pfm_round_trip_gray_and_rgb_exact_bits() {
+        let gray: Vec<f32> = vec![
+            0.0,
+            -0.0,
+            1.0,
+            f32::from_bits(1),
+            0.1,
+            f32::from_bits(0x7fc0_1234),
+        ];
+        let vis = Visibility::Gray(gray.clone());
+        let bytes = encode_pfm(&vis, 3, 2);
+        assert!(bytes.starts_with(b"Pf\n3 2\n-1.0\n"));
+        let (w, h, back) = read_pfm(&bytes).unwrap();
+        assert_eq!((w, h), (3, 2));
+        let Visibility::Gray(back) = back else {
+            panic!("expected gray")
+        };
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&back), bits(&gray));
+
+        let rgb: Vec<[f32; 3]> = (0..6).map(|i| [i as f32, 0.5 / i as f32, -1.0]).collect();
+        let vis = Visibility::Rgb(rgb.clone());
+        let bytes = encode_pfm(&vis, 2, 3);
+        assert!(bytes.starts_with(b"PF\n2 3\n-1.0\n"));
+        let (w, h, back) = read_pfm(&bytes).unwrap();
+        assert_eq!((w, h), (2, 3));
+        assert_eq!(back, Visibility::Rgb(rgb));
+    }
+
+    #[test]
+    fn pfm_rows_are_bottom_to_top() {
+        // Image row 0 (top) = [1, 2], row 1 = [3, 4]; the file stores row 1 first.
+        let bytes = encode_pfm(&Visibility::Gray(vec![1.0, 2.0, 3.0, 4.0]), 2, 2);
+        let data = &bytes[bytes.len() - 16..];
+        let first = f32::from_le_bytes(data[0..4].try_into().unwrap());
+        assert_eq!(first, 3.0);
+    }
+
+    #[test]
+    fn pfm_big_endian_and_errors() {
+        let mut bytes = b"Pf 2 1 1.0\n".to_vec();
+        bytes.extend_from_slice(&0.25f32.to_be_bytes());
+        bytes.extend_from_slice(&0.75f32.to_be_bytes());
+        let (_, _, v) = read_pfm(&bytes).unwrap();
+        assert_eq!(v, Visibility::Gray(vec![0.25, 0.75]));
+
+        assert!(read_pfm(b"").is_err());
+        assert!(read_pfm(b"P6\n1 1\n-1.0\n\0\0\0\0").is_err());
+        assert!(read_pfm(b"Pf\n1 1\n-1.0\n\0\0\0").is_err());
+        assert!(read_pfm(b"Pf\n1 1\n-1.0\n\0\0\0\0\0").is_err());
+        assert!(read_pfm(b"Pf\nx 1\n-1.0\n\0\0\0\0").is_err());
+        assert!(read_pfm(b"Pf\n1 1\n0\n\0\0\0\0").is_err());
+        assert!(read_pfm(b"Pf\n4294967295 4294967295\n-1.0\n").is_err());
+        assert!(read_pfm(b"Pf\n0 0\n-1.0").is_err());
+        assert!(read_pfm(b"Pf\n0 0\n-1.0\n").is_ok());
+    }
+
+    #[test]
+    fn writes_every_file_and_they_decode() {
+        let dir = temp_dir("write");
+        let vis = Visibility::Gray(vec![0.0, 0.25, 0.5, 0.75, 1.0, 0.125]);
+        let out = sample_output(vis.clone());
+        let shaded = vec![[0.5f32, 0.25, 1.0]; 6];
+        write_method_outputs(&dir, "hard-sv", &out, &shaded, 3, 2).unwrap();
+        let m = dir.join("hard-sv");
+        let mut names: Vec<String> = std::fs::read_dir(&m)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        assert_eq!(
+            names,
+            [
+                "image.png",
+                "stats.json",
+                "stencil.png",
+                "visibility.exr",
+                "visibility.pfm",
+                "visibility.png"
+            ]
+        );
+
+        let img = image::open(m.join("image.png")).unwrap().to_rgb8();
+        assert_eq!(img.dimensions(), (3, 2));
+        assert_eq!(img.get_pixel(0, 0).0, [188, 137, 255]);
+
+        let v16 = image::open(m.join("visibility.png")).unwrap();
+        let image::DynamicImage::ImageLuma16(v16) = v16 else {
+            panic!("expected 16-bit gray")
+        };
+        assert_eq!(v16.into_raw(), vec![0, 16384, 32768, 49151, 65535, 8192]);
+
+        let exr = image::open(m.join("visibility.exr")).unwrap().to_rgb32f();
+        assert_eq!(exr.dimensions(), (3, 2));
+        assert_eq!(exr.get_pixel(1, 0).0, [0.25; 3]);
+        assert_eq!(exr.get_pixel(2, 1).0, [0.125; 3]);
+
+        let (w, h, back) = read_pfm(&std::fs::read(m.join("visibility.pfm")).unwrap()).unwrap();
+        assert_eq!((w, h, back), (3, 2, vis));
+
+        let (w, h, st) = decode_gray8_png(&std::fs::read(m.join("stencil.png")).unwrap()).unwrap();
+        assert_eq!((w, h), (3, 2));
+        assert_eq!(st, out.raw_images[0].values);
+
+        let json: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(m.join("stats.json")).unwrap()).unwrap();
+        assert_eq!(json["method"], "hard-sv");
+        assert_eq!(json["width"], 3);
+        assert_eq!(json["totals"]["overflow_events"], 0);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn rgb_visibility_writes_rgb16_and_pf() {
+        let dir = temp_dir("rgb");
+        let vis = Visibility::Rgb(vec![[0.0, 0.5, 1.0], [1.0, 0.0, 0.25]]);
+        let mut out = sample_output(vis.clone());
+        out.raw_images.clear();
+        write_method_outputs(&dir, "ssv", &out, &[[0.0; 3]; 2], 2, 1).unwrap();
+        let m = dir.join("ssv");
+        let image::DynamicImage::ImageRgb16(v16) = image::open(m.join("visibility.png")).unwrap()
+        else {
+            panic!("expected 16-bit RGB")
+        };
+        assert_eq!(v16.into_raw(), vec![0, 32768, 65535, 65535, 0, 16384]);
+        let pfm = std::fs::read(m.join("visibility.pfm")).unwrap();
+        assert!(pfm.starts_with(b"PF\n"));
+        assert_eq!(read_pfm(&pfm).unwrap().2, vis);
+        let exr = image::open(m.join("visibility.exr")).unwrap().to_rgb32f();
+        assert_eq!(exr.get_pixel(1, 0).0, [1.0, 0.0, 0.25]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn bad_sizes_write_nothing() {
+        let dir = temp_dir("bad");
+        let mut out = sample_output(Visibility::Gray(vec![0.0; 6]));
+        // Raw image of the wrong size: encoding fails before any file exists.
+        out.raw_images[0].values.pop();
+        let err = write_method_outputs(&dir, "hard-sv", &out, &[[0.0; 3]; 6], 3, 2).unwrap_err();
+        assert!(err.to_string().contains("stencil"), "{err}");
+        assert!(!dir.exists());
+        let out = sample_output(Visibility::Gray(vec![0.0; 6]));
+        assert!(write_method_outputs(&dir, "hard-sv", &out, &[[0.0; 3]; 5], 3, 2).is_err());
+        assert!(write_method_outputs(&dir, "../x", &out, &[[0.0; 3]; 6], 3, 2).is_err());
+        let mut out2 = out.clone();
+        out2.raw_images[0].name = "../evil".into();
+        assert!(write_method_outputs(&dir, "hard-sv", &out2, &[[0.0; 3]; 6], 3, 2).is_err());
+        out2.raw_images[0].name = "visibility".into();
+        assert!(write_method_outputs(&dir, "hard-sv", &out2, &[[0.0; 3]; 6], 3, 2).is_err());
+        assert!(!dir.exists());
+    }
+
+    #[test]
+    fn side_by_side_layout() {
+        let dir = temp_dir("sbs");
+        let path = dir.join("sub").join("cmp.png");
+        let a = vec![[255, 0, 0]; 4];
+        let b = vec![[0, 0, 255]; 4];
+        write_side_by_side_png(&path, 2, 2, &[a, b]).unwrap();
+        let img = image::open(&path).unwrap().to_rgb8();
+        assert_eq!(img.dimensions(), (2 + PANEL_GAP + 2, 2));
+        assert_eq!(img.get_pixel(0, 1).0, [255, 0, 0]);
+        assert_eq!(img.get_pixel(2, 0).0, PANEL_GAP_COLOR);
+        assert_eq!(img.get_pixel(2 + PANEL_GAP, 1).0, [0, 0, 255]);
+        assert!(write_side_by_side_png(&path, 2, 2, &[vec![[0; 3]; 3]]).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

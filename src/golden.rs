@@ -1,0 +1,652 @@
+//! Golden outputs: the bit-exact regression loop (DESIGN.md "Tests"; after vello's sparse
+//! tests and resvg).
+//!
+//! # Layout
+//!
+//! ```text
+//! golden/<scene>/<method>/visibility.pfm     the visibility buffer, exact f32 bits
+//! golden/<scene>/<method>/<raw>.png          each raw 8-bit buffer, e.g. hard-sv's stencil.png
+//! ```
+//!
+//! Files are compared on their **decoded values** — f32 bits of the PFM, u8 values of the
+//! PNG — never on the compressed bytes, so a different PNG encoder version cannot fail a test
+//! and a `-0.0` vs `0.0` or a 1-ulp change cannot pass one.
+//!
+//! # The loop
+//!
+//! - Missing golden file: [`check`] writes it and fails once with
+//!   `golden missing, written: PATH — review and commit it`.
+//! - Mismatch: [`check`] writes `target/golden-failures/<scene>/<method>/actual.pfm` and
+//!   `expected_diff_actual.png` (expected | diff mask | actual, visibility shown as sRGB gray;
+//!   for raw images `actual_<raw>.png` and `expected_diff_actual_<raw>.png`) and fails naming
+//!   the first differing pixel, both values with their bits, the number of differing pixels
+//!   and the paths. `target/` is the sibling of the golden root (`<crate>/golden` →
+//!   `<crate>/target`).
+//! - Re-blessing is explicit: `PENUMBRA_BLESS=1` makes [`check`] rewrite instead of
+//!   compare, and the CLI's `golden --bless` calls [`bless`]. Goldens are never loosened
+//!   silently: there is no tolerance.
+
+use crate::methods::output::{MethodOutput, Visibility};
+use crate::metrics::{diff_mask, diff_mask_u8};
+use crate::output::{
+    decode_gray8_png, encode_gray8_png, encode_pfm, encode_side_by_side_png, raw_image_file_name,
+    read_pfm, visibility_to_srgb8, write_files_all_or_nothing,
+};
+use std::path::{Path, PathBuf};
+
+/// The environment variable that turns [`check`] into [`bless`]: set it to `1`.
+pub const BLESS_ENV: &str = "PENUMBRA_BLESS";
+
+/// The file name of the visibility golden.
+pub const VISIBILITY_FILE: &str = "visibility.pfm";
+
+/// Where the goldens of one scene and method live: `root/scene/method`.
+pub fn golden_dir(root: &Path, scene: &str, method: &str) -> PathBuf {
+    root.join(scene).join(method)
+}
+
+/// Where failures of one scene and method are written:
+/// `<parent of root>/target/golden-failures/scene/method`.
+pub fn failure_dir(root: &Path, scene: &str, method: &str) -> PathBuf {
+    failures_root(root).join(scene).join(method)
+}
+
+fn failures_root(root: &Path) -> PathBuf {
+    let parent = match root.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    parent.join("target").join("golden-failures")
+}
+
+/// True when [`BLESS_ENV`] is set to `1`.
+fn bless_requested() -> bool {
+    std::env::var(BLESS_ENV).is_ok_and(|v| v == "1")
+}
+
+fn check_component(what: &str, s: &str) -> Result<(), String> {
+    if s.is_empty() || s.starts_with('.') || s.contains(['/', '\\']) {
+        return Err(format!(
+            "golden: {what} name {s:?} is not a plain directory name"
+        ));
+    }
+    Ok(())
+}
+
+/// The golden files of one output, `(file name, bytes)`: [`VISIBILITY_FILE`], then one PNG
+/// per raw image in output order.
+fn golden_files(
+    out: &MethodOutput,
+    width: u32,
+    height: u32,
+) -> Result<Vec<(String, Vec<u8>)>, String> {
+    let n = width as usize * height as usize;
+    if out.visibility.len() != n {
+        return Err(format!(
+            "golden: visibility has {} pixels, expected {width}x{height} = {n}",
+            out.visibility.len()
+        ));
+    }
+    let mut files = vec![(
+        VISIBILITY_FILE.to_string(),
+        encode_pfm(&out.visibility, width, height),
+    )];
+    for raw in &out.raw_images {
+        let name = raw_image_file_name(raw).map_err(|e| format!("golden: {e}"))?;
+        if files.iter().any(|(f, _)| *f == name) {
+            return Err(format!("golden: two outputs named {name}"));
+        }
+        let png = encode_gray8_png(&raw.values, width, height)
+            .map_err(|e| format!("golden: raw image {:?}: {e}", raw.name))?;
+        files.push((name, png));
+    }
+    Ok(files)
+}
+
+/// Golden-like files already in `dir` (`*.pfm`, `*.png`), sorted; empty if `dir` is missing.
+fn existing_golden_files(dir: &Path) -> Result<Vec<String>, String> {
+    let rd = match std::fs::read_dir(dir) {
+        Ok(rd) => rd,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(format!("golden: reading {}: {e}", dir.display())),
+    };
+    let mut names = Vec::new();
+    for entry in rd {
+        let entry = entry.map_err(|e| format!("golden: reading {}: {e}", dir.display()))?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if !name.starts_with('.') && (name.ends_with(".pfm") || name.ends_with(".png")) {
+            names.push(name);
+        }
+    }
+    names.sort();
+    Ok(names)
+}
+
+/// Rewrites the goldens of `scene`/`method` under `root` from `out` and returns the paths
+/// written. The size is taken from `out.stats.width`/`height` (and must match the buffers).
+/// Golden files of that method that `out` no longer produces (`*.pfm`, `*.png`) are removed.
+pub fn bless(
+    root: &Path,
+    scene: &str,
+    method: &str,
+    out: &MethodOutput,
+) -> Result<Vec<PathBuf>, String> {
+    bless_sized(root, scene, method, out.stats.width, out.stats.height, out)
+}
+
+fn bless_sized(
+    root: &Path,
+    scene: &str,
+    method: &str,
+    width: u32,
+    height: u32,
+    out: &MethodOutput,
+) -> Result<Vec<PathBuf>, String> {
+    check_component("scene", scene)?;
+    check_component("method", method)?;
+    let dir = golden_dir(root, scene, method);
+    let files = golden_files(out, width, height)?;
+    write_files_all_or_nothing(&dir, &files)
+        .map_err(|e| format!("golden: writing {}: {e}", dir.display()))?;
+    for stale in existing_golden_files(&dir)? {
+        if !files.iter().any(|(f, _)| *f == stale) {
+            let p = dir.join(&stale);
+            std::fs::remove_file(&p)
+                .map_err(|e| format!("golden: removing stale {}: {e}", p.display()))?;
+        }
+    }
+    Ok(files.into_iter().map(|(f, _)| dir.join(f)).collect())
+}
+
+/// Checks `out` (a `width×height` render of `scene` by `method`) against the goldens under
+/// `root` (usually `<crate>/golden`), bit for bit on decoded values. See the module docs for
+/// what happens when a golden is missing or differs; with `PENUMBRA_BLESS=1` the goldens are
+/// rewritten instead ([`bless`]) and the check passes.
+///
+/// Stale failure files of this scene and method are removed first, so
+/// `target/golden-failures` only shows current failures.
+pub fn check(
+    root: &Path,
+    scene: &str,
+    method: &str,
+    width: u32,
+    height: u32,
+    out: &MethodOutput,
+) -> Result<(), String> {
+    if bless_requested() {
+        let written = bless_sized(root, scene, method, width, height, out)?;
+        for p in written {
+            eprintln!("blessed {}", p.display());
+        }
+        return Ok(());
+    }
+    check_against(
+        root,
+        &failures_root(root),
+        scene,
+        method,
+        width,
+        height,
+        out,
+    )
+}
+
+/// [`check`] without the environment: compares, writes missing goldens and failures under
+/// `failures_root/scene/method`.
+fn check_against(
+    root: &Path,
+    failures_root: &Path,
+    scene: &str,
+    method: &str,
+    width: u32,
+    height: u32,
+    out: &MethodOutput,
+) -> Result<(), String> {
+    check_component("scene", scene)?;
+    check_component("method", method)?;
+    let dir = golden_dir(root, scene, method);
+    let fail_dir = failures_root.join(scene).join(method);
+    match std::fs::remove_dir_all(&fail_dir) {
+        Ok(()) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => return Err(format!("golden: clearing {}: {e}", fail_dir.display())),
+    }
+    let files = golden_files(out, width, height)?;
+
+    let mut problems: Vec<String> = Vec::new();
+    let mut missing: Vec<(String, Vec<u8>)> = Vec::new();
+    let mut failure_files: Vec<(String, Vec<u8>)> = Vec::new();
+    let what = format!("{scene}/{method}");
+
+    for (name, bytes) in &files {
+        let path = dir.join(name);
+        let expected = match std::fs::read(&path) {
+            Ok(b) => b,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                missing.push((name.clone(), bytes.clone()));
+                continue;
+            }
+            Err(e) => {
+                problems.push(format!("golden {what}: reading {}: {e}", path.display()));
+                continue;
+            }
+        };
+        let result = if name == VISIBILITY_FILE {
+            compare_visibility(&expected, &out.visibility, width, height)
+        } else {
+            let raw = out
+                .raw_images
+                .iter()
+                .find(|r| format!("{}.png", r.name) == *name)
+                .expect("every golden file but the PFM comes from a raw image");
+            compare_raw(&expected, &raw.values, width, height)
+        };
+        match result {
+            Ok(()) => {}
+            Err(mismatch) => {
+                let (actual_name, panel_name) = if name == VISIBILITY_FILE {
+                    (
+                        "actual.pfm".to_string(),
+                        "expected_diff_actual.png".to_string(),
+                    )
+                } else {
+                    (
+                        format!("actual_{name}"),
+                        format!("expected_diff_actual_{name}"),
+                    )
+                };
+                let mut msg = format!(
+                    "golden mismatch {what} {name}: {}\n  expected: {}\n  actual:   {}",
+                    mismatch.summary,
+                    path.display(),
+                    fail_dir.join(&actual_name).display()
+                );
+                failure_files.push((actual_name, bytes.clone()));
+                if let Some(panels) = mismatch.panels {
+                    match encode_side_by_side_png(width, height, &panels) {
+                        Ok(png) => {
+                            msg.push_str(&format!(
+                                "\n  images:   {} (expected | diff | actual)",
+                                fail_dir.join(&panel_name).display()
+                            ));
+                            failure_files.push((panel_name, png));
+                        }
+                        Err(e) => msg.push_str(&format!("\n  (no diff image: {e})")),
+                    }
+                }
+                problems.push(msg);
+            }
+        }
+    }
+
+    for stale in existing_golden_files(&dir)? {
+        if !files.iter().any(|(f, _)| *f == stale) {
+            problems.push(format!(
+                "golden {what}: {} exists but the method no longer produces {stale}",
+                dir.join(&stale).display()
+            ));
+        }
+    }
+
+    if !failure_files.is_empty() {
+        if let Err(e) = write_files_all_or_nothing(&fail_dir, &failure_files) {
+            problems.push(format!(
+                "golden {what}: could not write failure files to {}: {e}",
+                fail_dir.display()
+            ));
+        }
+    }
+    if !missing.is_empty() {
+        match write_files_all_or_nothing(&dir, &missing) {
+            Ok(()) => {
+                for (name, _) in &missing {
+                    problems.push(format!(
+                        "golden missing, written: {} — review and commit it",
+                        dir.join(name).display()
+                    ));
+                }
+            }
+            Err(e) => problems.push(format!(
+                "golden missing for {what} and could not be written to {}: {e}",
+                dir.display()
+            )),
+        }
+    }
+
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        if !failure_files.is_empty() || problems.iter().any(|p| p.contains("no longer")) {
+            problems.push(format!(
+                "  if the change is intended: {BLESS_ENV}=1 cargo test, or `penumbra golden --bless`"
+            ));
+        }
+        Err(problems.join("\n"))
+    }
+}
+
+/// Why one golden file did not match: a one-line summary and, when sizes agree, the
+/// expected | diff | actual panels.
+struct Mismatch {
+    summary: String,
+    panels: Option<Vec<Vec<[u8; 3]>>>,
+}
+
+fn fmt_pixel(v: &Visibility, i: usize) -> String {
+    match v {
+        Visibility::Gray(g) => format!("{:?} (0x{:08x})", g[i], g[i].to_bits()),
+        Visibility::Rgb(c) => {
+            let [r, g, b] = c[i];
+            format!(
+                "[{r:?}, {g:?}, {b:?}] (0x{:08x}, 0x{:08x}, 0x{:08x})",
+                r.to_bits(),
+                g.to_bits(),
+                b.to_bits()
+            )
+        }
+    }
+}
+
+fn kind(v: &Visibility) -> &'static str {
+    match v {
+        Visibility::Gray(_) => "gray (Pf)",
+        Visibility::Rgb(_) => "RGB (PF)",
+    }
+}
+
+/// True when pixel `i` has the same bits in both buffers (both gray, or both RGB).
+fn same_bits(a: &Visibility, b: &Visibility, i: usize) -> bool {
+    match (a, b) {
+        (Visibility::Gray(x), Visibility::Gray(y)) => x[i].to_bits() == y[i].to_bits(),
+        (Visibility::Rgb(x), Visibility::Rgb(y)) => {
+            (0..3).all(|c| x[i][c].to_bits() == y[i][c].to_bits())
+        }
+        _ => false,
+    }
+}
+
+fn compare_visibility(
+    expected_bytes: &[u8],
+    actual: &Visibility,
+    width: u32,
+    height: u32,
+) -> Result<(), Mismatch> {
+    let (ew, eh, expected) = read_pfm(expected_bytes).map_err(|e| Mismatch {
+        summary: format!("the golden does not decode: {e}"),
+        panels: None,
+    })?;
+    if (ew, eh) != (width, height) {
+        return Err(Mismatch {
+            summary: format!("size differs: expected {ew}x{eh}, actual {width}x{height}"),
+            panels: None,
+        });
+    }
+    let w = width as usize;
+    let n = w * height as usize;
+    let differing: Vec<usize> = (0..n)
+        .filter(|&i| !same_bits(&expected, actual, i))
+        .collect();
+    let Some(&first) = differing.first() else {
+        return Ok(());
+    };
+    let kinds = if kind(&expected) != kind(actual) {
+        format!("expected {}, actual {}; ", kind(&expected), kind(actual))
+    } else {
+        String::new()
+    };
+    let summary = format!(
+        "{kinds}{} of {n} pixels differ; first at (x={}, y={}): expected {}, actual {}",
+        differing.len(),
+        first % w,
+        first / w,
+        fmt_pixel(&expected, first),
+        fmt_pixel(actual, first),
+    );
+    let panels = vec![
+        visibility_to_srgb8(&expected),
+        diff_mask(&expected, actual, width, height),
+        visibility_to_srgb8(actual),
+    ];
+    Err(Mismatch {
+        summary,
+        panels: Some(panels),
+    })
+}
+
+fn compare_raw(
+    expected_bytes: &[u8],
+    actual: &[u8],
+    width: u32,
+    height: u32,
+) -> Result<(), Mismatch> {
+    let (ew, eh, expected) = decode_gray8_png(expected_bytes).map_err(|e| Mismatch {
+        summary: format!("the golden does not decode: {e}"),
+        panels: None,
+    })?;
+    if (ew, eh) != (width, height) {
+        return Err(Mismatch {
+            summary: format!("size differs: expected {ew}x{eh}, actual {width}x{height}"),
+            panels: None,
+        });
+    }
+    let w = width as usize;
+    let differing = expected.iter().zip(actual).filter(|(a, b)| a != b).count();
+    let Some(first) = expected.iter().zip(actual).position(|(a, b)| a != b) else {
+        return Ok(());
+    };
+    let summary = format!(
+        "{differing} of {} pixels differ; first at (x={}, y={}): expected {}, actual {}",
+        expected.len(),
+        first % w,
+        first / w,
+        expected[first],
+        actual[first],
+    );
+    let gray = |v: &[u8]| v.iter().map(|&x| [x; 3]).collect::<Vec<_>>();
+    let panels = vec![
+        gray(&expected),
+        diff_mask_u8(&expected, actual, width, height),
+        gray(actual),
+    ];
+    Err(Mismatch {
+        summary,
+        panels: Some(panels),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::counters::Counters;
+    use crate::methods::output::{MethodStats, RawImage8};
+
+    /// A fresh `<tmp>/penumbra-golden-…/golden` root and its failures root.
+    fn roots(tag: &str) -> (PathBuf, PathBuf, PathBuf) {
+        use std::sync::atomic::{AtomicU32, Ordering};
+        static N: AtomicU32 = AtomicU32::new(0);
+        let base = std::env::temp_dir().join(format!(
+            "penumbra-golden-{tag}-{}-{}",
+            std::process::id(),
+            N.fetch_add(1, Ordering::Relaxed)
+        ));
+        let _ = std::fs::remove_dir_all(&base);
+        let root = base.join("golden");
+        let fails = failures_root(&root);
+        (base, root, fails)
+    }
+
+    fn output(vis: Vec<f32>, stencil: Option<Vec<u8>>) -> MethodOutput {
+        MethodOutput {
+            visibility: Visibility::Gray(vis),
+            raw_images: stencil
+                .map(|values| {
+                    vec![RawImage8 {
+                        name: "stencil".into(),
+                        values,
+                    }]
+                })
+                .unwrap_or_default(),
+            stats: MethodStats {
+                method: "hard-sv".into(),
+                width: 3,
+                height: 2,
+                wall_seconds: 0.0,
+                plan: serde_json::Value::Null,
+                passes: vec![],
+                totals: Counters::default(),
+            },
+        }
+    }
+
+    fn base_out() -> MethodOutput {
+        output(
+            vec![0.0, 0.25, 0.5, 0.75, 1.0, 0.125],
+            Some(vec![0, 1, 2, 3, 4, 5]),
+        )
+    }
+
+    fn run(root: &Path, fails: &Path, out: &MethodOutput) -> Result<(), String> {
+        check_against(root, fails, "scene", "hard-sv", 3, 2, out)
+    }
+
+    #[test]
+    fn failures_go_next_to_the_golden_root() {
+        assert_eq!(
+            failure_dir(Path::new("/c/golden"), "s", "m"),
+            Path::new("/c/target/golden-failures/s/m")
+        );
+    }
+
+    #[test]
+    fn missing_is_written_and_fails_once() {
+        let (base, root, fails) = roots("missing");
+        let out = base_out();
+        let err = run(&root, &fails, &out).unwrap_err();
+        assert!(err.contains("golden missing, written:"), "{err}");
+        assert!(
+            err.contains("visibility.pfm") && err.contains("stencil.png"),
+            "{err}"
+        );
+        assert!(root.join("scene/hard-sv/visibility.pfm").exists());
+        assert!(root.join("scene/hard-sv/stencil.png").exists());
+        run(&root, &fails, &out).unwrap();
+        assert!(!fails.exists());
+        std::fs::remove_dir_all(&base).unwrap();
+    }
+
+    #[test]
+    fn one_ulp_mismatch_names_pixel_and_writes_failures() {
+        let (base, root, fails) = roots("ulp");
+        let out = base_out();
+        bless(&root, "scene", "hard-sv", &out).unwrap();
+        let mut bad = out.clone();
+        let Visibility::Gray(v) = &mut bad.visibility else {
+            unreachable!()
+        };
+        v[4] = f32::from_bits(v[4].to_bits() - 1);
+        v[5] = 0.5;
+        let err = run(&root, &fails, &bad).unwrap_err();
+        assert!(err.contains("2 of 6 pixels differ"), "{err}");
+        assert!(err.contains("first at (x=1, y=1)"), "{err}");
+        assert!(
+            err.contains("0x3f800000") && err.contains("0x3f7fffff"),
+            "{err}"
+        );
+        let fd = fails.join("scene/hard-sv");
+        assert!(
+            err.contains(&fd.join("actual.pfm").display().to_string()),
+            "{err}"
+        );
+        let actual = read_pfm(&std::fs::read(fd.join("actual.pfm")).unwrap()).unwrap();
+        assert_eq!(actual.2, bad.visibility);
+        let img = image::open(fd.join("expected_diff_actual.png"))
+            .unwrap()
+            .to_rgb8();
+        let gap = crate::output::PANEL_GAP;
+        assert_eq!(img.dimensions(), (9 + 2 * gap, 2));
+        // Diff panel: black where equal, red where different.
+        assert_eq!(img.get_pixel(3 + gap, 0).0, [0, 0, 0]);
+        assert!(img.get_pixel(3 + gap + 1, 1).0[0] >= crate::metrics::DIFF_MIN_RED);
+        // The stencil still matches, so there is no stencil failure.
+        assert!(!err.contains("stencil"), "{err}");
+        // Fixing the output clears the failure directory on the next check.
+        run(&root, &fails, &out).unwrap();
+        assert!(!fd.exists());
+        std::fs::remove_dir_all(&base).unwrap();
+    }
+
+    #[test]
+    fn raw_image_mismatch() {
+        let (base, root, fails) = roots("raw");
+        let out = base_out();
+        bless(&root, "scene", "hard-sv", &out).unwrap();
+        let mut bad = out.clone();
+        bad.raw_images[0].values[2] = 255;
+        let err = run(&root, &fails, &bad).unwrap_err();
+        assert!(err.contains("stencil.png"), "{err}");
+        assert!(
+            err.contains("1 of 6 pixels differ; first at (x=2, y=0): expected 2, actual 255"),
+            "{err}"
+        );
+        let fd = fails.join("scene/hard-sv");
+        assert!(fd.join("actual_stencil.png").exists());
+        assert!(fd.join("expected_diff_actual_stencil.png").exists());
+        std::fs::remove_dir_all(&base).unwrap();
+    }
+
+    #[test]
+    fn size_kind_and_stale_files_fail() {
+        let (base, root, fails) = roots("size");
+        let out = base_out();
+        bless(&root, "scene", "hard-sv", &out).unwrap();
+        // A different size.
+        let small = output(vec![0.0; 2], Some(vec![0; 2]));
+        let err = check_against(&root, &fails, "scene", "hard-sv", 2, 1, &small).unwrap_err();
+        assert!(
+            err.contains("size differs: expected 3x2, actual 2x1"),
+            "{err}"
+        );
+        // Gray golden vs RGB output.
+        let mut rgb = out.clone();
+        rgb.visibility = Visibility::Rgb((0..6).map(|i| [out.visibility.gray(i); 3]).collect());
+        let err = run(&root, &fails, &rgb).unwrap_err();
+        assert!(err.contains("expected gray (Pf), actual RGB (PF)"), "{err}");
+        // The method stopped producing the stencil.
+        let no_raw = output(vec![0.0, 0.25, 0.5, 0.75, 1.0, 0.125], None);
+        let err = run(&root, &fails, &no_raw).unwrap_err();
+        assert!(err.contains("no longer produces stencil.png"), "{err}");
+        // Blessing removes the stale golden.
+        bless(&root, "scene", "hard-sv", &no_raw).unwrap();
+        assert!(!root.join("scene/hard-sv/stencil.png").exists());
+        run(&root, &fails, &no_raw).unwrap();
+        std::fs::remove_dir_all(&base).unwrap();
+    }
+
+    #[test]
+    fn nan_bits_compare_exactly() {
+        let (base, root, fails) = roots("nan");
+        let out = output(vec![f32::NAN, 0.0, 0.0, 0.0, 0.0, 0.0], None);
+        bless(&root, "scene", "hard-sv", &out).unwrap();
+        run(&root, &fails, &out).unwrap();
+        let other = output(
+            vec![f32::from_bits(0x7fc0_0001), 0.0, 0.0, 0.0, 0.0, 0.0],
+            None,
+        );
+        assert!(run(&root, &fails, &other).is_err());
+        // -0.0 vs 0.0 differs in bits, so it fails too.
+        let neg = output(vec![f32::NAN, -0.0, 0.0, 0.0, 0.0, 0.0], None);
+        let err = run(&root, &fails, &neg).unwrap_err();
+        assert!(err.contains("first at (x=1, y=0)"), "{err}");
+        std::fs::remove_dir_all(&base).unwrap();
+    }
+
+    #[test]
+    fn bad_names_and_sizes_are_errors() {
+        let (base, root, fails) = roots("names");
+        let out = base_out();
+        assert!(check_against(&root, &fails, "../x", "m", 3, 2, &out).is_err());
+        assert!(check_against(&root, &fails, "s", "", 3, 2, &out).is_err());
+        assert!(check_against(&root, &fails, "s", "m", 4, 2, &out).is_err());
+        assert!(!base.exists());
+    }
+}
