@@ -7,6 +7,7 @@
 //! camera, closed two-manifold meshes.
 
 pub mod procedural;
+pub mod validate;
 
 use glam::{DVec3, Vec3};
 use std::collections::BTreeMap;

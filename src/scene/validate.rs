@@ -1,0 +1,575 @@
+//! Scene validation: everything a renderer relies on is checked once, here, and reported as
+//! one [`InputError`] naming the scene, the object and the problem (DESIGN.md "Bad input").
+//!
+//! Checked: image size in `1..=MAX_IMAGE_SIZE`; every number finite (camera, light, every
+//! vertex, colours); camera with `vfov_deg` in (0,180), `eye ≠ target`, `up` not parallel to
+//! the view direction, `near > 0` if given; a light of positive size (radius > 0; `u`, `v`
+//! non-zero and not parallel; disk normal non-zero; a non-empty texture of `width·height`
+//! texels in [0,1]); at least one mesh, each a closed, consistently wound two-manifold
+//! ([`crate::geometry::adjacency::build`], the message names the offending edge); the light
+//! centre strictly outside every mesh (bounding box, then ray parity); `ambient` in [0,1];
+//! a `methods` list, if given, not empty (the names are checked by the methods registry).
+
+use super::{Camera, Light, LightShape, Mesh, Scene};
+use crate::error::InputError;
+use crate::geometry::adjacency;
+use crate::limits::MAX_IMAGE_SIZE;
+use glam::{DVec3, Vec3};
+
+/// Checks every invariant a [`Scene`] promises (see the module docs); the first violation is
+/// returned, in the order image size, camera, light, ambient, methods, meshes, light placement.
+pub fn validate(scene: &Scene) -> Result<(), InputError> {
+    let err = |object: &str, message: String| InputError::at(&scene.source, object, message);
+    for (what, v) in [("width", scene.width), ("height", scene.height)] {
+        if v == 0 || v > MAX_IMAGE_SIZE {
+            return Err(err(what, format!("{v} is outside 1..={MAX_IMAGE_SIZE}")));
+        }
+    }
+    validate_camera(&scene.camera).map_err(|(o, m)| err(o, m))?;
+    validate_light(&scene.light).map_err(|(o, m)| err(o, m))?;
+    if !(scene.ambient.is_finite() && (0.0..=1.0).contains(&scene.ambient)) {
+        return Err(err(
+            "ambient",
+            format!("{} is outside [0,1]", scene.ambient),
+        ));
+    }
+    if let Some(methods) = &scene.methods {
+        if methods.is_empty() {
+            return Err(err(
+                "methods",
+                "empty list (omit `methods` to run every method)".into(),
+            ));
+        }
+    }
+    if scene.meshes.is_empty() {
+        return Err(InputError::new(&scene.source, "the scene has no meshes"));
+    }
+    for (i, mesh) in scene.meshes.iter().enumerate() {
+        let object = format!("meshes[{i}] ({})", mesh.name);
+        validate_mesh(mesh).map_err(|m| err(&object, m))?;
+    }
+    for (i, mesh) in scene.meshes.iter().enumerate() {
+        if let Some(why) = light_touches(mesh, scene.light.center) {
+            return Err(err(
+                "light",
+                format!(
+                    "light intersects geometry: the light center {} is {why} meshes[{i}] ({})",
+                    fmt_v3(scene.light.center.as_dvec3()),
+                    mesh.name
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Formats a vector as `(x, y, z)` with Rust's shortest round-trip digits.
+fn fmt_v3(v: DVec3) -> String {
+    format!("({}, {}, {})", v.x, v.y, v.z)
+}
+
+fn finite3(v: DVec3) -> bool {
+    v.is_finite()
+}
+
+/// Camera checks; the error is (object, message).
+fn validate_camera(c: &Camera) -> Result<(), (&'static str, String)> {
+    for (what, v) in [
+        ("camera.eye", c.eye),
+        ("camera.target", c.target),
+        ("camera.up", c.up),
+    ] {
+        if !finite3(v) {
+            return Err((what, format!("{} is not finite", fmt_v3(v))));
+        }
+    }
+    if !(c.vfov_deg.is_finite() && c.vfov_deg > 0.0 && c.vfov_deg < 180.0) {
+        return Err((
+            "camera.vfov_deg",
+            format!("{} is outside (0, 180)", c.vfov_deg),
+        ));
+    }
+    if let Some(n) = c.near {
+        if !(n.is_finite() && n > 0.0) {
+            return Err(("camera.near", format!("{n} must be a finite number > 0")));
+        }
+    }
+    let dir = c.target - c.eye;
+    if dir == DVec3::ZERO {
+        return Err((
+            "camera.target",
+            "equals camera.eye (no view direction)".into(),
+        ));
+    }
+    if !dir.is_finite() {
+        return Err(("camera.target", "too far from camera.eye (overflow)".into()));
+    }
+    if c.up == DVec3::ZERO {
+        return Err(("camera.up", "is the zero vector".into()));
+    }
+    // Relative test on normalized vectors: sin(angle) below 1e-9 counts as parallel.
+    if dir.normalize().cross(c.up.normalize()).length() <= 1e-9 {
+        return Err((
+            "camera.up",
+            format!("{} is parallel to the view direction", fmt_v3(c.up)),
+        ));
+    }
+    Ok(())
+}
+
+/// Light checks; the error is (object, message).
+fn validate_light(l: &Light) -> Result<(), (&'static str, String)> {
+    let v3 = |v: Vec3| fmt_v3(v.as_dvec3());
+    if !l.center.is_finite() {
+        return Err(("light.center", format!("{} is not finite", v3(l.center))));
+    }
+    let radius = |r: f32| {
+        if r.is_finite() && r > 0.0 {
+            Ok(())
+        } else {
+            Err((
+                "light.radius",
+                format!("{r} must be a finite number > 0 (zero-size light)"),
+            ))
+        }
+    };
+    let rect = |u: Vec3, v: Vec3| {
+        for (what, x) in [("light.u", u), ("light.v", v)] {
+            if !x.is_finite() {
+                return Err((what, format!("{} is not finite", v3(x))));
+            }
+            if x == Vec3::ZERO {
+                return Err((what, "is the zero vector (zero-size light)".to_string()));
+            }
+        }
+        let (ud, vd) = (u.as_dvec3(), v.as_dvec3());
+        if ud.normalize().cross(vd.normalize()).length() <= 1e-6 {
+            return Err((
+                "light.v",
+                format!(
+                    "{} is parallel to light.u {} (zero-area light)",
+                    v3(v),
+                    v3(u)
+                ),
+            ));
+        }
+        Ok(())
+    };
+    match &l.shape {
+        LightShape::Point => Ok(()),
+        LightShape::Sphere { radius: r } => radius(*r),
+        LightShape::Disk { radius: r, normal } => {
+            radius(*r)?;
+            if !normal.is_finite() {
+                return Err(("light.normal", format!("{} is not finite", v3(*normal))));
+            }
+            if *normal == Vec3::ZERO {
+                return Err(("light.normal", "is the zero vector".into()));
+            }
+            Ok(())
+        }
+        LightShape::Rect { u, v } => rect(*u, *v),
+        LightShape::TexturedRect { u, v, texture } => {
+            rect(*u, *v)?;
+            let (w, h) = (texture.width as usize, texture.height as usize);
+            if w == 0 || h == 0 {
+                return Err((
+                    "light.texture",
+                    format!("{} is empty ({w}×{h})", texture.source),
+                ));
+            }
+            if texture.texels.len() != w * h {
+                return Err((
+                    "light.texture",
+                    format!(
+                        "{}: {} texels for {w}×{h}",
+                        texture.source,
+                        texture.texels.len()
+                    ),
+                ));
+            }
+            if let Some(i) = texture
+                .texels
+                .iter()
+                .position(|t| t.iter().any(|c| !(0.0..=1.0).contains(c)))
+            {
+                return Err((
+                    "light.texture",
+                    format!(
+                        "{}: texel {i} is {:?}, outside [0,1]",
+                        texture.source, texture.texels[i]
+                    ),
+                ));
+            }
+            Ok(())
+        }
+    }
+}
+
+/// Mesh checks: finite vertices, a colour in [0,1], at least one triangle, closed two-manifold.
+fn validate_mesh(m: &Mesh) -> Result<(), String> {
+    if let Some(i) = m.positions.iter().position(|p| !p.is_finite()) {
+        let p = m.positions[i];
+        return Err(format!(
+            "vertex {i} is not finite: ({}, {}, {})",
+            p.x, p.y, p.z
+        ));
+    }
+    if m.color.iter().any(|c| !(0.0..=1.0).contains(c)) {
+        return Err(format!("color {:?} is outside [0,1]", m.color));
+    }
+    if m.triangles.is_empty() {
+        return Err("the mesh has no triangles".into());
+    }
+    adjacency::build(m).map_err(|e| e.to_string())?;
+    Ok(())
+}
+
+/// Whether the point `c` is on or inside the closed mesh `m`: `None` when strictly outside,
+/// else the words for the message ("inside", "on the surface of").
+///
+/// Outside the mesh's bounding box is outside. Otherwise a point within 1e-6 of the box
+/// diagonal of a triangle is on the surface, and else the parity of ray crossings decides.
+/// A ray passing within 1e-9 (barycentric) of an edge is ambiguous and another fixed,
+/// non-axis-aligned direction is tried. Two-sided quads have even parity everywhere off
+/// their plane, as they should.
+fn light_touches(m: &Mesh, c: Vec3) -> Option<&'static str> {
+    let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    for p in &m.positions {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    if c.cmplt(lo).any() || c.cmpgt(hi).any() {
+        return None;
+    }
+    let cd = c.as_dvec3();
+    let tol = 1e-6 * (hi - lo).as_dvec3().length().max(f64::MIN_POSITIVE);
+    let tri = |t: &[u32; 3]| t.map(|i| m.positions[i as usize].as_dvec3());
+    if m.triangles.iter().any(|t| {
+        let [a, b, p] = tri(t);
+        closest_point_on_triangle(cd, a, b, p).distance(cd) <= tol
+    }) {
+        return Some("on the surface of");
+    }
+    const DIRS: [DVec3; 3] = [
+        DVec3::new(0.431_752_3, 0.810_293_7, 0.396_122_1),
+        DVec3::new(-0.622_341_9, 0.213_457_7, 0.753_118_3),
+        DVec3::new(0.158_832_4, -0.701_225_6, 0.695_119_8),
+    ];
+    let mut inside = false;
+    for dir in DIRS {
+        let mut crossings = 0u32;
+        let mut ambiguous = false;
+        for t in &m.triangles {
+            let [a, b, p] = tri(t);
+            match ray_hits(cd, dir, a, b, p) {
+                Hit::No => {}
+                Hit::Yes => crossings += 1,
+                Hit::Ambiguous => {
+                    ambiguous = true;
+                    break;
+                }
+            }
+        }
+        inside = crossings % 2 == 1;
+        if !ambiguous {
+            break;
+        }
+    }
+    inside.then_some("inside")
+}
+
+enum Hit {
+    No,
+    Yes,
+    Ambiguous,
+}
+
+/// Möller–Trumbore ray/triangle test in f64 (t > 0), flagging grazing hits near an edge.
+fn ray_hits(o: DVec3, d: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Hit {
+    const EPS: f64 = 1e-9;
+    let e1 = b - a;
+    let e2 = c - a;
+    let p = d.cross(e2);
+    let det = e1.dot(p);
+    let scale = e1.length() * e2.length();
+    if det.abs() <= 1e-12 * scale {
+        return Hit::No; // ray parallel to the plane (or degenerate triangle)
+    }
+    let inv = 1.0 / det;
+    let s = o - a;
+    let u = s.dot(p) * inv;
+    let q = s.cross(e1);
+    let v = d.dot(q) * inv;
+    let t = e2.dot(q) * inv;
+    if t <= 0.0 {
+        return Hit::No;
+    }
+    let w = 1.0 - u - v;
+    if u < -EPS || v < -EPS || w < -EPS {
+        return Hit::No;
+    }
+    if u <= EPS || v <= EPS || w <= EPS {
+        return Hit::Ambiguous;
+    }
+    Hit::Yes
+}
+
+/// Closest point to `p` on triangle `abc` (Ericson, Real-Time Collision Detection §5.1.5).
+fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+    let ab = b - a;
+    let ac = c - a;
+    let ap = p - a;
+    let d1 = ab.dot(ap);
+    let d2 = ac.dot(ap);
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = p - b;
+    let d3 = ab.dot(bp);
+    let d4 = ac.dot(bp);
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3));
+    }
+    let cp = p - c;
+    let d5 = ab.dot(cp);
+    let d6 = ac.dot(cp);
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    }
+    let denom = va + vb + vc;
+    if denom == 0.0 {
+        // Degenerate (zero-area) triangle: fall back to its longest edge's closest point.
+        let seg = |x: DVec3, y: DVec3| {
+            let d = y - x;
+            let l2 = d.length_squared();
+            if l2 == 0.0 {
+                x
+            } else {
+                x + d * ((p - x).dot(d) / l2).clamp(0.0, 1.0)
+            }
+        };
+        let cands = [seg(a, b), seg(b, c), seg(c, a)];
+        return cands
+            .into_iter()
+            .min_by(|x, y| x.distance_squared(p).total_cmp(&y.distance_squared(p)))
+            .unwrap_or(a);
+    }
+    let v = vb / denom;
+    let w = vc / denom;
+    a + ab * v + ac * w
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::procedural::{box_mesh, two_sided_quad, uv_sphere};
+    use crate::scene::RgbTexture;
+
+    fn scene() -> Scene {
+        Scene {
+            source: "test-scene".into(),
+            width: 64,
+            height: 48,
+            camera: Camera {
+                eye: DVec3::new(0.0, 2.0, 5.0),
+                target: DVec3::ZERO,
+                up: DVec3::Y,
+                vfov_deg: 45.0,
+                near: None,
+            },
+            light: Light {
+                center: Vec3::new(0.0, 4.0, 0.0),
+                shape: LightShape::Rect {
+                    u: Vec3::X * 0.5,
+                    v: Vec3::Z * 0.5,
+                },
+            },
+            meshes: vec![
+                box_mesh(
+                    "floor",
+                    Vec3::new(-3.0, -0.1, -3.0),
+                    Vec3::new(3.0, 0.0, 3.0),
+                    [0.8; 3],
+                ),
+                uv_sphere("ball", Vec3::new(0.0, 1.0, 0.0), 0.5, 8, 12, [0.8; 3]),
+            ],
+            methods: None,
+            options: Default::default(),
+            ambient: 0.15,
+        }
+    }
+
+    fn msg(s: &Scene) -> String {
+        validate(s).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn good_scene_passes() {
+        validate(&scene()).unwrap();
+    }
+
+    #[test]
+    fn image_size() {
+        let mut s = scene();
+        s.width = 0;
+        assert_eq!(msg(&s), "test-scene: width: 0 is outside 1..=16384");
+        s.width = 1;
+        s.height = MAX_IMAGE_SIZE + 1;
+        assert!(msg(&s).contains("height"));
+    }
+
+    #[test]
+    fn camera_errors() {
+        let mut s = scene();
+        s.camera.eye.x = f64::NAN;
+        assert!(
+            msg(&s).contains("camera.eye: (NaN, 2, 5) is not finite"),
+            "{}",
+            msg(&s)
+        );
+        let mut s = scene();
+        s.camera.target = s.camera.eye;
+        assert!(msg(&s).contains("camera.target: equals camera.eye"));
+        let mut s = scene();
+        s.camera.up = s.camera.target - s.camera.eye;
+        assert!(msg(&s).contains("camera.up") && msg(&s).contains("parallel"));
+        let mut s = scene();
+        s.camera.vfov_deg = 180.0;
+        assert!(msg(&s).contains("camera.vfov_deg"));
+        let mut s = scene();
+        s.camera.near = Some(0.0);
+        assert!(msg(&s).contains("camera.near"));
+    }
+
+    #[test]
+    fn light_errors() {
+        let mut s = scene();
+        s.light.shape = LightShape::Sphere { radius: 0.0 };
+        assert!(msg(&s).contains("light.radius: 0 must be a finite number > 0 (zero-size light)"));
+        s.light.shape = LightShape::Rect {
+            u: Vec3::ZERO,
+            v: Vec3::Z,
+        };
+        assert!(msg(&s).contains("light.u: is the zero vector"));
+        s.light.shape = LightShape::Rect {
+            u: Vec3::X,
+            v: Vec3::X * -2.0,
+        };
+        assert!(msg(&s).contains("light.v") && msg(&s).contains("parallel"));
+        s.light.shape = LightShape::Disk {
+            radius: 1.0,
+            normal: Vec3::ZERO,
+        };
+        assert!(msg(&s).contains("light.normal"));
+        s.light.shape = LightShape::TexturedRect {
+            u: Vec3::X,
+            v: Vec3::Z,
+            texture: RgbTexture {
+                width: 0,
+                height: 0,
+                texels: vec![],
+                source: "t.png".into(),
+            },
+        };
+        assert!(msg(&s).contains("light.texture: t.png is empty"));
+        s.light.shape = LightShape::Point;
+        s.light.center.y = f32::INFINITY;
+        assert!(msg(&s).contains("light.center"));
+    }
+
+    #[test]
+    fn mesh_errors() {
+        let mut s = scene();
+        s.meshes[1].positions[5] = Vec3::new(0.25, 1.0, f32::NAN);
+        assert_eq!(
+            msg(&s),
+            "test-scene: meshes[1] (ball): vertex 5 is not finite: (0.25, 1, NaN)"
+        );
+        let mut s = scene();
+        s.meshes[0].triangles.pop();
+        let m = msg(&s);
+        assert!(
+            m.starts_with("test-scene: meshes[0] (floor): open mesh: edge "),
+            "{m}"
+        );
+        let mut s = scene();
+        s.meshes.clear();
+        assert!(msg(&s).contains("no meshes"));
+        let mut s = scene();
+        s.ambient = 1.5;
+        assert!(msg(&s).contains("ambient"));
+    }
+
+    #[test]
+    fn light_inside_geometry() {
+        let mut s = scene();
+        s.light.center = Vec3::new(0.1, 1.05, -0.02);
+        let m = msg(&s);
+        assert!(
+            m.contains("light intersects geometry") && m.contains("inside meshes[1] (ball)"),
+            "{m}"
+        );
+        // Inside the bounding box of the sphere but outside the sphere itself: fine.
+        s.light.center = Vec3::new(0.45, 1.45, 0.45);
+        validate(&s).unwrap();
+        // On the floor's top surface.
+        s.light.center = Vec3::new(1.0, 0.0, 1.0);
+        assert!(msg(&s).contains("on the surface of meshes[0] (floor)"));
+        // Next to a two-sided quad, inside its (flat) bounding box only when on its plane.
+        let q = [
+            Vec3::new(-1.0, 2.0, 1.0),
+            Vec3::new(1.0, 2.0, 1.0),
+            Vec3::new(1.0, 2.0, -1.0),
+            Vec3::new(-1.0, 2.0, -1.0),
+        ];
+        s.meshes[1] = two_sided_quad("quad", q, [0.5; 3]);
+        s.light.center = Vec3::new(0.3, 2.0, 0.2);
+        assert!(msg(&s).contains("on the surface of meshes[1] (quad)"));
+        s.light.center = Vec3::new(0.3, 3.0, 0.2);
+        validate(&s).unwrap();
+    }
+
+    #[test]
+    fn closest_point_cases() {
+        let (a, b, c) = (DVec3::ZERO, DVec3::X, DVec3::Y);
+        let near = |p: DVec3, q: DVec3| assert!(p.distance(q) < 1e-12, "{p} vs {q}");
+        near(
+            closest_point_on_triangle(DVec3::new(0.2, 0.2, 1.0), a, b, c),
+            DVec3::new(0.2, 0.2, 0.0),
+        );
+        near(
+            closest_point_on_triangle(DVec3::new(-1.0, -1.0, 0.0), a, b, c),
+            a,
+        );
+        near(
+            closest_point_on_triangle(DVec3::new(2.0, -1.0, 0.0), a, b, c),
+            b,
+        );
+        near(
+            closest_point_on_triangle(DVec3::new(0.5, -1.0, 0.0), a, b, c),
+            DVec3::new(0.5, 0.0, 0.0),
+        );
+        near(
+            closest_point_on_triangle(DVec3::new(1.0, 1.0, 0.0), a, b, c),
+            DVec3::new(0.5, 0.5, 0.0),
+        );
+        // Zero-area triangle.
+        near(
+            closest_point_on_triangle(DVec3::new(0.5, 1.0, 0.0), a, b, DVec3::X * 2.0),
+            DVec3::X * 0.5,
+        );
+    }
+}
