@@ -1,1 +1,152 @@
-//! The frame plan.
+//! The frame plan (DESIGN.md "Only the effects a scene calls for"): derived from the scene
+//! before anything is allocated — which methods run, which passes and buffers each needs, and
+//! whether z-fail is needed because the eye sits inside a shadow volume (detected, not asked).
+
+use crate::scene::{LightShape, Scene};
+use glam::{DVec3, Vec3};
+
+/// Grid of near-plane points tested for shadow (per side).
+const NEAR_GRID: u32 = 9;
+
+/// The light points whose hard shadow volumes a method renders, for the z-fail decision:
+/// the center, plus the extreme points of the shape (rectangle corners; four rim points of a
+/// disk or of a sphere's silhouette disk in every axis plane). The union of their shadows
+/// bounds the shadow of any point of the light only approximately; a user can force z-fail.
+pub fn representative_light_points(scene: &Scene) -> Vec<Vec3> {
+    let c = scene.light.center;
+    let mut pts = vec![c];
+    match &scene.light.shape {
+        LightShape::Point => {}
+        LightShape::Rect { u, v } | LightShape::TexturedRect { u, v, .. } => {
+            for (su, sv) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                pts.push(c + *u * su + *v * sv);
+            }
+        }
+        LightShape::Disk { radius, normal } => {
+            let n = normal.normalize();
+            let a = n.any_orthonormal_vector();
+            let b = n.cross(a);
+            for d in [a, -a, b, -b] {
+                pts.push(c + d * *radius);
+            }
+        }
+        LightShape::Sphere { radius } => {
+            for d in [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z] {
+                pts.push(c + d * *radius);
+            }
+        }
+    }
+    pts
+}
+
+/// Whether any point of the near-plane rectangle (a 9×9 grid plus the eye) lies in the hard
+/// shadow of any of `lights`: then z-pass counts are wrong (the near plane clips a shadow
+/// volume) and z-fail is needed. A point is in shadow when the segment to the light point
+/// crosses a triangle (exact f64 segment–triangle test).
+pub fn eye_in_shadow(scene: &Scene, near: f64, lights: &[Vec3]) -> bool {
+    let cam = &scene.camera;
+    let fwd = (cam.target - cam.eye).normalize();
+    let right = fwd.cross(cam.up).normalize();
+    let up = right.cross(fwd);
+    let half_h = near * (cam.vfov_deg.to_radians() * 0.5).tan();
+    let half_w = half_h * scene.width as f64 / scene.height as f64;
+    let mut pts = vec![cam.eye];
+    for i in 0..NEAR_GRID {
+        for j in 0..NEAR_GRID {
+            let s = i as f64 / (NEAR_GRID - 1) as f64 * 2.0 - 1.0;
+            let t = j as f64 / (NEAR_GRID - 1) as f64 * 2.0 - 1.0;
+            pts.push(cam.eye + fwd * near + right * (s * half_w) + up * (t * half_h));
+        }
+    }
+    pts.iter().any(|p| {
+        lights
+            .iter()
+            .any(|l| segment_blocked(scene, *p, l.as_dvec3()))
+    })
+}
+
+fn segment_blocked(scene: &Scene, p: DVec3, q: DVec3) -> bool {
+    let d = q - p;
+    scene.meshes.iter().any(|m| {
+        m.triangles.iter().any(|t| {
+            let [a, b, c] = t.map(|i| m.positions[i as usize].as_dvec3());
+            segment_hits_triangle(p, d, a, b, c)
+        })
+    })
+}
+
+/// Möller–Trumbore restricted to the open segment p + t·d, t ∈ (0, 1).
+fn segment_hits_triangle(p: DVec3, d: DVec3, a: DVec3, b: DVec3, c: DVec3) -> bool {
+    let e1 = b - a;
+    let e2 = c - a;
+    let h = d.cross(e2);
+    let det = e1.dot(h);
+    if det.abs() < 1e-300 {
+        return false;
+    }
+    let inv = 1.0 / det;
+    let s = p - a;
+    let u = s.dot(h) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return false;
+    }
+    let q = s.cross(e1);
+    let v = d.dot(q) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return false;
+    }
+    let t = e2.dot(q) * inv;
+    t > 0.0 && t < 1.0
+}
+
+/// One buffer a pass uses.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct BufferPlan {
+    /// Buffer name.
+    pub name: String,
+    /// Storage format, e.g. `D24`, `S8`, `f64x3 accumulator`.
+    pub format: String,
+    /// Bytes per sample.
+    pub bytes_per_sample: u32,
+}
+
+/// What one method will do for this frame.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct MethodPlan {
+    /// Method name.
+    pub method: String,
+    /// Pass names in execution order.
+    pub passes: Vec<String>,
+    /// Buffers allocated.
+    pub buffers: Vec<BufferPlan>,
+    /// Method settings after option parsing and automatic decisions.
+    pub settings: serde_json::Value,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn segment_triangle() {
+        let a = DVec3::new(-1.0, 0.0, -1.0);
+        let b = DVec3::new(1.0, 0.0, -1.0);
+        let c = DVec3::new(0.0, 0.0, 1.0);
+        let p = DVec3::new(0.0, -1.0, 0.0);
+        assert!(segment_hits_triangle(p, DVec3::new(0.0, 2.0, 0.0), a, b, c));
+        assert!(!segment_hits_triangle(
+            p,
+            DVec3::new(0.0, 0.5, 0.0),
+            a,
+            b,
+            c
+        ));
+        assert!(!segment_hits_triangle(
+            p,
+            DVec3::new(5.0, 2.0, 0.0),
+            a,
+            b,
+            c
+        ));
+    }
+}

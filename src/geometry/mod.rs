@@ -1,3 +1,7 @@
-//! Geometry preparation: mesh adjacency, possible silhouettes, loops, shadow volumes.
+//! Geometry preparation: mesh adjacency, possible silhouettes from a light point, silhouette
+//! loops (Paper V), hard shadow volumes with caps.
 
 pub mod adjacency;
+pub mod loops;
+pub mod shadow_volume;
+pub mod silhouette;

@@ -1,3 +1,93 @@
-//! One module per soft-shadow method; each cites its paper section.
+//! One module per soft-shadow method; each cites its paper section. This module is the
+//! registry: method names, which light shapes each supports, and dispatch.
 
+pub mod hard_sv;
+pub mod nsample;
+pub mod options;
+pub mod raycast;
 pub mod output;
+
+use crate::error::InputError;
+use crate::frame::Frame;
+use crate::gpu::counters::Counters;
+use crate::plan::MethodPlan;
+use crate::scene::{LightShape, Scene};
+use output::{MethodOutput, MethodStats, PassStats};
+use std::time::Instant;
+
+/// Every method penumbra implements, in the order the default run shows them.
+pub const ALL: &[&str] = &["raycast", "nsample", "hard-sv"];
+
+/// The reference every other method's error is measured against.
+pub const REFERENCE: &str = "raycast";
+
+/// Whether `method` can render a light of this shape.
+pub fn supports(method: &str, shape: &LightShape) -> bool {
+    match method {
+        // hard-sv uses the light center; nsample and raycast sample any shape.
+        "hard-sv" | "nsample" | "raycast" => {
+            let _ = shape;
+            true
+        }
+        _ => false,
+    }
+}
+
+/// The methods to run for `scene`: its `methods` list (validated), else every method that
+/// supports its light shape.
+pub fn selected(scene: &Scene) -> Result<Vec<String>, InputError> {
+    match &scene.methods {
+        None => Ok(ALL.iter().filter(|m| supports(m, &scene.light.shape)).map(|m| m.to_string()).collect()),
+        Some(list) => {
+            for m in list {
+                if !ALL.contains(&m.as_str()) {
+                    return Err(InputError::at(&scene.source, "methods", format!("unknown method {m:?}; known: {}", ALL.join(", "))));
+                }
+                if !supports(m, &scene.light.shape) {
+                    return Err(InputError::at(
+                        &scene.source,
+                        "methods",
+                        format!("method {m} does not support {} lights", scene.light.shape.type_name()),
+                    ));
+                }
+            }
+            Ok(list.clone())
+        }
+    }
+}
+
+/// Check that every `[options.X]` table names a known method (or `gpu`).
+pub fn check_option_tables(scene: &Scene) -> Result<(), InputError> {
+    for k in scene.options.keys() {
+        if k != "gpu" && !ALL.contains(&k.as_str()) {
+            return Err(InputError::at(&scene.source, format!("options.{k}"), format!("unknown method {k:?}; known: gpu, {}", ALL.join(", "))));
+        }
+    }
+    Ok(())
+}
+
+/// Run one method on a rendered frame.
+pub fn run(method: &str, frame: &Frame) -> Result<MethodOutput, InputError> {
+    match method {
+        "hard-sv" => hard_sv::run(frame),
+        "nsample" => nsample::run(frame),
+        _ => Err(InputError::at(&frame.scene.source, "methods", format!("unknown method {method:?}"))),
+    }
+}
+
+/// Assemble [`MethodStats`] for a method that started at `start` (totals summed over passes).
+pub fn method_stats(method: &str, frame: &Frame, start: Instant, plan: &MethodPlan, passes: Vec<PassStats>) -> MethodStats {
+    let mut totals = Counters::default();
+    for p in &passes {
+        totals += p.counters;
+    }
+    MethodStats {
+        method: method.into(),
+        width: frame.scene.width,
+        height: frame.scene.height,
+        wall_seconds: start.elapsed().as_secs_f64(),
+        plan: serde_json::to_value(plan).unwrap_or(serde_json::Value::Null),
+        passes,
+        totals,
+    }
+}

@@ -1,0 +1,275 @@
+//! The shared first pass of every frame: the scene rendered into the depth buffer (D24 by
+//! default, LESS, back faces culled) with the id of the visible triangle per pixel, the
+//! per-tile hierarchical-Z bounds, and the receiver point and normal each pixel shows.
+//!
+//! Every method reads this depth buffer (Paper III §3.2.2: "p = point(x, y, z); z is the depth
+//! buffer value") and never writes it. Scene triangles are submitted mesh by mesh in file order;
+//! primitive id = running triangle index over all meshes.
+
+use crate::error::InputError;
+use crate::geometry::adjacency::{self, Adjacency};
+use crate::gpu::buffers::{alloc_tiles, DepthTile};
+use crate::gpu::counters::Counters;
+use crate::gpu::depth::{DepthFormat, DepthFunc, DepthState};
+use crate::gpu::raster::{bin, draw, no_tile_culling};
+use crate::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
+use crate::gpu::tiling::Tiling;
+use crate::gpu::transform::{ClipVertex, Projection};
+use crate::methods::output::PassStats;
+use crate::scene::Scene;
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// The pixel at which no geometry was drawn.
+pub const BACKGROUND: u32 = u32::MAX;
+
+/// Pipeline settings shared by every pass of a frame (`[options.gpu]`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct GpuSettings {
+    /// Tile edge in pixels.
+    pub tile_size: u32,
+    /// Depth buffer format.
+    pub depth: DepthFormat,
+}
+
+impl Default for GpuSettings {
+    fn default() -> Self {
+        Self {
+            tile_size: crate::limits::DEFAULT_TILE_SIZE,
+            depth: DepthFormat::D24,
+        }
+    }
+}
+
+/// A surface point seen at a pixel, with its geometric normal (facing the camera).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Receiver {
+    /// World-space point.
+    pub point: Vec3,
+    /// Unit normal.
+    pub normal: Vec3,
+}
+
+/// Per-tile storage of the scene pass.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneTile {
+    /// Depth.
+    pub depth: DepthTile,
+    /// Visible primitive id per sample, [`BACKGROUND`] where nothing was drawn.
+    pub prim: Vec<u32>,
+}
+
+/// The result of the scene pass, shared read-only by all methods.
+#[derive(Debug, Clone)]
+pub struct Frame<'s> {
+    /// The scene.
+    pub scene: &'s Scene,
+    /// Camera transform.
+    pub proj: Projection,
+    /// Pipeline settings.
+    pub gpu: GpuSettings,
+    /// Tiling of the image.
+    pub tiling: Tiling,
+    /// Edge adjacency of each mesh.
+    pub adjacency: Vec<Adjacency>,
+    /// Scene depth and primitive ids, tile-major, hierarchical Z built.
+    pub tiles: Vec<SceneTile>,
+    /// Mesh index and triangle index of each primitive id.
+    pub prim_owner: Vec<(u32, u32)>,
+    /// Stats of the scene pass.
+    pub pass: PassStats,
+}
+
+impl<'s> Frame<'s> {
+    /// Build adjacency and render the scene depth pass.
+    pub fn render(scene: &'s Scene, gpu: GpuSettings) -> Result<Self, InputError> {
+        let adjacency = scene
+            .meshes
+            .iter()
+            .enumerate()
+            .map(|(k, m)| {
+                adjacency::build(m).map_err(|e| {
+                    InputError::at(
+                        &scene.source,
+                        format!("meshes[{k}] ({})", m.name),
+                        e.to_string(),
+                    )
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let tiling = Tiling::new(scene.width, scene.height, gpu.tile_size)
+            .map_err(|e| InputError::at(&scene.source, "options.gpu.tile_size", e))?;
+        let proj = Projection::for_scene(scene);
+        let start = Instant::now();
+        let mut prims = Vec::new();
+        let mut prim_owner = Vec::new();
+        for (mi, m) in scene.meshes.iter().enumerate() {
+            let clip: Vec<ClipVertex> = m.positions.iter().map(|p| proj.clip_point(*p)).collect();
+            for (ti, t) in m.triangles.iter().enumerate() {
+                prims.push(t.map(|i| clip[i as usize]));
+                prim_owner.push((mi as u32, ti as u32));
+            }
+        }
+        let (tris, mut counters) = setup_all(&prims, CullMode::Back, &tiling);
+        let bins = bin(&tiling, &tris);
+        let mut tiles = alloc_tiles(&tiling, |_, len| SceneTile {
+            depth: DepthTile::cleared(gpu.depth, len),
+            prim: vec![BACKGROUND; len],
+        });
+        let state = DepthState {
+            func: DepthFunc::Less,
+            write: true,
+        };
+        counters += draw(
+            &tiling,
+            &mut tiles,
+            &tris,
+            &bins,
+            no_tile_culling,
+            |_, tile, tri, f, c| {
+                let (pass, z) = tile.depth.test(&state, &f, c);
+                if pass {
+                    c.depth_passed += 1;
+                    tile.depth.write(f.local, z, c);
+                    tile.prim[f.local] = tri.prim;
+                }
+            },
+        );
+        tiles
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(t, tile)| tile.depth.build_hiz(&tiling, t));
+        let pass = PassStats {
+            name: "scene-depth".into(),
+            wall_seconds: start.elapsed().as_secs_f64(),
+            runs: 1,
+            counters,
+        };
+        Ok(Self {
+            scene,
+            proj,
+            gpu,
+            tiling,
+            adjacency,
+            tiles,
+            prim_owner,
+            pass,
+        })
+    }
+
+    /// Number of pixels.
+    pub fn pixel_count(&self) -> usize {
+        (self.scene.width * self.scene.height) as usize
+    }
+
+    /// Visible primitive per pixel, row-major.
+    pub fn prim_ids(&self) -> Vec<u32> {
+        let flat: Vec<u32> = self
+            .tiles
+            .iter()
+            .flat_map(|t| t.prim.iter().copied())
+            .collect();
+        self.tiling.to_row_major(&flat)
+    }
+
+    /// Stored depth per pixel, row-major.
+    pub fn depth_values(&self) -> Vec<u32> {
+        let flat: Vec<u32> = self
+            .tiles
+            .iter()
+            .flat_map(|t| t.depth.values.iter().copied())
+            .collect();
+        self.tiling.to_row_major(&flat)
+    }
+
+    /// Geometric unit normal of primitive `prim` (outward; visible faces face the camera
+    /// because back faces are culled).
+    pub fn normal_of(&self, prim: u32) -> Vec3 {
+        let (mi, ti) = self.prim_owner[prim as usize];
+        let m = &self.scene.meshes[mi as usize];
+        let [a, b, c] = m.triangles[ti as usize].map(|i| m.positions[i as usize].as_dvec3());
+        (b - a).cross(c - a).normalize_or_zero().as_vec3()
+    }
+
+    /// The receiver of every pixel, row-major; `None` for background. By default
+    /// (`primary_ray = false`) the point is the depth-buffer point: the pixel center
+    /// un-projected at its stored depth — the point the rasterized methods see. With
+    /// `primary_ray = true` it is the exact intersection of the ray through the pixel center
+    /// with the plane of the visible triangle, in f64.
+    pub fn receivers(&self, primary_ray: bool) -> Vec<Option<Receiver>> {
+        let prims = self.prim_ids();
+        let depth = self.depth_values();
+        let w = self.scene.width;
+        (0..prims.len())
+            .into_par_iter()
+            .map(|i| {
+                let prim = prims[i];
+                if prim == BACKGROUND {
+                    return None;
+                }
+                let (x, y) = (i as u32 % w, i as u32 / w);
+                let normal = self.normal_of(prim);
+                let point = if primary_ray {
+                    self.primary_hit(x, y, prim)
+                } else {
+                    self.proj
+                        .unproject(x, y, self.gpu.depth.to_window(depth[i]))
+                };
+                Some(Receiver {
+                    point: point.as_vec3(),
+                    normal,
+                })
+            })
+            .collect()
+    }
+
+    fn primary_hit(&self, x: u32, y: u32, prim: u32) -> DVec3 {
+        let eye = self.scene.camera.eye;
+        let far = self.proj.unproject(x, y, 0.5);
+        let dir = far - eye;
+        let (mi, ti) = self.prim_owner[prim as usize];
+        let m = &self.scene.meshes[mi as usize];
+        let [a, b, c] = m.triangles[ti as usize].map(|i| m.positions[i as usize].as_dvec3());
+        let n = (b - a).cross(c - a);
+        let denom = n.dot(dir);
+        if denom == 0.0 {
+            return far;
+        }
+        eye + dir * (n.dot(a - eye) / denom)
+    }
+}
+
+/// Set up every primitive (in parallel, order kept) and return the raster triangles in
+/// submission order with the setup counters.
+pub fn setup_all(
+    prims: &[[ClipVertex; 3]],
+    cull: CullMode,
+    tiling: &Tiling,
+) -> (Vec<RasterTriangle>, Counters) {
+    let parts: Vec<(Vec<RasterTriangle>, Counters)> = prims
+        .par_iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let mut out = Vec::new();
+            let mut c = Counters::default();
+            setup_triangle(
+                p,
+                k as u32,
+                cull,
+                tiling.width,
+                tiling.height,
+                &mut out,
+                &mut c,
+            );
+            (out, c)
+        })
+        .collect();
+    let mut tris = Vec::with_capacity(prims.len());
+    let mut counters = Counters::default();
+    for (t, c) in parts {
+        tris.extend(t);
+        counters += c;
+    }
+    (tris, counters)
+}

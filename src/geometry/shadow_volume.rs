@@ -1,0 +1,67 @@
+//! Hard shadow volumes (Paper I §3; Paper II §5; Everitt & Kilgard's robust z-fail with an
+//! infinite far plane).
+//!
+//! For a light point L, each possible silhouette edge a→b (oriented as in its light-facing
+//! triangle) gives the shadow quad `b, a, a∞, b∞` with `x∞ = (x − L, 0)` at w = 0, wound so its
+//! normal points out of the volume. Caps (z-fail only): the light-facing triangles as they
+//! are (front cap) and the light-back-facing triangles projected to infinity with their
+//! winding kept (back cap); both are then outward-facing too.
+//!
+//! Submission order (part of the contract, it matters with saturating stencil ops): meshes in
+//! scene order; per mesh the front cap (triangle order), then the quads (adjacency edge order,
+//! two triangles each: `(b, a, a∞)`, `(b, a∞, b∞)`), then the back cap (triangle order).
+
+use super::adjacency::Adjacency;
+use super::silhouette::{away_from_light, light_facing, possible_silhouettes};
+use crate::gpu::transform::{ClipVertex, Projection};
+use crate::scene::Mesh;
+use glam::Vec3;
+
+/// Which primitives a shadow volume is built from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum Capping {
+    /// Quads only (z-pass).
+    Open,
+    /// Quads plus front and back caps (z-fail).
+    Capped,
+}
+
+/// The clip-space triangles of the shadow volumes of `meshes` from light point `light`,
+/// in submission order.
+pub fn shadow_volume_triangles(
+    meshes: &[(&Mesh, &Adjacency)],
+    light: Vec3,
+    proj: &Projection,
+    capping: Capping,
+) -> Vec<[ClipVertex; 3]> {
+    let mut out = Vec::new();
+    for (mesh, adj) in meshes {
+        let facing = light_facing(mesh, light);
+        let near: Vec<ClipVertex> = mesh.positions.iter().map(|p| proj.clip_point(*p)).collect();
+        let far: Vec<ClipVertex> = mesh
+            .positions
+            .iter()
+            .map(|p| proj.clip_direction(away_from_light(*p, light)))
+            .collect();
+        if capping == Capping::Capped {
+            for (t, f) in mesh.triangles.iter().zip(&facing) {
+                if *f {
+                    out.push(t.map(|i| near[i as usize]));
+                }
+            }
+        }
+        for e in possible_silhouettes(mesh, adj, &facing) {
+            let (a, b) = (e.va as usize, e.vb as usize);
+            out.push([near[b], near[a], far[a]]);
+            out.push([near[b], far[a], far[b]]);
+        }
+        if capping == Capping::Capped {
+            for (t, f) in mesh.triangles.iter().zip(&facing) {
+                if !*f {
+                    out.push(t.map(|i| far[i as usize]));
+                }
+            }
+        }
+    }
+    out
+}

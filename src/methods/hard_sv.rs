@@ -1,0 +1,183 @@
+//! `hard-sv`: hard shadow volumes from the light center (Paper I §3; Paper II §5; Everitt &
+//! Kilgard's z-fail with an infinite far plane), counted in an 8-bit stencil buffer.
+//!
+//! * z-pass: stencil cleared to 0; front-facing shadow-volume triangles whose fragment passes
+//!   LESS against the scene depth increment, back-facing ones decrement.
+//! * z-fail: front and back caps added ([`Capping::Capped`]); back-facing triangles whose
+//!   fragment *fails* LESS increment, front-facing ones decrement.
+//! * `stencil = "wrap"` uses INCR_WRAP/DECR_WRAP, `"saturate"` uses INCR/DECR: with more than 255
+//!   overlapping volumes, wrap brings a count of 256 back to 0 (lit), saturate sticks at 255,
+//!   and saturating decrements that clamp at 0 before their increment arrive leave counts > 0.
+//! * `submission = "two-sided"` (default): one pass, two-sided stencil, primitives in the order
+//!   of [`crate::geometry::shadow_volume`]. `"two-pass"`: the incrementing facing is drawn first
+//!   (culling the other), then the decrementing one — the classic order that keeps saturating
+//!   counts from clamping at 0.
+//!
+//! A pixel is lit (visibility 1) when its stencil count is 0; background pixels are lit.
+
+use super::options::OptionReader;
+use super::output::{MethodOutput, PassStats, RawImage8, Visibility};
+use crate::error::InputError;
+use crate::frame::{setup_all, Frame, BACKGROUND};
+use crate::geometry::shadow_volume::{shadow_volume_triangles, Capping};
+use crate::gpu::buffers::{alloc_tiles, StencilTile};
+use crate::gpu::counters::Counters;
+use crate::gpu::depth::{DepthFunc, DepthState};
+use crate::gpu::raster::{bin, draw, no_tile_culling};
+use crate::gpu::setup::CullMode;
+use crate::gpu::stencil::{StencilFace, StencilOp, StencilState};
+use crate::plan::{eye_in_shadow, BufferPlan, MethodPlan};
+use glam::Vec3;
+use std::time::Instant;
+
+/// Counting direction of the stencil passes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum ShadowTest {
+    /// Count volume boundaries between the eye and the receiver.
+    ZPass,
+    /// Count volume boundaries between the receiver and infinity (caps needed).
+    ZFail,
+}
+
+/// Stencil overflow behaviour.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum StencilOverflow {
+    /// INCR_WRAP / DECR_WRAP.
+    Wrap,
+    /// INCR / DECR (saturate).
+    Saturate,
+}
+
+/// How shadow-volume triangles are submitted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum Submission {
+    /// One pass with two-sided stencil.
+    TwoSided,
+    /// Incrementing facing first, then decrementing facing.
+    TwoPass,
+}
+
+/// Settings of one hard-shadow stencil render.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct StencilShadowSettings {
+    /// z-pass or z-fail.
+    pub test: ShadowTest,
+    /// Wrap or saturate.
+    pub overflow: StencilOverflow,
+    /// Submission order.
+    pub submission: Submission,
+}
+
+/// `hard-sv` options: `mode = auto|zpass|zfail`, `stencil = wrap|saturate`,
+/// `submission = two-sided|two-pass`. With `auto`, z-fail is chosen when the eye (or any point
+/// of the near plane) is in the light center's shadow.
+pub fn read_settings(
+    r: &mut OptionReader,
+    frame: &Frame,
+    lights: &[Vec3],
+) -> Result<(StencilShadowSettings, &'static str), InputError> {
+    let mode = r.choice("mode", &["auto", "zpass", "zfail"], "auto")?;
+    let overflow = match r.choice("stencil", &["wrap", "saturate"], "wrap")? {
+        "wrap" => StencilOverflow::Wrap,
+        _ => StencilOverflow::Saturate,
+    };
+    let submission = match r.choice("submission", &["two-sided", "two-pass"], "two-sided")? {
+        "two-sided" => Submission::TwoSided,
+        _ => Submission::TwoPass,
+    };
+    let test = match mode {
+        "zpass" => ShadowTest::ZPass,
+        "zfail" => ShadowTest::ZFail,
+        _ if eye_in_shadow(frame.scene, frame.proj.near, lights) => ShadowTest::ZFail,
+        _ => ShadowTest::ZPass,
+    };
+    Ok((StencilShadowSettings { test, overflow, submission }, mode))
+}
+
+/// Render the hard shadow volumes of every mesh from light point `light` into a fresh 8-bit
+/// stencil buffer (tile-major) against the frame's depth buffer. Returns the stencil tiles and
+/// the counters (setup + rasterization).
+pub fn stencil_shadow(frame: &Frame, light: Vec3, s: &StencilShadowSettings) -> (Vec<StencilTile>, Counters) {
+    let capping = match s.test {
+        ShadowTest::ZPass => Capping::Open,
+        ShadowTest::ZFail => Capping::Capped,
+    };
+    let meshes: Vec<_> = frame.scene.meshes.iter().zip(&frame.adjacency).collect();
+    let prims = shadow_volume_triangles(&meshes, light, &frame.proj, capping);
+    let (incr, decr) = match s.overflow {
+        StencilOverflow::Wrap => (StencilOp::IncrWrap, StencilOp::DecrWrap),
+        StencilOverflow::Saturate => (StencilOp::Incr, StencilOp::Decr),
+    };
+    let keep = StencilOp::Keep;
+    // (front face, back face) ops for (depth fail, depth pass).
+    let state = match s.test {
+        ShadowTest::ZPass => StencilState { front: StencilFace::always(keep, incr), back: StencilFace::always(keep, decr) },
+        ShadowTest::ZFail => StencilState { front: StencilFace::always(decr, keep), back: StencilFace::always(incr, keep) },
+    };
+    let depth = DepthState { func: DepthFunc::Less, write: false };
+    let passes: Vec<CullMode> = match (s.submission, s.test) {
+        (Submission::TwoSided, _) => vec![CullMode::None],
+        // z-pass increments on front faces: draw them first (cull back), then the back faces.
+        (Submission::TwoPass, ShadowTest::ZPass) => vec![CullMode::Back, CullMode::Front],
+        // z-fail increments on back faces: draw them first (cull front).
+        (Submission::TwoPass, ShadowTest::ZFail) => vec![CullMode::Front, CullMode::Back],
+    };
+    let tiling = &frame.tiling;
+    let mut stencil = alloc_tiles(tiling, |_, len| StencilTile::cleared(0, len));
+    let mut counters = Counters::default();
+    for cull in passes {
+        let (tris, c) = setup_all(&prims, cull, tiling);
+        counters += c;
+        let bins = bin(tiling, &tris);
+        counters += draw(tiling, &mut stencil, &tris, &bins, no_tile_culling, |t, st, tri, f, c| {
+            let (pass, _) = frame.tiles[t].depth.test(&depth, &f, c);
+            c.depth_passed += pass as u64;
+            st.apply(&state, tri.front_facing, &f, pass, c);
+        });
+    }
+    (stencil, counters)
+}
+
+/// Row-major stencil values.
+pub fn stencil_row_major(frame: &Frame, tiles: &[StencilTile]) -> Vec<u8> {
+    let flat: Vec<u8> = tiles.iter().flat_map(|t| t.values.iter().copied()).collect();
+    frame.tiling.to_row_major(&flat)
+}
+
+/// Run `hard-sv` on a rendered frame.
+pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
+    let start = Instant::now();
+    let mut r = OptionReader::new(frame.scene, "hard-sv");
+    let center = frame.scene.light.center;
+    let (settings, mode) = read_settings(&mut r, frame, &[center])?;
+    r.finish()?;
+    let pass_start = Instant::now();
+    let (tiles, counters) = stencil_shadow(frame, center, &settings);
+    let name = match settings.test {
+        ShadowTest::ZPass => "shadow-volume-zpass",
+        ShadowTest::ZFail => "shadow-volume-zfail",
+    };
+    let pass = PassStats { name: name.into(), wall_seconds: pass_start.elapsed().as_secs_f64(), runs: 1, counters };
+    let stencil = stencil_row_major(frame, &tiles);
+    let prims = frame.prim_ids();
+    let vis: Vec<f32> = stencil
+        .iter()
+        .zip(&prims)
+        .map(|(s, p)| if *p == BACKGROUND || *s == 0 { 1.0 } else { 0.0 })
+        .collect();
+    let plan = MethodPlan {
+        method: "hard-sv".into(),
+        passes: vec![frame.pass.name.clone(), name.into()],
+        buffers: vec![
+            BufferPlan { name: "depth".into(), format: format!("{:?}", frame.gpu.depth), bytes_per_sample: frame.gpu.depth.bytes() as u32 },
+            BufferPlan { name: "stencil".into(), format: "S8".into(), bytes_per_sample: 1 },
+        ],
+        settings: serde_json::json!({ "mode": mode, "resolved": settings, "gpu": frame.gpu }),
+    };
+    let passes = vec![frame.pass.clone(), pass];
+    Ok(MethodOutput {
+        visibility: Visibility::Gray(vis),
+        raw_images: vec![RawImage8 { name: "stencil".into(), values: stencil }],
+        stats: super::method_stats("hard-sv", frame, start, &plan, passes),
+    })
+}
