@@ -6,6 +6,7 @@
 //! [`Scene`] has been validated ([`validate`]): finite numbers, non-degenerate light and
 //! camera, closed two-manifold meshes.
 
+pub mod builtin;
 pub mod procedural;
 pub mod validate;
 

@@ -1,0 +1,330 @@
+//! Built-in scenes, generated in code so the default run needs no files.
+//!
+//! Every scene has a floor (a thin closed box whose top is the plane y = 0) as the receiver,
+//! a light well clear of all geometry, a 256×256 image, ambient 0.15, `methods = None` (every
+//! method that supports the light shape) and no options. World units are arbitrary; y is up.
+//!
+//! | name | occluders | light | triangles |
+//! |---|---|---|---|
+//! | `cube-of-spheres` | 3×3×3 spheres r 0.18, spacing 0.45 (8 stacks × 12 slices) | rect ½-extents 0.5 | 4548 |
+//! | `single-quad` | one 1×1 two-sided quad at y = 1 | rect ½-extents 0.5 at y = 3 | 16 |
+//! | `cylinder` | capped cylinder, 24 segments, r 0.35, h 1, floating at y = 0.4 | sphere r 0.3 | 108 |
+//! | `eye-in-shadow` | a 4×3 slab above the camera + a floating box in the lit region | rect ½-extents 0.4 | 36 |
+//! | `overlap-stress` | 300 stacked 1.2×1.2 two-sided quads, spacing 0.002 | point | 1212 |
+
+use super::procedural::{box_mesh, cylinder, two_sided_quad, uv_sphere};
+use super::{Camera, Light, LightShape, Mesh, RawOptions, Scene};
+use glam::{DVec3, Vec3};
+
+/// The scene `penumbra render` uses when none is given.
+pub const DEFAULT: &str = "cube-of-spheres";
+
+/// Names of the built-in scenes, in the order `penumbra list` prints them.
+const NAMES: &[&str] = &[
+    "cube-of-spheres",
+    "single-quad",
+    "cylinder",
+    "eye-in-shadow",
+    "overlap-stress",
+];
+
+/// Names of all built-in scenes.
+pub fn names() -> &'static [&'static str] {
+    NAMES
+}
+
+/// The built-in scene `name` (its `source` is the name), or `None` if there is no such scene.
+pub fn load(name: &str) -> Option<Scene> {
+    let scene = match name {
+        "cube-of-spheres" => cube_of_spheres(),
+        "single-quad" => single_quad(),
+        "cylinder" => cylinder_scene(),
+        "eye-in-shadow" => eye_in_shadow(),
+        "overlap-stress" => overlap_stress(),
+        _ => return None,
+    };
+    Some(Scene {
+        source: name.to_string(),
+        ..scene
+    })
+}
+
+/// Albedo of floors.
+const FLOOR: [f32; 3] = [0.8, 0.8, 0.8];
+/// Albedo of occluders.
+const OCCLUDER: [f32; 3] = [0.85, 0.45, 0.3];
+
+/// A floor slab of thickness 0.1 whose top face is y = 0, spanning x and z in the ranges.
+fn floor(x: [f32; 2], z: [f32; 2]) -> Mesh {
+    box_mesh(
+        "floor",
+        Vec3::new(x[0], -0.1, z[0]),
+        Vec3::new(x[1], 0.0, z[1]),
+        FLOOR,
+    )
+}
+
+/// A camera with the default near plane.
+fn camera(eye: [f64; 3], target: [f64; 3], vfov_deg: f64) -> Camera {
+    Camera {
+        eye: DVec3::from_array(eye),
+        target: DVec3::from_array(target),
+        up: DVec3::Y,
+        vfov_deg,
+        near: None,
+    }
+}
+
+/// A downward-facing square light (u × v points to −y) of half extent `h`.
+fn rect(h: f32) -> LightShape {
+    LightShape::Rect {
+        u: Vec3::new(h, 0.0, 0.0),
+        v: Vec3::new(0.0, 0.0, h),
+    }
+}
+
+/// The common defaults; `source` is filled in by [`load`].
+fn scene(camera: Camera, light: Light, meshes: Vec<Mesh>) -> Scene {
+    Scene {
+        source: String::new(),
+        width: 256,
+        height: 256,
+        camera,
+        light,
+        meshes,
+        methods: None,
+        options: RawOptions::new(),
+        ambient: 0.15,
+    }
+}
+
+/// Forest et al. 2006 Fig. 1 / Paper III Fig. 15: a cube of 27 spheres above the floor whose
+/// penumbrae overlap heavily.
+fn cube_of_spheres() -> Scene {
+    let mut meshes = vec![floor([-4.0, 4.0], [-4.0, 4.0])];
+    for i in 0..3 {
+        for j in 0..3 {
+            for k in 0..3 {
+                let c = Vec3::new(
+                    0.45 * (i as f32 - 1.0),
+                    1.2 + 0.45 * (j as f32 - 1.0),
+                    0.45 * (k as f32 - 1.0),
+                );
+                let name = format!("sphere[{i},{j},{k}]");
+                meshes.push(uv_sphere(&name, c, 0.18, 8, 12, OCCLUDER));
+            }
+        }
+    }
+    scene(
+        camera([2.2, 3.0, 4.2], [-0.25, 0.4, -0.1], 50.0),
+        Light {
+            center: Vec3::new(0.3, 4.0, 0.2),
+            shape: rect(0.5),
+        },
+        meshes,
+    )
+}
+
+/// One two-sided 1×1 quad at y = 1 under a rectangular light at y = 3: the whole penumbra
+/// (|x|, |z| ≤ 1) falls on the floor and is seen from in front without the quad hiding it.
+fn single_quad() -> Scene {
+    let q = [
+        Vec3::new(-0.5, 1.0, 0.5),
+        Vec3::new(0.5, 1.0, 0.5),
+        Vec3::new(0.5, 1.0, -0.5),
+        Vec3::new(-0.5, 1.0, -0.5),
+    ];
+    scene(
+        camera([0.0, 2.2, 3.6], [0.0, 0.2, -0.2], 45.0),
+        Light {
+            center: Vec3::new(0.0, 3.0, 0.0),
+            shape: rect(0.5),
+        },
+        vec![
+            floor([-3.0, 3.0], [-3.0, 3.0]),
+            two_sided_quad("quad", q, OCCLUDER),
+        ],
+    )
+}
+
+/// A standing capped cylinder floating 0.4 above the floor, lit from the side by a sphere
+/// light so that its shadow falls sideways onto the floor.
+fn cylinder_scene() -> Scene {
+    scene(
+        camera([1.0, 2.6, 4.0], [-0.3, 0.4, 0.0], 45.0),
+        Light {
+            center: Vec3::new(1.2, 3.2, 0.6),
+            shape: LightShape::Sphere { radius: 0.3 },
+        },
+        vec![
+            floor([-3.0, 3.0], [-3.0, 3.0]),
+            cylinder(
+                "cylinder",
+                Vec3::new(0.0, 0.4, 0.0),
+                0.35,
+                1.0,
+                24,
+                OCCLUDER,
+            ),
+        ],
+    )
+}
+
+/// The slab occluder of `eye-in-shadow` (min, max).
+const SLAB: (Vec3, Vec3) = (Vec3::new(-2.0, 1.6, -2.0), Vec3::new(2.0, 1.7, 1.0));
+
+/// The camera sits under a large horizontal slab, inside its hard shadow volume (the segment
+/// from the eye to the light center crosses the slab), looking along +z at the shadowed floor
+/// and beyond it into the lit region, where a small floating box casts its own shadow.
+/// z-pass counts are wrong here; z-fail is right.
+fn eye_in_shadow() -> Scene {
+    scene(
+        camera([0.0, 0.8, 0.5], [0.0, 0.0, 2.5], 60.0),
+        Light {
+            center: Vec3::new(0.0, 4.0, -0.5),
+            shape: rect(0.4),
+        },
+        vec![
+            floor([-6.0, 6.0], [-8.0, 8.0]),
+            box_mesh("slab", SLAB.0, SLAB.1, OCCLUDER),
+            box_mesh(
+                "box",
+                Vec3::new(-0.4, 0.3, 3.4),
+                Vec3::new(0.4, 0.9, 4.2),
+                OCCLUDER,
+            ),
+        ],
+    )
+}
+
+/// Number of quads in `overlap-stress`.
+const STRESS_QUADS: u32 = 300;
+
+/// 300 two-sided quads (1.2×1.2) stacked 0.002 apart from y = 1 under a point light at y = 4:
+/// floor points with |x|, |z| < 0.8 are inside all 300 shadow volumes (more than an 8-bit
+/// stencil holds, so wrap and saturate differ), and the band 0.8 < |x| or |z| < 1.0 is inside
+/// fewer, from 299 down to 1, because the higher quads cast larger shadows.
+fn overlap_stress() -> Scene {
+    let mut meshes = vec![floor([-3.0, 3.0], [-3.0, 3.0])];
+    for i in 0..STRESS_QUADS {
+        let y = (1.0 + 0.002 * f64::from(i)) as f32;
+        let q = [
+            Vec3::new(-0.6, y, 0.6),
+            Vec3::new(0.6, y, 0.6),
+            Vec3::new(0.6, y, -0.6),
+            Vec3::new(-0.6, y, -0.6),
+        ];
+        meshes.push(two_sided_quad(&format!("quad[{i}]"), q, OCCLUDER));
+    }
+    scene(
+        camera([0.0, 2.0, 3.5], [0.0, 0.3, -0.3], 45.0),
+        Light {
+            center: Vec3::new(0.0, 4.0, 0.0),
+            shape: LightShape::Point,
+        },
+        meshes,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::validate::validate;
+
+    #[test]
+    fn every_builtin_validates() {
+        assert!(names().contains(&DEFAULT));
+        for &name in names() {
+            let s = load(name).unwrap();
+            assert_eq!(s.source, name);
+            validate(&s).unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!((s.width, s.height), (256, 256));
+        }
+        assert!(load("no-such-scene").is_none());
+    }
+
+    #[test]
+    fn triangle_counts() {
+        let count = |n: &str| {
+            load(n)
+                .unwrap()
+                .meshes
+                .iter()
+                .map(|m| m.triangles.len())
+                .sum::<usize>()
+        };
+        assert_eq!(count("cube-of-spheres"), 12 + 27 * 168);
+        assert_eq!(count("single-quad"), 12 + 4);
+        assert_eq!(count("cylinder"), 12 + 96);
+        assert_eq!(count("eye-in-shadow"), 36);
+        assert_eq!(count("overlap-stress"), 12 + 300 * 4);
+    }
+
+    /// The light's extent (a bounding sphere of its shape) clears every mesh's bounding box.
+    #[test]
+    fn lights_clear_geometry() {
+        for &name in names() {
+            let s = load(name).unwrap();
+            let r = match &s.light.shape {
+                LightShape::Point => 0.0,
+                LightShape::Sphere { radius } | LightShape::Disk { radius, .. } => *radius,
+                LightShape::Rect { u, v } | LightShape::TexturedRect { u, v, .. } => {
+                    u.length() + v.length()
+                }
+            };
+            for m in &s.meshes {
+                let (lo, hi) = m
+                    .positions
+                    .iter()
+                    .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| {
+                        (l.min(*p), h.max(*p))
+                    });
+                let d = s.light.center.clamp(lo, hi).distance(s.light.center);
+                assert!(d > r + 0.5, "{name}: light {r} within {d} of {}", m.name);
+            }
+        }
+    }
+
+    /// Where the segment from `p` to `light` crosses the plane y = `y`.
+    fn cross_at(p: Vec3, light: Vec3, y: f32) -> Vec3 {
+        let t = (y - p.y) / (light.y - p.y);
+        p + (light - p) * t
+    }
+
+    #[test]
+    fn eye_is_strictly_inside_the_slab_shadow_volume() {
+        let s = load("eye-in-shadow").unwrap();
+        let eye = s.camera.eye.as_vec3();
+        for y in [SLAB.0.y, SLAB.1.y] {
+            let c = cross_at(eye, s.light.center, y);
+            let margin = (c.x - SLAB.0.x)
+                .min(SLAB.1.x - c.x)
+                .min(c.z - SLAB.0.z)
+                .min(SLAB.1.z - c.z);
+            assert!(margin > 0.5, "eye only {margin} inside the shadow volume");
+        }
+        assert!(eye.y < SLAB.0.y && eye.y > 0.0);
+    }
+
+    #[test]
+    fn overlap_stress_counts() {
+        let s = load("overlap-stress").unwrap();
+        // Number of quads the segment from a floor point to the light crosses.
+        let count = |x: f32| {
+            let p = Vec3::new(x, 0.0, 0.0);
+            s.meshes[1..]
+                .iter()
+                .filter(|m| {
+                    let y = m.positions[0].y;
+                    let c = cross_at(p, s.light.center, y);
+                    c.x.abs() < 0.6 && c.z.abs() < 0.6
+                })
+                .count()
+        };
+        assert_eq!(count(0.0), 300);
+        assert_eq!(count(0.79), 300);
+        let band = count(0.9);
+        assert!(band > 0 && band < 255, "{band}");
+        assert_eq!(count(1.01), 0);
+    }
+}
