@@ -7,6 +7,8 @@
 //! camera, closed two-manifold meshes.
 
 pub mod builtin;
+pub mod file;
+pub mod obj;
 pub mod procedural;
 pub mod validate;
 

@@ -1,0 +1,684 @@
+//! Scene files: one schema, written as TOML (`.toml`) or JSON (`.json`).
+//!
+//! ```toml
+//! width = 256                 # optional, default 256
+//! height = 256                # optional, default 256
+//! ambient = 0.15              # optional, default 0.15
+//! methods = ["hard-sv", "nsample"]   # optional, default: every method for the light shape
+//!
+//! [camera]
+//! eye = [0, 2, 5]
+//! target = [0, 0, 0]
+//! up = [0, 1, 0]
+//! vfov_deg = 45
+//! near = 0.1                  # optional
+//!
+//! [light]
+//! type = "rect"               # point | sphere | disk | rect | textured_rect
+//! center = [0, 4, 0]
+//! u = [0.5, 0, 0]             # rect, textured_rect: half-extent vectors
+//! v = [0, 0, 0.5]
+//! radius = 0.5                # sphere, disk
+//! normal = [0, -1, 0]         # disk (used as written, not normalized)
+//! texture = "fire.png"        # textured_rect, relative to the scene file, sRGB → linear
+//!
+//! [[meshes]]
+//! obj = "models/bunny.obj"    # relative to the scene file
+//! transform = [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]   # optional, column-major, affine
+//! color = [0.8, 0.8, 0.8]     # optional, linear RGB albedo
+//!
+//! [options.nsample]           # per-method options, checked later by each method
+//! n = 256
+//! ```
+//!
+//! Unknown keys anywhere are errors (`deny_unknown_fields`), as are light fields that do not
+//! belong to the chosen light type and missing ones that do (the error names `light.<field>`).
+//! Option values must be scalars (integer, float, bool, string). Every error is one line
+//! naming the file, and for syntax and schema errors the line and column.
+
+use super::obj::{check_transform, load_obj};
+use super::validate::validate;
+use super::{builtin, Camera, Light, LightShape, Mesh, OptionValue, RawOptions, RgbTexture, Scene};
+use crate::error::InputError;
+use glam::{DVec3, Mat4, Vec3};
+use serde::de::{self, IgnoredAny, MapAccess, SeqAccess, Visitor};
+use serde::{Deserialize, Deserializer};
+use std::collections::BTreeMap;
+use std::fmt;
+use std::path::Path;
+
+/// The syntax a scene file is written in; both share one schema.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// TOML (`.toml`).
+    Toml,
+    /// JSON (`.json`).
+    Json,
+}
+
+impl Format {
+    /// The format for a file name's extension (`.toml`, `.json`, case-insensitive).
+    pub fn from_path(path: &Path) -> Option<Format> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "toml" => Some(Format::Toml),
+            "json" => Some(Format::Json),
+            _ => None,
+        }
+    }
+}
+
+/// Default image edge in pixels.
+const DEFAULT_SIZE: u32 = 256;
+/// Default ambient term.
+const DEFAULT_AMBIENT: f64 = 0.15;
+/// Default mesh albedo.
+const DEFAULT_COLOR: [f64; 3] = [0.8, 0.8, 0.8];
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneDef {
+    width: Option<u32>,
+    height: Option<u32>,
+    ambient: Option<f64>,
+    methods: Option<Vec<String>>,
+    camera: CameraDef,
+    light: LightDef,
+    meshes: Vec<MeshDef>,
+    #[serde(default)]
+    options: BTreeMap<String, BTreeMap<String, RawValue>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CameraDef {
+    eye: [f64; 3],
+    target: [f64; 3],
+    up: [f64; 3],
+    vfov_deg: f64,
+    near: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LightDef {
+    #[serde(rename = "type")]
+    kind: String,
+    center: [f64; 3],
+    u: Option<[f64; 3]>,
+    v: Option<[f64; 3]>,
+    radius: Option<f64>,
+    normal: Option<[f64; 3]>,
+    texture: Option<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MeshDef {
+    obj: String,
+    transform: Option<Vec<f64>>,
+    color: Option<[f64; 3]>,
+}
+
+/// An option value as written; arrays and tables are kept only to be reported as errors.
+enum RawValue {
+    Scalar(OptionValue),
+    Array,
+    Table,
+}
+
+impl<'de> Deserialize<'de> for RawValue {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = RawValue;
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str("an integer, float, bool or string")
+            }
+            fn visit_bool<E: de::Error>(self, b: bool) -> Result<RawValue, E> {
+                Ok(RawValue::Scalar(OptionValue::Bool(b)))
+            }
+            fn visit_i64<E: de::Error>(self, i: i64) -> Result<RawValue, E> {
+                Ok(RawValue::Scalar(OptionValue::Int(i)))
+            }
+            fn visit_u64<E: de::Error>(self, u: u64) -> Result<RawValue, E> {
+                i64::try_from(u)
+                    .map(|i| RawValue::Scalar(OptionValue::Int(i)))
+                    .map_err(|_| E::custom(format!("integer {u} is too large")))
+            }
+            fn visit_f64<E: de::Error>(self, x: f64) -> Result<RawValue, E> {
+                Ok(RawValue::Scalar(OptionValue::Float(x)))
+            }
+            fn visit_str<E: de::Error>(self, s: &str) -> Result<RawValue, E> {
+                Ok(RawValue::Scalar(OptionValue::Str(s.to_string())))
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<RawValue, A::Error> {
+                while seq.next_element::<IgnoredAny>()?.is_some() {}
+                Ok(RawValue::Array)
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<RawValue, A::Error> {
+                while map.next_entry::<IgnoredAny, IgnoredAny>()?.is_some() {}
+                Ok(RawValue::Table)
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// Loads, builds and validates the scene file at `path` (format from its extension; OBJ and
+/// texture paths relative to its directory). The scene's `source` is `path` as given.
+pub fn load_scene_file(path: &Path) -> Result<Scene, InputError> {
+    let source = path.display().to_string();
+    let format = Format::from_path(path).ok_or_else(|| {
+        InputError::new(
+            &source,
+            "unknown scene file extension (expected .toml or .json)",
+        )
+    })?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| InputError::new(&source, format!("cannot read scene file: {e}")))?;
+    let base_dir = path.parent().unwrap_or(Path::new(""));
+    parse_scene_str(&text, format, &source, base_dir)
+}
+
+/// Parses scene text in `format`, loads its OBJs and texture relative to `base_dir`, and
+/// validates the result; errors name `source_name`. Never panics on any input (fuzzed).
+pub fn parse_scene_str(
+    text: &str,
+    format: Format,
+    source_name: &str,
+    base_dir: &Path,
+) -> Result<Scene, InputError> {
+    let def: SceneDef = match format {
+        Format::Toml => toml::from_str(text).map_err(|e| toml_error(source_name, text, &e))?,
+        Format::Json => serde_json::from_str(text).map_err(|e| json_error(source_name, &e))?,
+    };
+    let scene = build(def, source_name, base_dir)?;
+    validate(&scene)?;
+    Ok(scene)
+}
+
+/// A built-in scene name or a scene file path. Built-in names take precedence; an argument
+/// that is neither gives an error listing the built-in scenes.
+pub fn resolve(arg: &str) -> Result<Scene, InputError> {
+    if let Some(scene) = builtin::load(arg) {
+        return Ok(scene);
+    }
+    let path = Path::new(arg);
+    if path.is_file() {
+        return load_scene_file(path);
+    }
+    Err(InputError::new(
+        arg,
+        format!(
+            "not a built-in scene or an existing scene file (built-in scenes: {})",
+            builtin::names().join(", ")
+        ),
+    ))
+}
+
+/// One line from a TOML error: "line L, column C: message".
+fn toml_error(source: &str, text: &str, e: &toml::de::Error) -> InputError {
+    let msg = one_line(e.message());
+    match e.span() {
+        Some(span) => {
+            let (line, col) = line_col(text, span.start);
+            InputError::new(source, format!("line {line}, column {col}: {msg}"))
+        }
+        None => InputError::new(source, msg),
+    }
+}
+
+/// One line from a serde_json error: "line L, column C: message".
+fn json_error(source: &str, e: &serde_json::Error) -> InputError {
+    let full = e.to_string();
+    let suffix = format!(" at line {} column {}", e.line(), e.column());
+    let msg = one_line(full.strip_suffix(&suffix).unwrap_or(&full));
+    if e.line() == 0 {
+        InputError::new(source, msg)
+    } else {
+        InputError::new(
+            source,
+            format!("line {}, column {}: {msg}", e.line(), e.column()),
+        )
+    }
+}
+
+/// Joins the lines of a multi-line message with "; ".
+fn one_line(s: &str) -> String {
+    s.lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+/// 1-based line and column (in characters) of byte offset `at` in `text`.
+fn line_col(text: &str, at: usize) -> (usize, usize) {
+    let mut at = at.min(text.len());
+    while !text.is_char_boundary(at) {
+        at -= 1;
+    }
+    let before = &text[..at];
+    let line = before.matches('\n').count() + 1;
+    let col = before.rsplit('\n').next().unwrap_or("").chars().count() + 1;
+    (line, col)
+}
+
+fn v3(a: [f64; 3]) -> Vec3 {
+    DVec3::from_array(a).as_vec3()
+}
+
+/// Turns the parsed definition into a scene: light fields per type, meshes, options.
+fn build(def: SceneDef, source: &str, base_dir: &Path) -> Result<Scene, InputError> {
+    let at = |object: &str, message: String| InputError::at(source, object, message);
+    let camera = Camera {
+        eye: DVec3::from_array(def.camera.eye),
+        target: DVec3::from_array(def.camera.target),
+        up: DVec3::from_array(def.camera.up),
+        vfov_deg: def.camera.vfov_deg,
+        near: def.camera.near,
+    };
+    let light = build_light(def.light, source, base_dir)?;
+
+    let mut meshes = Vec::with_capacity(def.meshes.len());
+    for (i, m) in def.meshes.iter().enumerate() {
+        meshes.push(build_mesh(m, i, source, base_dir)?);
+    }
+
+    let mut options = RawOptions::new();
+    for (method, table) in def.options {
+        let mut out = BTreeMap::new();
+        for (key, value) in table {
+            match value {
+                RawValue::Scalar(v) => {
+                    out.insert(key, v);
+                }
+                RawValue::Array | RawValue::Table => {
+                    return Err(at(
+                        &format!("options.{method}.{key}"),
+                        "must be a single integer, float, bool or string".into(),
+                    ));
+                }
+            }
+        }
+        options.insert(method, out);
+    }
+
+    Ok(Scene {
+        source: source.to_string(),
+        width: def.width.unwrap_or(DEFAULT_SIZE),
+        height: def.height.unwrap_or(DEFAULT_SIZE),
+        camera,
+        light,
+        meshes,
+        methods: def.methods,
+        options,
+        ambient: def.ambient.unwrap_or(DEFAULT_AMBIENT) as f32,
+    })
+}
+
+/// The light types and the fields each one takes besides `type` and `center`.
+const LIGHT_FIELDS: [(&str, &[&str]); 5] = [
+    ("point", &[]),
+    ("sphere", &["radius"]),
+    ("disk", &["radius", "normal"]),
+    ("rect", &["u", "v"]),
+    ("textured_rect", &["u", "v", "texture"]),
+];
+
+fn build_light(l: LightDef, source: &str, base_dir: &Path) -> Result<Light, InputError> {
+    let at =
+        |field: &str, message: String| InputError::at(source, format!("light.{field}"), message);
+    let Some(&(kind, fields)) = LIGHT_FIELDS.iter().find(|(k, _)| *k == l.kind) else {
+        let kinds: Vec<&str> = LIGHT_FIELDS.iter().map(|(k, _)| *k).collect();
+        return Err(at(
+            "type",
+            format!(
+                "unknown light type {:?} (expected one of {})",
+                l.kind,
+                kinds.join(", ")
+            ),
+        ));
+    };
+    let present = [
+        ("u", l.u.is_some()),
+        ("v", l.v.is_some()),
+        ("radius", l.radius.is_some()),
+        ("normal", l.normal.is_some()),
+        ("texture", l.texture.is_some()),
+    ];
+    let takes = if fields.is_empty() {
+        "only center".to_string()
+    } else {
+        fields.join(", ")
+    };
+    for (name, is) in present {
+        if is && !fields.contains(&name) {
+            return Err(at(
+                name,
+                format!("not used by a \"{kind}\" light (it takes {takes})"),
+            ));
+        }
+        if !is && fields.contains(&name) {
+            return Err(at(
+                name,
+                format!("missing: a \"{kind}\" light needs {takes}"),
+            ));
+        }
+    }
+    // Every field the type needs is present (checked above).
+    let u = l.u.map(v3).unwrap_or_default();
+    let v = l.v.map(v3).unwrap_or_default();
+    let radius = l.radius.unwrap_or_default() as f32;
+    let shape = match kind {
+        "point" => LightShape::Point,
+        "sphere" => LightShape::Sphere { radius },
+        "disk" => LightShape::Disk {
+            radius,
+            normal: l.normal.map(v3).unwrap_or_default(),
+        },
+        "rect" => LightShape::Rect { u, v },
+        _ => {
+            let rel = l.texture.unwrap_or_default();
+            let texture = load_texture(&base_dir.join(&rel)).map_err(|m| at("texture", m))?;
+            LightShape::TexturedRect { u, v, texture }
+        }
+    };
+    Ok(Light {
+        center: v3(l.center),
+        shape,
+    })
+}
+
+fn build_mesh(m: &MeshDef, i: usize, source: &str, base_dir: &Path) -> Result<Mesh, InputError> {
+    let at = |field: &str, message: String| {
+        InputError::at(source, format!("meshes[{i}]{field}"), message)
+    };
+    let transform = match &m.transform {
+        None => None,
+        Some(t) => {
+            let arr: [f64; 16] = t.as_slice().try_into().map_err(|_| {
+                at(
+                    ".transform",
+                    format!(
+                        "has {} numbers, needs 16 (a column-major 4×4 matrix)",
+                        t.len()
+                    ),
+                )
+            })?;
+            let mat = Mat4::from_cols_array(&arr.map(|x| x as f32));
+            check_transform(&mat).map_err(|e| at(".transform", e))?;
+            Some(mat)
+        }
+    };
+    let color = m.color.unwrap_or(DEFAULT_COLOR).map(|c| c as f32);
+    let path = base_dir.join(&m.obj);
+    let display = path.display().to_string();
+    load_obj(&path, &display, transform, color).map_err(|e| {
+        at(
+            &format!(" ({})", m.obj),
+            format!("{}: {}", e.file, e.message),
+        )
+    })
+}
+
+/// Loads an image as linear RGB in [0,1]: 8- and 16-bit images are sRGB-decoded, float
+/// images (EXR) are taken as linear. Alpha is ignored.
+fn load_texture(path: &Path) -> Result<RgbTexture, String> {
+    let name = path.display().to_string();
+    let img = image::ImageReader::open(path)
+        .and_then(|r| r.with_guessed_format())
+        .map_err(|e| format!("cannot open {name}: {e}"))?
+        .decode()
+        .map_err(|e| format!("cannot decode {name}: {e}"))?;
+    let (width, height) = (img.width(), img.height());
+    let float = matches!(
+        img.color(),
+        image::ColorType::Rgb32F | image::ColorType::Rgba32F
+    );
+    let texels = if float {
+        img.to_rgb32f().pixels().map(|p| p.0).collect()
+    } else {
+        img.to_rgb16()
+            .pixels()
+            .map(|p| p.0.map(|c| srgb_to_linear(f64::from(c) / 65535.0) as f32))
+            .collect()
+    };
+    Ok(RgbTexture {
+        width,
+        height,
+        texels,
+        source: name,
+    })
+}
+
+/// The sRGB electro-optical transfer function (IEC 61966-2-1), in f64.
+fn srgb_to_linear(c: f64) -> f64 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A directory with a closed tetrahedron and a floor box, for parsing tests.
+    fn fixture() -> std::path::PathBuf {
+        // One directory per call: tests run in parallel and must not see half-written files.
+        static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let dir =
+            std::env::temp_dir().join(format!("penumbra-scene-file-{}-{n}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(
+            dir.join("tet.obj"),
+            "v 0 1 0\nv 0 2 0\nv 1 1 0\nv 0 1 1\nf 1 3 4\nf 1 2 3\nf 1 4 2\nf 2 4 3\n",
+        )
+        .unwrap();
+        std::fs::write(
+            dir.join("floor.obj"),
+            "v -2 -0.1 -2\nv 2 -0.1 -2\nv -2 0 -2\nv 2 0 -2\nv -2 -0.1 2\nv 2 -0.1 2\nv -2 0 2\nv 2 0 2\n\
+             f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n",
+        )
+        .unwrap();
+        dir
+    }
+
+    const GOOD: &str = r#"
+width = 64
+methods = ["hard-sv"]
+[camera]
+eye = [0, 2, 5]
+target = [0, 0, 0]
+up = [0, 1, 0]
+vfov_deg = 45
+[light]
+type = "rect"
+center = [0, 4, 0]
+u = [0.5, 0, 0]
+v = [0, 0, 0.5]
+[[meshes]]
+obj = "floor.obj"
+[[meshes]]
+obj = "tet.obj"
+color = [1, 0, 0]
+transform = [1,0,0,0, 0,1,0,0, 0,0,1,0, 0.5,0,0,1]
+[options.nsample]
+n = 256
+jitter = true
+name = "x"
+f = 0.5
+"#;
+
+    fn toml_in(dir: &Path, text: &str) -> Result<Scene, InputError> {
+        parse_scene_str(text, Format::Toml, "s.toml", dir)
+    }
+
+    fn toml(text: &str) -> Result<Scene, InputError> {
+        toml_in(&fixture(), text)
+    }
+
+    #[test]
+    fn good_toml() {
+        let s = toml(GOOD).unwrap();
+        assert_eq!((s.width, s.height), (64, 256));
+        assert_eq!(s.ambient, 0.15);
+        assert_eq!(s.methods, Some(vec!["hard-sv".to_string()]));
+        assert_eq!(s.meshes.len(), 2);
+        assert_eq!(s.meshes[1].color, [1.0, 0.0, 0.0]);
+        assert!(s.meshes[1].positions.contains(&Vec3::new(1.5, 1.0, 0.0)));
+        assert_eq!(s.meshes[0].color, [0.8, 0.8, 0.8]);
+        let o = &s.options["nsample"];
+        assert_eq!(o["n"], OptionValue::Int(256));
+        assert_eq!(o["jitter"], OptionValue::Bool(true));
+        assert_eq!(o["name"], OptionValue::Str("x".into()));
+        assert_eq!(o["f"], OptionValue::Float(0.5));
+        assert_eq!(
+            s.light.shape,
+            LightShape::Rect {
+                u: Vec3::X * 0.5,
+                v: Vec3::Z * 0.5
+            }
+        );
+    }
+
+    #[test]
+    fn json_same_schema() {
+        let json = r#"{"width": 64, "methods": ["hard-sv"],
+            "camera": {"eye": [0, 2, 5], "target": [0, 0, 0], "up": [0, 1, 0], "vfov_deg": 45},
+            "light": {"type": "rect", "center": [0, 4, 0], "u": [0.5, 0, 0], "v": [0, 0, 0.5]},
+            "meshes": [{"obj": "floor.obj"}, {"obj": "tet.obj", "color": [1, 0, 0],
+                "transform": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0.5,0,0,1]}],
+            "options": {"nsample": {"n": 256, "jitter": true, "name": "x", "f": 0.5}}}"#;
+        let dir = fixture();
+        let s = parse_scene_str(json, Format::Json, "s.toml", &dir).unwrap();
+        assert_eq!(s, toml_in(&dir, GOOD).unwrap());
+    }
+
+    fn err(text: &str) -> String {
+        toml(text).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn syntax_and_schema_errors() {
+        let e = err("width = \n");
+        assert!(e.starts_with("s.toml: line 1, column "), "{e}");
+        assert!(!e.contains('\n'));
+        let e = err(&GOOD.replace("width = 64", "widht = 64"));
+        assert!(
+            e.starts_with("s.toml: line 2, column 1: unknown field `widht`"),
+            "{e}"
+        );
+        let e = err(&GOOD.replace("vfov_deg = 45", "vfov_deg = \"wide\""));
+        assert!(e.contains("line 8") && e.contains("invalid type"), "{e}");
+        let e = parse_scene_str(
+            "{\"width\": 5,\n \"x\": 1}",
+            Format::Json,
+            "s.json",
+            Path::new("."),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.starts_with("s.json: line 2, column ") && e.contains(": unknown field `x`"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn light_fields() {
+        let e = err(&GOOD.replace("type = \"rect\"", "type = \"sphere\""));
+        assert_eq!(
+            e,
+            "s.toml: light.u: not used by a \"sphere\" light (it takes radius)"
+        );
+        let e = err(&GOOD.replace("v = [0, 0, 0.5]", ""));
+        assert_eq!(e, "s.toml: light.v: missing: a \"rect\" light needs u, v");
+        let e = err(&GOOD.replace("type = \"rect\"", "type = \"square\""));
+        assert!(
+            e.starts_with("s.toml: light.type: unknown light type \"square\""),
+            "{e}"
+        );
+        let e = err(&GOOD.replace("u = [0.5, 0, 0]", "u = [0, 0, 0]"));
+        assert!(e.contains("light.u: is the zero vector"), "{e}");
+        let e = err(&GOOD.replace(
+            "type = \"rect\"",
+            "type = \"textured_rect\"\ntexture = \"no.png\"",
+        ));
+        assert!(e.starts_with("s.toml: light.texture: cannot open "), "{e}");
+    }
+
+    #[test]
+    fn mesh_and_option_errors() {
+        let e = err(&GOOD.replace("obj = \"tet.obj\"", "obj = \"nope.obj\""));
+        assert!(
+            e.starts_with("s.toml: meshes[1] (nope.obj): ")
+                && e.contains("nope.obj: cannot read OBJ file"),
+            "{e}"
+        );
+        let e = err(&GOOD.replace("0.5,0,0,1]", "0.5,0,0]"));
+        assert_eq!(
+            e,
+            "s.toml: meshes[1].transform: has 15 numbers, needs 16 (a column-major 4×4 matrix)"
+        );
+        let e = err(&GOOD.replace("n = 256", "n = [1, 2]"));
+        assert_eq!(
+            e,
+            "s.toml: options.nsample.n: must be a single integer, float, bool or string"
+        );
+        let e = err(&GOOD.replace("n = 256", "n = { a = 1 }"));
+        assert!(e.contains("options.nsample.n"), "{e}");
+        let e = err(&GOOD.replace("[camera]", "ambient = nan\n[camera]"));
+        assert!(e.contains("ambient"), "{e}");
+    }
+
+    #[test]
+    fn texture_light() {
+        let dir = fixture();
+        let mut img = image::RgbImage::new(2, 1);
+        img.put_pixel(0, 0, image::Rgb([255, 0, 128]));
+        img.put_pixel(1, 0, image::Rgb([10, 20, 30]));
+        img.save(dir.join("t.png")).unwrap();
+        let s = toml_in(
+            &dir,
+            &GOOD.replace(
+                "type = \"rect\"",
+                "type = \"textured_rect\"\ntexture = \"t.png\"",
+            ),
+        )
+        .unwrap();
+        let LightShape::TexturedRect { texture, .. } = &s.light.shape else {
+            panic!()
+        };
+        assert_eq!((texture.width, texture.height), (2, 1));
+        assert_eq!(texture.texels[0][0], 1.0);
+        assert_eq!(texture.texels[0][1], 0.0);
+        assert!((texture.texels[0][2] - 0.2158605).abs() < 1e-6);
+        assert!((texture.texels[1][0] - 10.0 / 255.0 / 12.92).abs() < 1e-7);
+    }
+
+    #[test]
+    fn resolve_names_and_paths() {
+        assert_eq!(resolve("single-quad").unwrap().source, "single-quad");
+        let e = resolve("no-such-thing").unwrap_err().to_string();
+        assert!(
+            e.starts_with("no-such-thing: not a built-in scene") && e.contains("cube-of-spheres"),
+            "{e}"
+        );
+        let dir = fixture();
+        std::fs::write(dir.join("s.yaml"), "x").unwrap();
+        let p = dir.join("s.yaml");
+        let e = resolve(p.to_str().unwrap()).unwrap_err();
+        assert!(e.message.contains("unknown scene file extension"));
+    }
+
+    #[test]
+    fn line_col_counts_chars() {
+        assert_eq!(line_col("ab\ncé\nx", 6), (2, 3));
+        assert_eq!(line_col("", 5), (1, 1));
+    }
+}
