@@ -415,12 +415,8 @@ fn build_mesh(m: &MeshDef, i: usize, source: &str, base_dir: &Path) -> Result<Me
     let color = m.color.unwrap_or(DEFAULT_COLOR).map(|c| c as f32);
     let path = base_dir.join(&m.obj);
     let display = path.display().to_string();
-    load_obj(&path, &display, transform, color).map_err(|e| {
-        at(
-            &format!(" ({})", m.obj),
-            format!("{}: {}", e.file, e.message),
-        )
-    })
+    load_obj(&path, &display, transform, color)
+        .map_err(|e| InputError::at(source, format!("meshes[{i}] ({display})"), e.message))
 }
 
 /// Loads an image as linear RGB in [0,1]: 8- and 16-bit images are sRGB-decoded, float
@@ -616,8 +612,7 @@ f = 0.5
     fn mesh_and_option_errors() {
         let e = err(&GOOD.replace("obj = \"tet.obj\"", "obj = \"nope.obj\""));
         assert!(
-            e.starts_with("s.toml: meshes[1] (nope.obj): ")
-                && e.contains("nope.obj: cannot read OBJ file"),
+            e.starts_with("s.toml: meshes[1] (") && e.contains("nope.obj): cannot read OBJ file: "),
             "{e}"
         );
         let e = err(&GOOD.replace("0.5,0,0,1]", "0.5,0,0]"));

@@ -67,9 +67,13 @@ pub fn parse_obj(
         for p in mesh.positions.chunks_exact(3) {
             let v = Vec3::new(p[0], p[1], p[2]);
             if !v.is_finite() {
+                let object = match model.name.as_str() {
+                    "unnamed_object" | "" => String::new(),
+                    name => format!(" in object \"{name}\""),
+                };
                 return Err(err(format!(
-                    "vertex ({}, {}, {}) of object \"{}\" is not finite",
-                    v.x, v.y, v.z, model.name
+                    "vertex ({}, {}, {}){object} is not finite",
+                    v.x, v.y, v.z
                 )));
             }
             // +0.0 turns −0.0 into +0.0, so both weld together.
@@ -210,10 +214,7 @@ mod tests {
     #[test]
     fn nan_vertex() {
         let e = parse("v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", None).unwrap_err();
-        assert_eq!(
-            e.to_string(),
-            "test.obj: vertex (NaN, 0, 0) of object \"unnamed_object\" is not finite"
-        );
+        assert_eq!(e.to_string(), "test.obj: vertex (NaN, 0, 0) is not finite");
         let e = parse("v 0 0 0\nv inf 0 0\nv 0 1 0\nf 1 2 3\n", None).unwrap_err();
         assert!(e.message.contains("(inf, 0, 0)"), "{e}");
     }

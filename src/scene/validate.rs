@@ -6,7 +6,8 @@
 //! the view direction, `near > 0` if given; a light of positive size (radius > 0; `u`, `v`
 //! non-zero and not parallel; disk normal non-zero; a non-empty texture of `width·height`
 //! texels in [0,1]); at least one mesh, each a closed, consistently wound two-manifold
-//! ([`crate::geometry::adjacency::build`], the message names the offending edge); the light
+//! ([`crate::geometry::adjacency::build`], the message names the offending edge) that is not
+//! inside out (signed volume not negative; flat two-sided meshes have volume 0); the light
 //! centre strictly outside every mesh (bounding box, then ray parity); `ambient` in [0,1];
 //! a `methods` list, if given, not empty (the names are checked by the methods registry).
 
@@ -54,7 +55,7 @@ pub fn validate(scene: &Scene) -> Result<(), InputError> {
                 "light",
                 format!(
                     "light intersects geometry: the light center {} is {why} meshes[{i}] ({})",
-                    fmt_v3(scene.light.center.as_dvec3()),
+                    fmt_f32v(scene.light.center),
                     mesh.name
                 ),
             ));
@@ -65,6 +66,11 @@ pub fn validate(scene: &Scene) -> Result<(), InputError> {
 
 /// Formats a vector as `(x, y, z)` with Rust's shortest round-trip digits.
 fn fmt_v3(v: DVec3) -> String {
+    format!("({}, {}, {})", v.x, v.y, v.z)
+}
+
+/// Formats an f32 vector as `(x, y, z)` with f32's shortest round-trip digits.
+fn fmt_f32v(v: Vec3) -> String {
     format!("({}, {}, {})", v.x, v.y, v.z)
 }
 
@@ -119,7 +125,7 @@ fn validate_camera(c: &Camera) -> Result<(), (&'static str, String)> {
 
 /// Light checks; the error is (object, message).
 fn validate_light(l: &Light) -> Result<(), (&'static str, String)> {
-    let v3 = |v: Vec3| fmt_v3(v.as_dvec3());
+    let v3 = fmt_f32v;
     if !l.center.is_finite() {
         return Err(("light.center", format!("{} is not finite", v3(l.center))));
     }
@@ -222,6 +228,28 @@ fn validate_mesh(m: &Mesh) -> Result<(), String> {
         return Err("the mesh has no triangles".into());
     }
     adjacency::build(m).map_err(|e| e.to_string())?;
+    // Outward winding: the signed volume (relative to the first vertex, to limit
+    // cancellation) must not be negative beyond rounding; flat closed meshes such as
+    // two-sided quads have volume ≈ 0 and pass.
+    let o = m.positions[m.triangles[0][0] as usize].as_dvec3();
+    let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+    let mut volume6 = 0.0;
+    for t in &m.triangles {
+        let [a, b, c] = t.map(|i| m.positions[i as usize].as_dvec3() - o);
+        volume6 += a.dot(b.cross(c));
+        for p in [a, b, c] {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+    }
+    let extent = (hi - lo).max_element();
+    if volume6 < -1e-9 * extent * extent * extent {
+        return Err(format!(
+            "inside out: negative volume {} (triangles must be counter-clockwise seen from \
+             outside)",
+            volume6 / 6.0
+        ));
+    }
     Ok(())
 }
 
@@ -505,6 +533,11 @@ mod tests {
             m.starts_with("test-scene: meshes[0] (floor): open mesh: edge "),
             "{m}"
         );
+        let mut s = scene();
+        for t in &mut s.meshes[1].triangles {
+            t.swap(0, 1);
+        }
+        assert!(msg(&s).starts_with("test-scene: meshes[1] (ball): inside out: negative volume"));
         let mut s = scene();
         s.meshes.clear();
         assert!(msg(&s).contains("no meshes"));

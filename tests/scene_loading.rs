@@ -1,0 +1,173 @@
+//! Scene loading end to end: every shipped scene file loads and validates, every built-in
+//! scene validates, and every file in `scenes/bad/` fails with the expected one-line error
+//! naming the file and the problem.
+
+use penumbra::scene::file::{load_scene_file, resolve};
+use penumbra::scene::validate::validate;
+use penumbra::scene::{builtin, LightShape};
+use std::path::{Path, PathBuf};
+
+fn scenes_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
+}
+
+/// The `.toml` and `.json` files directly in `dir`, sorted.
+fn scene_files(dir: &Path) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            matches!(
+                p.extension().and_then(|e| e.to_str()),
+                Some("toml" | "json")
+            )
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+#[test]
+fn every_scene_file_loads() {
+    let files = scene_files(&scenes_dir());
+    assert!(
+        files.len() >= 3,
+        "expected at least 3 scene files, found {files:?}"
+    );
+    let mut json = 0;
+    for path in &files {
+        let scene = load_scene_file(path).unwrap_or_else(|e| panic!("{e}"));
+        validate(&scene).unwrap();
+        assert_eq!(scene.source, path.display().to_string());
+        assert!(
+            scene.meshes.len() >= 2,
+            "{}: a floor and an occluder",
+            path.display()
+        );
+        json += usize::from(path.extension().unwrap() == "json");
+        // resolve() accepts the same path.
+        assert_eq!(resolve(path.to_str().unwrap()).unwrap(), scene);
+    }
+    assert!(json >= 1, "at least one JSON scene");
+}
+
+#[test]
+fn shipped_scenes_cover_light_types() {
+    let mut kinds: Vec<&str> = scene_files(&scenes_dir())
+        .iter()
+        .map(|p| load_scene_file(p).unwrap().light.shape.type_name())
+        .collect();
+    kinds.sort();
+    kinds.dedup();
+    for k in ["rect", "sphere", "disk", "textured_rect"] {
+        assert!(
+            kinds.contains(&k),
+            "no shipped scene with a {k} light: {kinds:?}"
+        );
+    }
+}
+
+#[test]
+fn every_builtin_validates() {
+    assert!(builtin::names().contains(&builtin::DEFAULT));
+    for &name in builtin::names() {
+        let scene = builtin::load(name).unwrap();
+        validate(&scene).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(resolve(name).unwrap(), scene);
+    }
+    let err = resolve("no-such-scene").unwrap_err().to_string();
+    for &name in builtin::names() {
+        assert!(err.contains(name), "{err}");
+    }
+}
+
+/// Loads `scenes/bad/NAME` and returns the error as the CLI prints it.
+fn bad(name: &str) -> String {
+    let path = scenes_dir().join("bad").join(name);
+    let err = load_scene_file(&path).expect_err(name).to_string();
+    assert!(!err.contains('\n'), "error must be one line: {err}");
+    assert!(
+        err.starts_with(&path.display().to_string()),
+        "error must name the file: {err}"
+    );
+    err
+}
+
+fn assert_contains(err: &str, parts: &[&str]) {
+    for p in parts {
+        assert!(err.contains(p), "expected {p:?} in: {err}");
+    }
+}
+
+#[test]
+fn malformed_toml() {
+    assert_contains(
+        &bad("malformed.toml"),
+        &["malformed.toml: line 7, column 1: invalid array; expected `]`"],
+    );
+}
+
+#[test]
+fn missing_obj() {
+    assert_contains(
+        &bad("missing-obj.toml"),
+        &[
+            "missing-obj.toml: meshes[1] (",
+            "models/does-not-exist.obj): cannot read OBJ file: ",
+        ],
+    );
+}
+
+#[test]
+fn open_mesh() {
+    assert_contains(
+        &bad("open-mesh.toml"),
+        &[
+            "open-mesh.toml: meshes[1] (",
+            "open-box.obj): open mesh: edge ",
+            "has only one triangle",
+        ],
+    );
+}
+
+#[test]
+fn nan_vertex() {
+    assert_contains(
+        &bad("nan-vertex.toml"),
+        &[
+            "nan-vertex.toml: meshes[1] (",
+            "models/nan-vertex.obj): vertex (0, NaN, 0) is not finite",
+        ],
+    );
+}
+
+#[test]
+fn nan_light() {
+    assert_contains(
+        &bad("nan-light.toml"),
+        &["nan-light.toml: light.center: (0.5, NaN, 0.3) is not finite"],
+    );
+}
+
+#[test]
+fn zero_light() {
+    assert_contains(
+        &bad("zero-light.toml"),
+        &["zero-light.toml: light.u: is the zero vector (zero-size light)"],
+    );
+}
+
+#[test]
+fn unknown_method_loads_and_is_left_to_the_registry() {
+    let scene = load_scene_file(&scenes_dir().join("bad/unknown-method.toml")).unwrap();
+    assert_eq!(scene.methods, Some(vec!["no-such-method".to_string()]));
+    assert!(matches!(scene.light.shape, LightShape::Rect { .. }));
+}
+
+#[test]
+fn unknown_extension() {
+    let err = load_scene_file(&scenes_dir().join("models/cube.obj"))
+        .unwrap_err()
+        .to_string();
+    assert_contains(&err, &["cube.obj: unknown scene file extension"]);
+}
