@@ -17,12 +17,24 @@ pub struct InputError {
 impl InputError {
     /// An error about `file` as a whole.
     pub fn new(file: impl Into<String>, message: impl Into<String>) -> Self {
-        Self { file: file.into(), object: None, message: message.into() }
+        Self {
+            file: file.into(),
+            object: None,
+            message: message.into(),
+        }
     }
 
     /// An error about one `object` inside `file`.
-    pub fn at(file: impl Into<String>, object: impl Into<String>, message: impl Into<String>) -> Self {
-        Self { file: file.into(), object: Some(object.into()), message: message.into() }
+    pub fn at(
+        file: impl Into<String>,
+        object: impl Into<String>,
+        message: impl Into<String>,
+    ) -> Self {
+        Self {
+            file: file.into(),
+            object: Some(object.into()),
+            message: message.into(),
+        }
     }
 }
 

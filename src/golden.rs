@@ -650,3 +650,83 @@ mod tests {
         assert!(!base.exists());
     }
 }
+
+/// One pinned golden render: a built-in scene at a small size with a list of methods.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct GoldenCase {
+    /// Built-in scene name (also the golden sub-directory).
+    pub scene: &'static str,
+    /// Width and height in pixels (goldens are small so the suite stays fast).
+    pub size: u32,
+    /// Methods pinned for this scene.
+    pub methods: &'static [&'static str],
+}
+
+/// Golden image size (DESIGN.md "Goldens are rendered small").
+pub const GOLDEN_SIZE: u32 = 64;
+
+/// Every golden case: each built-in scene of the foundation with every method that exists.
+pub fn cases() -> Vec<GoldenCase> {
+    [
+        "cube-of-spheres",
+        "single-quad",
+        "cylinder",
+        "eye-in-shadow",
+    ]
+    .into_iter()
+    .map(|scene| GoldenCase {
+        scene,
+        size: GOLDEN_SIZE,
+        methods: crate::methods::ALL,
+    })
+    .collect()
+}
+
+/// Render one golden case: the built-in scene at the case's size with the case's methods.
+pub fn render_case(case: &GoldenCase) -> Result<Vec<crate::render::MethodRun>, String> {
+    let mut scene = crate::scene::builtin::load(case.scene)
+        .ok_or_else(|| format!("no built-in scene {}", case.scene))?;
+    scene.width = case.size;
+    scene.height = case.size;
+    scene.methods = Some(case.methods.iter().map(|m| m.to_string()).collect());
+    crate::render::render_scene(&scene).map_err(|e| e.to_string())
+}
+
+/// Check (or with `bless`, rewrite) every golden case under `root`. Returns a report, one line
+/// per (scene, method); fails with every mismatch listed.
+pub fn run_cases(root: &Path, bless_all: bool) -> Result<String, String> {
+    let mut report = String::new();
+    let mut failures = Vec::new();
+    for case in cases() {
+        for run in render_case(&case)? {
+            let result = if bless_all {
+                bless(root, case.scene, &run.method, &run.output).map(|_| ())
+            } else {
+                check(
+                    root,
+                    case.scene,
+                    &run.method,
+                    case.size,
+                    case.size,
+                    &run.output,
+                )
+            };
+            match result {
+                Ok(()) => {
+                    report += &format!(
+                        "{} {}/{}\n",
+                        if bless_all { "blessed" } else { "ok" },
+                        case.scene,
+                        run.method
+                    )
+                }
+                Err(e) => failures.push(format!("{}/{}: {e}", case.scene, run.method)),
+            }
+        }
+    }
+    if failures.is_empty() {
+        Ok(report)
+    } else {
+        Err(failures.join("\n"))
+    }
+}

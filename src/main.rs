@@ -1,1 +1,160 @@
-fn main() {}
+//! The `penumbra` command line: `render`, `list`, `golden`. With no arguments it renders the
+//! built-in default scene with every available method into `out/` and prints the error/time
+//! table. Bad input prints one line naming the file and the problem and exits with code 2,
+//! before any output is written.
+
+use clap::{Parser, Subcommand};
+use penumbra::error::InputError;
+use penumbra::scene::{builtin, file, validate, OptionValue, Scene};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "penumbra",
+    version,
+    about = "Deterministic soft-shadow algorithms on an emulated GPU"
+)]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Option<Cmd>,
+    /// Worker threads (default: all cores). Results are bit-identical for any count.
+    #[arg(long, global = true)]
+    threads: Option<usize>,
+}
+
+#[derive(Subcommand, Debug)]
+enum Cmd {
+    /// Render a scene (file or built-in name) with its methods and print the error/time table.
+    Render(RenderArgs),
+    /// Print the built-in scenes and the methods, one per line.
+    List,
+    /// Check (or with --bless rewrite) the golden outputs under golden/.
+    Golden {
+        /// Rewrite the goldens instead of checking them.
+        #[arg(long)]
+        bless: bool,
+        /// Golden root directory.
+        #[arg(long, default_value = "golden")]
+        root: PathBuf,
+    },
+}
+
+#[derive(clap::Args, Debug)]
+struct RenderArgs {
+    /// Scene file (.toml/.json) or built-in scene name.
+    #[arg(default_value = builtin::DEFAULT)]
+    scene: String,
+    /// Comma-separated methods (default: the scene's list, else every method its light supports).
+    #[arg(long, value_delimiter = ',')]
+    methods: Option<Vec<String>>,
+    /// Override the image width.
+    #[arg(long)]
+    width: Option<u32>,
+    /// Override the image height.
+    #[arg(long)]
+    height: Option<u32>,
+    /// Output directory.
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
+    /// A method option, METHOD.KEY=VALUE (repeatable), e.g. nsample.n=256 or gpu.tile_size=16.
+    #[arg(long = "opt")]
+    opts: Vec<String>,
+}
+
+fn parse_opt_value(v: &str) -> OptionValue {
+    if let Ok(b) = v.parse::<bool>() {
+        OptionValue::Bool(b)
+    } else if let Ok(i) = v.parse::<i64>() {
+        OptionValue::Int(i)
+    } else if let Ok(f) = v.parse::<f64>() {
+        OptionValue::Float(f)
+    } else {
+        OptionValue::Str(v.to_string())
+    }
+}
+
+fn apply_overrides(scene: &mut Scene, a: &RenderArgs) -> Result<(), InputError> {
+    if let Some(m) = &a.methods {
+        scene.methods = Some(m.clone());
+    }
+    if let Some(w) = a.width {
+        scene.width = w;
+    }
+    if let Some(h) = a.height {
+        scene.height = h;
+    }
+    for o in &a.opts {
+        let bad = || InputError::at("--opt", o.as_str(), "expected METHOD.KEY=VALUE");
+        let (lhs, value) = o.split_once('=').ok_or_else(bad)?;
+        let (method, key) = lhs.split_once('.').ok_or_else(bad)?;
+        if method.is_empty() || key.is_empty() {
+            return Err(bad());
+        }
+        scene
+            .options
+            .entry(method.to_string())
+            .or_default()
+            .insert(key.to_string(), parse_opt_value(value));
+    }
+    validate::validate(scene)
+}
+
+fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let mut scene = file::resolve(&a.scene)?;
+    apply_overrides(&mut scene, a)?;
+    let runs = penumbra::render::render_scene(&scene)?;
+    penumbra::render::write_runs(&a.out, &scene, &runs)?;
+    print!("{}", penumbra::render::table(&scene, &runs));
+    println!("outputs: {}/METHOD/{{image.png, visibility.png, visibility.exr, visibility.pfm, stats.json}}", a.out.display());
+    Ok(())
+}
+
+fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
+    if let Some(n) = cli.threads {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n.max(1))
+            .build_global()?;
+    }
+    match cli.cmd {
+        None => render(&RenderArgs {
+            scene: builtin::DEFAULT.into(),
+            methods: None,
+            width: None,
+            height: None,
+            out: "out".into(),
+            opts: vec![],
+        }),
+        Some(Cmd::Render(a)) => render(&a),
+        Some(Cmd::List) => {
+            println!("# built-in scenes");
+            for n in builtin::names() {
+                println!("{n}");
+            }
+            println!("# methods");
+            for m in penumbra::methods::ALL {
+                println!("{m}");
+            }
+            Ok(())
+        }
+        Some(Cmd::Golden { bless, root }) => {
+            let report = penumbra::golden::run_cases(&root, bless)?;
+            print!("{report}");
+            Ok(())
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    match run(Cli::parse()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("penumbra: {e}");
+            if e.downcast_ref::<InputError>().is_some() {
+                ExitCode::from(2)
+            } else {
+                ExitCode::FAILURE
+            }
+        }
+    }
+}

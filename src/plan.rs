@@ -65,7 +65,9 @@ pub fn eye_in_shadow(scene: &Scene, near: f64, lights: &[Vec3]) -> bool {
     })
 }
 
-fn segment_blocked(scene: &Scene, p: DVec3, q: DVec3) -> bool {
+/// Whether the open segment p→q crosses any scene triangle (exact f64 test, used for the
+/// z-fail decision and as hard-shadow ground truth in tests).
+pub fn segment_blocked(scene: &Scene, p: DVec3, q: DVec3) -> bool {
     let d = q - p;
     scene.meshes.iter().any(|m| {
         m.triangles.iter().any(|t| {

@@ -1,1 +1,156 @@
-//! Rendering one scene with a set of methods.
+//! Rendering one scene with a set of methods: the frame's scene pass, every method, the shaded
+//! images, the error table against the reference — all in memory, so that a bad option stops
+//! the run before any file is written (DESIGN.md "Bad input": no partial outputs).
+
+use crate::error::InputError;
+use crate::frame::{Frame, GpuSettings, BACKGROUND};
+use crate::gpu::depth::DepthFormat;
+use crate::methods::{self, options::OptionReader, output::MethodOutput, output::Visibility};
+use crate::metrics::{compare, ErrorStats};
+use crate::scene::Scene;
+use std::path::Path;
+
+/// Colour of pixels where no geometry was drawn (linear RGB).
+pub const BACKGROUND_COLOR: [f32; 3] = [0.02, 0.02, 0.03];
+
+/// One method's result within a render.
+#[derive(Debug, Clone)]
+pub struct MethodRun {
+    /// Method name.
+    pub method: String,
+    /// Its output.
+    pub output: MethodOutput,
+    /// The shaded image, linear RGB, row-major.
+    pub shaded: Vec<[f32; 3]>,
+    /// Error against the reference, when the reference ran and this is not it.
+    pub error: Option<ErrorStats>,
+}
+
+/// Read `[options.gpu]`: `tile_size` (power of two 2…256, default 8) and `depth` (`d24` | `d32f`).
+pub fn gpu_settings(scene: &Scene) -> Result<GpuSettings, InputError> {
+    let mut r = OptionReader::new(scene, "gpu");
+    let tile_size = r.uint(
+        "tile_size",
+        crate::limits::DEFAULT_TILE_SIZE as u64,
+        2..=256,
+    )? as u32;
+    if !tile_size.is_power_of_two() {
+        return Err(InputError::at(
+            &scene.source,
+            "options.gpu.tile_size",
+            format!("{tile_size} is not a power of two"),
+        ));
+    }
+    let depth = match r.choice("depth", &["d24", "d32f"], "d24")? {
+        "d24" => DepthFormat::D24,
+        _ => DepthFormat::D32F,
+    };
+    r.finish()?;
+    Ok(GpuSettings { tile_size, depth })
+}
+
+/// The shaded image (DESIGN.md "Methods"): `albedo · (ambient + visibility · max(0, n·l))` with
+/// l toward the light center (a point light there), per RGB channel of the visibility.
+pub fn shade(frame: &Frame, vis: &Visibility) -> Vec<[f32; 3]> {
+    let receivers = frame.receivers(false);
+    let prims = frame.prim_ids();
+    let ambient = frame.scene.ambient;
+    let light = frame.scene.light.center;
+    receivers
+        .iter()
+        .zip(&prims)
+        .enumerate()
+        .map(|(i, (r, prim))| match r {
+            Some(r) if *prim != BACKGROUND => {
+                let (mi, _) = frame.prim_owner[*prim as usize];
+                let albedo = frame.scene.meshes[mi as usize].color;
+                let l = (light - r.point).normalize_or_zero();
+                let diffuse = r.normal.dot(l).max(0.0);
+                let v = vis.rgb(i);
+                std::array::from_fn(|c| (albedo[c] * (ambient + v[c] * diffuse)).clamp(0.0, 1.0))
+            }
+            _ => BACKGROUND_COLOR,
+        })
+        .collect()
+}
+
+/// Render `scene` with its selected methods. The reference runs first when selected; every
+/// other method's error is measured against it.
+pub fn render_scene(scene: &Scene) -> Result<Vec<MethodRun>, InputError> {
+    methods::check_option_tables(scene)?;
+    let selected = methods::selected(scene)?;
+    let gpu = gpu_settings(scene)?;
+    let frame = Frame::render(scene, gpu)?;
+    let mut order: Vec<&String> = selected
+        .iter()
+        .filter(|m| m.as_str() == methods::REFERENCE)
+        .collect();
+    order.extend(selected.iter().filter(|m| m.as_str() != methods::REFERENCE));
+    let mut runs: Vec<MethodRun> = Vec::new();
+    for m in order {
+        let output = methods::run(m, &frame)?;
+        let shaded = shade(&frame, &output.visibility);
+        let error = runs
+            .iter()
+            .find(|r| r.method == methods::REFERENCE)
+            .filter(|_| m != methods::REFERENCE)
+            .map(|r| compare(&output.visibility, &r.output.visibility));
+        runs.push(MethodRun {
+            method: m.clone(),
+            output,
+            shaded,
+            error,
+        });
+    }
+    Ok(runs)
+}
+
+/// Write every run's files under `dir/METHOD/`.
+pub fn write_runs(dir: &Path, scene: &Scene, runs: &[MethodRun]) -> std::io::Result<()> {
+    for r in runs {
+        crate::output::write_method_outputs(
+            dir,
+            &r.method,
+            &r.output,
+            &r.shaded,
+            scene.width,
+            scene.height,
+        )?;
+    }
+    Ok(())
+}
+
+/// The table the default run prints: time and error vs the reference per method.
+pub fn table(scene: &Scene, runs: &[MethodRun]) -> String {
+    let mut s = format!(
+        "scene {} ({}×{}, {} light, reference: {})\n",
+        scene.source,
+        scene.width,
+        scene.height,
+        scene.light.shape.type_name(),
+        methods::REFERENCE
+    );
+    s += &format!(
+        "{:<18} {:>10} {:>10} {:>10} {:>10} {:>12} {:>12}\n",
+        "method", "time [s]", "RMSE", "mean |e|", "max |e|", "% > 1/255", "MB traffic"
+    );
+    for r in runs {
+        let t = r.output.stats.wall_seconds;
+        let mb = r.output.stats.totals.total_bytes() as f64 / 1e6;
+        match &r.error {
+            Some(e) => {
+                s += &format!(
+                    "{:<18} {:>10.3} {:>10.5} {:>10.5} {:>10.5} {:>12.3} {:>12.2}\n",
+                    r.method, t, e.rmse, e.mean_abs, e.max_abs, e.pct_over_1_255, mb
+                )
+            }
+            None => {
+                s += &format!(
+                    "{:<18} {:>10.3} {:>10} {:>10} {:>10} {:>12} {:>12.2}\n",
+                    r.method, t, "—", "—", "—", "—", mb
+                )
+            }
+        }
+    }
+    s
+}

@@ -91,13 +91,24 @@ pub fn read_settings(
         _ if eye_in_shadow(frame.scene, frame.proj.near, lights) => ShadowTest::ZFail,
         _ => ShadowTest::ZPass,
     };
-    Ok((StencilShadowSettings { test, overflow, submission }, mode))
+    Ok((
+        StencilShadowSettings {
+            test,
+            overflow,
+            submission,
+        },
+        mode,
+    ))
 }
 
 /// Render the hard shadow volumes of every mesh from light point `light` into a fresh 8-bit
 /// stencil buffer (tile-major) against the frame's depth buffer. Returns the stencil tiles and
 /// the counters (setup + rasterization).
-pub fn stencil_shadow(frame: &Frame, light: Vec3, s: &StencilShadowSettings) -> (Vec<StencilTile>, Counters) {
+pub fn stencil_shadow(
+    frame: &Frame,
+    light: Vec3,
+    s: &StencilShadowSettings,
+) -> (Vec<StencilTile>, Counters) {
     let capping = match s.test {
         ShadowTest::ZPass => Capping::Open,
         ShadowTest::ZFail => Capping::Capped,
@@ -111,10 +122,19 @@ pub fn stencil_shadow(frame: &Frame, light: Vec3, s: &StencilShadowSettings) -> 
     let keep = StencilOp::Keep;
     // (front face, back face) ops for (depth fail, depth pass).
     let state = match s.test {
-        ShadowTest::ZPass => StencilState { front: StencilFace::always(keep, incr), back: StencilFace::always(keep, decr) },
-        ShadowTest::ZFail => StencilState { front: StencilFace::always(decr, keep), back: StencilFace::always(incr, keep) },
+        ShadowTest::ZPass => StencilState {
+            front: StencilFace::always(keep, incr),
+            back: StencilFace::always(keep, decr),
+        },
+        ShadowTest::ZFail => StencilState {
+            front: StencilFace::always(decr, keep),
+            back: StencilFace::always(incr, keep),
+        },
     };
-    let depth = DepthState { func: DepthFunc::Less, write: false };
+    let depth = DepthState {
+        func: DepthFunc::Less,
+        write: false,
+    };
     let passes: Vec<CullMode> = match (s.submission, s.test) {
         (Submission::TwoSided, _) => vec![CullMode::None],
         // z-pass increments on front faces: draw them first (cull back), then the back faces.
@@ -129,18 +149,28 @@ pub fn stencil_shadow(frame: &Frame, light: Vec3, s: &StencilShadowSettings) -> 
         let (tris, c) = setup_all(&prims, cull, tiling);
         counters += c;
         let bins = bin(tiling, &tris);
-        counters += draw(tiling, &mut stencil, &tris, &bins, no_tile_culling, |t, st, tri, f, c| {
-            let (pass, _) = frame.tiles[t].depth.test(&depth, &f, c);
-            c.depth_passed += pass as u64;
-            st.apply(&state, tri.front_facing, &f, pass, c);
-        });
+        counters += draw(
+            tiling,
+            &mut stencil,
+            &tris,
+            &bins,
+            no_tile_culling,
+            |t, st, tri, f, c| {
+                let (pass, _) = frame.tiles[t].depth.test(&depth, &f, c);
+                c.depth_passed += pass as u64;
+                st.apply(&state, tri.front_facing, &f, pass, c);
+            },
+        );
     }
     (stencil, counters)
 }
 
 /// Row-major stencil values.
 pub fn stencil_row_major(frame: &Frame, tiles: &[StencilTile]) -> Vec<u8> {
-    let flat: Vec<u8> = tiles.iter().flat_map(|t| t.values.iter().copied()).collect();
+    let flat: Vec<u8> = tiles
+        .iter()
+        .flat_map(|t| t.values.iter().copied())
+        .collect();
     frame.tiling.to_row_major(&flat)
 }
 
@@ -157,27 +187,49 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         ShadowTest::ZPass => "shadow-volume-zpass",
         ShadowTest::ZFail => "shadow-volume-zfail",
     };
-    let pass = PassStats { name: name.into(), wall_seconds: pass_start.elapsed().as_secs_f64(), runs: 1, counters };
+    let pass = PassStats {
+        name: name.into(),
+        wall_seconds: pass_start.elapsed().as_secs_f64(),
+        runs: 1,
+        counters,
+    };
     let stencil = stencil_row_major(frame, &tiles);
     let prims = frame.prim_ids();
     let vis: Vec<f32> = stencil
         .iter()
         .zip(&prims)
-        .map(|(s, p)| if *p == BACKGROUND || *s == 0 { 1.0 } else { 0.0 })
+        .map(|(s, p)| {
+            if *p == BACKGROUND || *s == 0 {
+                1.0
+            } else {
+                0.0
+            }
+        })
         .collect();
     let plan = MethodPlan {
         method: "hard-sv".into(),
         passes: vec![frame.pass.name.clone(), name.into()],
         buffers: vec![
-            BufferPlan { name: "depth".into(), format: format!("{:?}", frame.gpu.depth), bytes_per_sample: frame.gpu.depth.bytes() as u32 },
-            BufferPlan { name: "stencil".into(), format: "S8".into(), bytes_per_sample: 1 },
+            BufferPlan {
+                name: "depth".into(),
+                format: format!("{:?}", frame.gpu.depth),
+                bytes_per_sample: frame.gpu.depth.bytes() as u32,
+            },
+            BufferPlan {
+                name: "stencil".into(),
+                format: "S8".into(),
+                bytes_per_sample: 1,
+            },
         ],
         settings: serde_json::json!({ "mode": mode, "resolved": settings, "gpu": frame.gpu }),
     };
     let passes = vec![frame.pass.clone(), pass];
     Ok(MethodOutput {
         visibility: Visibility::Gray(vis),
-        raw_images: vec![RawImage8 { name: "stencil".into(), values: stencil }],
+        raw_images: vec![RawImage8 {
+            name: "stencil".into(),
+            values: stencil,
+        }],
         stats: super::method_stats("hard-sv", frame, start, &plan, passes),
     })
 }

@@ -4,8 +4,8 @@
 pub mod hard_sv;
 pub mod nsample;
 pub mod options;
-pub mod raycast;
 pub mod output;
+pub mod raycast;
 
 use crate::error::InputError;
 use crate::frame::Frame;
@@ -37,17 +37,28 @@ pub fn supports(method: &str, shape: &LightShape) -> bool {
 /// supports its light shape.
 pub fn selected(scene: &Scene) -> Result<Vec<String>, InputError> {
     match &scene.methods {
-        None => Ok(ALL.iter().filter(|m| supports(m, &scene.light.shape)).map(|m| m.to_string()).collect()),
+        None => Ok(ALL
+            .iter()
+            .filter(|m| supports(m, &scene.light.shape))
+            .map(|m| m.to_string())
+            .collect()),
         Some(list) => {
             for m in list {
                 if !ALL.contains(&m.as_str()) {
-                    return Err(InputError::at(&scene.source, "methods", format!("unknown method {m:?}; known: {}", ALL.join(", "))));
+                    return Err(InputError::at(
+                        &scene.source,
+                        "methods",
+                        format!("unknown method {m:?}; known: {}", ALL.join(", ")),
+                    ));
                 }
                 if !supports(m, &scene.light.shape) {
                     return Err(InputError::at(
                         &scene.source,
                         "methods",
-                        format!("method {m} does not support {} lights", scene.light.shape.type_name()),
+                        format!(
+                            "method {m} does not support {} lights",
+                            scene.light.shape.type_name()
+                        ),
                     ));
                 }
             }
@@ -60,7 +71,11 @@ pub fn selected(scene: &Scene) -> Result<Vec<String>, InputError> {
 pub fn check_option_tables(scene: &Scene) -> Result<(), InputError> {
     for k in scene.options.keys() {
         if k != "gpu" && !ALL.contains(&k.as_str()) {
-            return Err(InputError::at(&scene.source, format!("options.{k}"), format!("unknown method {k:?}; known: gpu, {}", ALL.join(", "))));
+            return Err(InputError::at(
+                &scene.source,
+                format!("options.{k}"),
+                format!("unknown method {k:?}; known: gpu, {}", ALL.join(", ")),
+            ));
         }
     }
     Ok(())
@@ -71,12 +86,23 @@ pub fn run(method: &str, frame: &Frame) -> Result<MethodOutput, InputError> {
     match method {
         "hard-sv" => hard_sv::run(frame),
         "nsample" => nsample::run(frame),
-        _ => Err(InputError::at(&frame.scene.source, "methods", format!("unknown method {method:?}"))),
+        "raycast" => run_raycast(frame),
+        _ => Err(InputError::at(
+            &frame.scene.source,
+            "methods",
+            format!("unknown method {method:?}"),
+        )),
     }
 }
 
 /// Assemble [`MethodStats`] for a method that started at `start` (totals summed over passes).
-pub fn method_stats(method: &str, frame: &Frame, start: Instant, plan: &MethodPlan, passes: Vec<PassStats>) -> MethodStats {
+pub fn method_stats(
+    method: &str,
+    frame: &Frame,
+    start: Instant,
+    plan: &MethodPlan,
+    passes: Vec<PassStats>,
+) -> MethodStats {
     let mut totals = Counters::default();
     for p in &passes {
         totals += p.counters;
@@ -90,4 +116,54 @@ pub fn method_stats(method: &str, frame: &Frame, start: Instant, plan: &MethodPl
         passes,
         totals,
     }
+}
+
+/// `raycast` (the ground truth by definition): per pixel, the fraction of the light visible
+/// from the receiver point, with `samples` jittered stratified samples (default 1024, a perfect
+/// square) and `seed`. `receiver = "depth-buffer"` (default) uses the depth-buffer point the
+/// rasterized methods see; `"primary-ray"` the exact hit of the ray through the pixel center
+/// with the visible triangle's plane.
+fn run_raycast(frame: &Frame) -> Result<MethodOutput, InputError> {
+    let start = Instant::now();
+    let scene = frame.scene;
+    let mut r = options::OptionReader::new(scene, "raycast");
+    let settings = raycast::RaycastSettings {
+        samples: r.uint("samples", raycast::DEFAULT_SAMPLES as u64, 1..=65536)? as u32,
+        seed: r.uint("seed", 0, 0..=u64::MAX >> 1)?,
+    };
+    settings
+        .validate()
+        .map_err(|e| InputError::at(&scene.source, "options.raycast.samples", e))?;
+    let receiver = r.choice("receiver", &["depth-buffer", "primary-ray"], "depth-buffer")?;
+    r.finish()?;
+    let pass_start = Instant::now();
+    let receivers: Vec<Option<raycast::Receiver>> = frame
+        .receivers(receiver == "primary-ray")
+        .into_iter()
+        .map(|o| {
+            o.map(|x| raycast::Receiver {
+                point: x.point,
+                normal: x.normal,
+            })
+        })
+        .collect();
+    let visibility = raycast::raycast_visibility(scene, &receivers, &settings);
+    let pass = PassStats {
+        name: "raycast".into(),
+        wall_seconds: pass_start.elapsed().as_secs_f64(),
+        runs: 1,
+        counters: Counters::default(),
+    };
+    let plan = MethodPlan {
+        method: "raycast".into(),
+        passes: vec![frame.pass.name.clone(), "raycast".into()],
+        buffers: vec![],
+        settings: serde_json::json!({ "samples": settings.samples, "seed": settings.seed, "pattern": "jittered", "receiver": receiver }),
+    };
+    let passes = vec![frame.pass.clone(), pass];
+    Ok(MethodOutput {
+        visibility,
+        raw_images: vec![],
+        stats: method_stats("raycast", frame, start, &plan, passes),
+    })
 }

@@ -50,12 +50,19 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let n = r.uint("n", DEFAULT_SAMPLES, 1..=4096)?;
     let (settings, mode) = read_settings(&mut r, frame, &representative_light_points(scene))?;
     r.finish()?;
-    let samples = stratified(&scene.light, n as u32, Pattern::Centered, sphere_disk_target(frame))
-        .map_err(|e| InputError::at(&scene.source, "options.nsample.n", e))?;
+    let samples = stratified(
+        &scene.light,
+        n as u32,
+        Pattern::Centered,
+        sphere_disk_target(frame),
+    )
+    .map_err(|e| InputError::at(&scene.source, "options.nsample.n", e))?;
     let colored = matches!(scene.light.shape, LightShape::TexturedRect { .. });
 
     let tiling = &frame.tiling;
-    let mut acc: Vec<Vec<[f64; 3]>> = (0..tiling.tile_count()).map(|_| vec![[0.0; 3]; tiling.tile_len()]).collect();
+    let mut acc: Vec<Vec<[f64; 3]>> = (0..tiling.tile_count())
+        .map(|_| vec![[0.0; 3]; tiling.tile_len()])
+        .collect();
     let mut counters = Counters::default();
     let pass_start = Instant::now();
     for s in &samples {
@@ -87,20 +94,55 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let prims = frame.prim_ids();
     let to_f32 = |p: &[f64; 3]| p.map(|x| x.clamp(0.0, 1.0) as f32);
     let visibility = if colored {
-        Visibility::Rgb(rows.iter().zip(&prims).map(|(p, id)| if *id == BACKGROUND { [1.0; 3] } else { to_f32(p) }).collect())
+        Visibility::Rgb(
+            rows.iter()
+                .zip(&prims)
+                .map(|(p, id)| {
+                    if *id == BACKGROUND {
+                        [1.0; 3]
+                    } else {
+                        to_f32(p)
+                    }
+                })
+                .collect(),
+        )
     } else {
-        Visibility::Gray(rows.iter().zip(&prims).map(|(p, id)| if *id == BACKGROUND { 1.0 } else { to_f32(p)[0] }).collect())
+        Visibility::Gray(
+            rows.iter()
+                .zip(&prims)
+                .map(|(p, id)| if *id == BACKGROUND { 1.0 } else { to_f32(p)[0] })
+                .collect(),
+        )
     };
     let plan = MethodPlan {
         method: "nsample".into(),
-        passes: vec![frame.pass.name.clone(), format!("{pass_name} ×{}", samples.len())],
+        passes: vec![
+            frame.pass.name.clone(),
+            format!("{pass_name} ×{}", samples.len()),
+        ],
         buffers: vec![
-            BufferPlan { name: "depth".into(), format: format!("{:?}", frame.gpu.depth), bytes_per_sample: frame.gpu.depth.bytes() as u32 },
-            BufferPlan { name: "stencil".into(), format: "S8".into(), bytes_per_sample: 1 },
-            BufferPlan { name: "accumulator".into(), format: "f64x3".into(), bytes_per_sample: 24 },
+            BufferPlan {
+                name: "depth".into(),
+                format: format!("{:?}", frame.gpu.depth),
+                bytes_per_sample: frame.gpu.depth.bytes() as u32,
+            },
+            BufferPlan {
+                name: "stencil".into(),
+                format: "S8".into(),
+                bytes_per_sample: 1,
+            },
+            BufferPlan {
+                name: "accumulator".into(),
+                format: "f64x3".into(),
+                bytes_per_sample: 24,
+            },
         ],
         settings: serde_json::json!({ "n": samples.len(), "pattern": "centered", "mode": mode, "resolved": settings, "colored": colored, "gpu": frame.gpu }),
     };
     let passes = vec![frame.pass.clone(), pass];
-    Ok(MethodOutput { visibility, raw_images: vec![], stats: super::method_stats("nsample", frame, start, &plan, passes) })
+    Ok(MethodOutput {
+        visibility,
+        raw_images: vec![],
+        stats: super::method_stats("nsample", frame, start, &plan, passes),
+    })
 }

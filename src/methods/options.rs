@@ -29,24 +29,50 @@ impl OptionReader {
     }
 
     /// A string option restricted to `allowed`.
-    pub fn choice(&mut self, key: &str, allowed: &[&'static str], default: &'static str) -> Result<&'static str, InputError> {
+    pub fn choice(
+        &mut self,
+        key: &str,
+        allowed: &[&'static str],
+        default: &'static str,
+    ) -> Result<&'static str, InputError> {
         match self.table.remove(key) {
             None => Ok(default),
-            Some(OptionValue::Str(s)) => allowed
-                .iter()
-                .find(|a| **a == s)
-                .copied()
-                .ok_or_else(|| self.err(key, format!("unknown value {s:?}; expected one of {}", allowed.join(", ")))),
-            Some(v) => Err(self.err(key, format!("expected one of {}, got {v}", allowed.join(", ")))),
+            Some(OptionValue::Str(s)) => {
+                allowed.iter().find(|a| **a == s).copied().ok_or_else(|| {
+                    self.err(
+                        key,
+                        format!(
+                            "unknown value {s:?}; expected one of {}",
+                            allowed.join(", ")
+                        ),
+                    )
+                })
+            }
+            Some(v) => Err(self.err(
+                key,
+                format!("expected one of {}, got {v}", allowed.join(", ")),
+            )),
         }
     }
 
     /// An integer option in `range`.
-    pub fn uint(&mut self, key: &str, default: u64, range: std::ops::RangeInclusive<u64>) -> Result<u64, InputError> {
+    pub fn uint(
+        &mut self,
+        key: &str,
+        default: u64,
+        range: std::ops::RangeInclusive<u64>,
+    ) -> Result<u64, InputError> {
         match self.table.remove(key) {
             None => Ok(default),
             Some(OptionValue::Int(i)) if i >= 0 && range.contains(&(i as u64)) => Ok(i as u64),
-            Some(v) => Err(self.err(key, format!("expected an integer in {}..={}, got {v}", range.start(), range.end()))),
+            Some(v) => Err(self.err(
+                key,
+                format!(
+                    "expected an integer in {}..={}, got {v}",
+                    range.start(),
+                    range.end()
+                ),
+            )),
         }
     }
 
