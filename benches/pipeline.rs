@@ -1,0 +1,109 @@
+//! Criterion benchmarks of the rendering pipeline on the built-in `cube-of-spheres` scene at
+//! 256×256:
+//!
+//! * `scene-depth`: the shared first pass of every frame ([`Frame::render`]: adjacency, the
+//!   depth pass and hierarchical Z);
+//! * `hard-sv/zpass`, `hard-sv/zfail`: one hard shadow-volume stencil pass from the light
+//!   center ([`stencil_shadow`]) against a frame rendered once up front;
+//! * `method/nsample-n16`: the `nsample` method with `n = 16` (16 stencil passes and their
+//!   accumulation) on that frame;
+//! * `method/raycast-samples16`: the `raycast` reference with `samples = 16` on that frame.
+//!
+//! The method benchmarks run [`penumbra::methods::run`] on a prebuilt frame, so they exclude
+//! the depth pass (measured on its own) and the shading of the image.
+//!
+//! Sample counts and measurement times are kept small so that `cargo bench --bench pipeline`
+//! finishes well within three minutes on a shared two-core machine. Run with
+//! `cargo bench --bench pipeline`; `cargo test` does not build or run this target.
+
+use criterion::{black_box, criterion_group, criterion_main, Criterion, SamplingMode};
+use penumbra::frame::{Frame, GpuSettings};
+use penumbra::methods::hard_sv::{
+    stencil_shadow, ShadowTest, StencilOverflow, StencilShadowSettings, Submission,
+};
+use penumbra::scene::{builtin, OptionValue, Scene};
+use std::time::Duration;
+
+/// The benchmarked scene.
+const SCENE: &str = "cube-of-spheres";
+/// Image width and height in pixels.
+const SIZE: u32 = 256;
+
+/// `cube-of-spheres` at [`SIZE`]×[`SIZE`] with `nsample.n = 16` and `raycast.samples = 16`.
+fn scene() -> Scene {
+    let mut scene = builtin::load(SCENE).expect("built-in scene cube-of-spheres");
+    scene.width = SIZE;
+    scene.height = SIZE;
+    set_option(&mut scene, "nsample", "n", 16);
+    set_option(&mut scene, "raycast", "samples", 16);
+    scene
+}
+
+/// Sets the integer option `method.key = value` on `scene`.
+fn set_option(scene: &mut Scene, method: &str, key: &str, value: i64) {
+    scene
+        .options
+        .entry(method.to_string())
+        .or_default()
+        .insert(key.to_string(), OptionValue::Int(value));
+}
+
+/// Stencil settings for one hard-shadow pass with the given counting direction (wrap,
+/// two-sided: the `hard-sv` defaults).
+fn stencil_settings(test: ShadowTest) -> StencilShadowSettings {
+    StencilShadowSettings {
+        test,
+        overflow: StencilOverflow::Wrap,
+        submission: Submission::TwoSided,
+    }
+}
+
+/// Registers every benchmark of this file.
+fn pipeline(c: &mut Criterion) {
+    let scene = scene();
+
+    c.bench_function("scene-depth", |b| {
+        b.iter(|| Frame::render(black_box(&scene), GpuSettings::default()).expect("scene pass"))
+    });
+
+    let frame = Frame::render(&scene, GpuSettings::default()).expect("scene pass");
+    let center = scene.light.center;
+    for (name, test) in [
+        ("hard-sv/zpass", ShadowTest::ZPass),
+        ("hard-sv/zfail", ShadowTest::ZFail),
+    ] {
+        let settings = stencil_settings(test);
+        c.bench_function(name, |b| {
+            b.iter(|| stencil_shadow(black_box(&frame), black_box(center), &settings))
+        });
+    }
+
+    // One iteration of these takes a few hundred milliseconds: flat sampling runs the same
+    // small number of iterations per sample instead of criterion's linear ramp, which would
+    // need 55 iterations for 10 samples.
+    let mut group = c.benchmark_group("method");
+    group.sampling_mode(SamplingMode::Flat);
+    group.measurement_time(Duration::from_secs(5));
+    for (name, method) in [("nsample-n16", "nsample"), ("raycast-samples16", "raycast")] {
+        group.bench_function(name, |b| {
+            b.iter(|| penumbra::methods::run(black_box(method), black_box(&frame)).expect(method))
+        });
+    }
+    group.finish();
+}
+
+/// Small samples and short measurement windows: the whole file runs in well under three
+/// minutes, at the price of wider confidence intervals.
+fn config() -> Criterion {
+    Criterion::default()
+        .sample_size(10)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(3))
+}
+
+criterion_group! {
+    name = benches;
+    config = config();
+    targets = pipeline
+}
+criterion_main!(benches);
