@@ -7,7 +7,12 @@
 //!   the papers' N-sample reference (Paper III §5.1) and of the ray-cast ground truth; sphere
 //!   lights are sampled as the disk through their center facing the receiver (Paper IV §4.2.1).
 //!
-//! Exact clipping, analytic coverage and the coverage lookup tables (Papers III, IV) belong
+//! - [`coverage`]: exact coverage of a rectangular light by the projected semi-infinite hard
+//!   shadow quad of one silhouette edge, by homogeneous clipping (Paper III §3.2.2).
+//!
+//! Analytic coverage and the coverage lookup tables (Papers III, IV) belong
 //! here too as they are added.
 
+pub mod coverage;
+pub mod lookup_tables;
 pub mod sampling;

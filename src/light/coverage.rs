@@ -1,0 +1,352 @@
+//! Exact coverage of a rectangular light by the projected semi-infinite hard shadow quad of one
+//! silhouette edge, by clipping (Paper III §3.2.2, Figure 8).
+//!
+//! # What is computed
+//!
+//! For a silhouette edge `e0 e1` and the light center `c`, the *semi-infinite hard shadow quad*
+//! `Q` is the part of the triangle cone `(c; e0, e1)` beyond the edge: `e0, e1` and the rays
+//! `e_i + λ(e_i − c)`, `λ ≥ 0`. Seen from a receiver point `p`, `Q` is projected onto the
+//! light; the **coverage** is the area of the light covered by that projection divided by the
+//! light's area. Summed with signs over a closed silhouette loop and added to the hard shadow
+//! count from the light center (pass 1), it gives the visible fraction of the light by Green's
+//! theorem (Paper III §3.2, Figure 9).
+//!
+//! Only the part of `Q` strictly *between* `p` and the light plane can hide light from `p`, so
+//! `Q` is first clipped to that slab; this also makes the result exact when the edge crosses
+//! the plane through `p` parallel to the light (its projection then runs through infinity) or
+//! lies behind `p`.
+//!
+//! # Representation
+//!
+//! Everything is done in f64 in the light's affine frame ([`RectLight`]): a point is
+//! `c + s·u + t·v + h·n` with `n` the unit normal `u × v / |u × v|`, so the light is the square
+//! `s, t ∈ [−1, 1]`, `h = 0`, whatever the angle between `u` and `v` (area ratios are affine
+//! invariant). Points of `Q` are homogeneous 4-vectors `(s, t, h, w)` (the rays' ends are the
+//! directions `(e_i − c, 0)`). The central projection from `p = (p_s, p_t, h_p)` onto `h = 0` is
+//! the linear map `(s, t, h, w) ↦ (s·h_p − p_s·h, t·h_p − p_t·h, w·h_p − h)`, so all clipping —
+//! the slab `0 ≤ h ≤ h_p·w` and the four light borders `|S| ≤ W`, `|T| ≤ W` — is done by
+//! Sutherland–Hodgman on homogeneous coordinates before any division (the same technique
+//! Paper IV §4.2.2 uses in its shader). The clipped polygon is convex; its area is the shoelace
+//! formula on the dehomogenised vertices.
+//!
+//! # Sign (Paper III §3.2.2, pseudo code lines 6–9)
+//!
+//! The paper adds the coverage when `p` is in the negative half space of `Q` (the side that
+//! holds the umbra) and subtracts it otherwise. The functions here return the coverage signed
+//! by the orientation of `(c, e0, e1, p)`: positive when `det(e0 − c, e1 − c, p − c) > 0`, i.e.
+//! when `p` is on the side the normal `(e0 − c) × (e1 − c)` points to. A caller orders the edge so
+//! that this normal points into its shadow volume and adds the result to its V-buffer.
+//! (For a shadow quad `b, a, a∞, b∞` of [`crate::geometry::shadow_volume`], whose normal points
+//! out of the volume, that is `e0 = b`, `e1 = a`.)
+//!
+//! [`projected_edge_in_light`] and [`segment_coverage`] split the same computation at the point
+//! where the 4D coverage texture of Paper III §3.3 indexes it: the projected edge clipped to the
+//! light square, and the coverage as a function of that clipped edge alone.
+
+use crate::scene::{Light, LightShape};
+use glam::{DVec2, DVec3, DVec4};
+
+/// A rectangular (parallelogram) light in f64 with its affine frame (module doc,
+/// "Representation"): `center + s·u + t·v`, `s, t ∈ [−1, 1]` (Paper III §3.2.2: "a rectangular
+/// light source L").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RectLight {
+    /// The light center `c` (the point the hard shadow quads are built from).
+    pub center: DVec3,
+    /// Half-extent vector along `s`.
+    pub u: DVec3,
+    /// Half-extent vector along `t`.
+    pub v: DVec3,
+    /// Unit normal `u × v / |u × v|` (the `h` axis).
+    pub normal: DVec3,
+    /// Dual vector of `u`: `s = (x − c)·dual_u`.
+    dual_u: DVec3,
+    /// Dual vector of `v`: `t = (x − c)·dual_v`.
+    dual_v: DVec3,
+}
+
+impl RectLight {
+    /// The light `center + s·u + t·v`, `s, t ∈ [−1, 1]`. `u` and `v` must be non-parallel and
+    /// non-zero (scene validation guarantees this for scene lights).
+    pub fn new(center: DVec3, u: DVec3, v: DVec3) -> Self {
+        let normal = u.cross(v).normalize();
+        let dual_u = v.cross(normal) / u.dot(v.cross(normal));
+        let dual_v = normal.cross(u) / v.dot(normal.cross(u));
+        RectLight {
+            center,
+            u,
+            v,
+            normal,
+            dual_u,
+            dual_v,
+        }
+    }
+
+    /// The rectangle of a `rect` or `textured_rect` scene light; `None` for other shapes.
+    pub fn from_light(light: &Light) -> Option<Self> {
+        match &light.shape {
+            LightShape::Rect { u, v } | LightShape::TexturedRect { u, v, .. } => Some(
+                RectLight::new(light.center.as_dvec3(), u.as_dvec3(), v.as_dvec3()),
+            ),
+            _ => None,
+        }
+    }
+
+    /// The light-frame coordinates `(s, t, h)` of the world point `x`.
+    pub fn local(&self, x: DVec3) -> DVec3 {
+        let d = x - self.center;
+        DVec3::new(d.dot(self.dual_u), d.dot(self.dual_v), d.dot(self.normal))
+    }
+
+    /// The world point at light-frame coordinates `(s, t, h)`.
+    pub fn world(&self, local: DVec3) -> DVec3 {
+        self.center + local.x * self.u + local.y * self.v + local.z * self.normal
+    }
+
+    /// The light's area `4·|u × v|`.
+    pub fn area(&self) -> f64 {
+        4.0 * self.u.cross(self.v).length()
+    }
+}
+
+/// Signed exact coverage of `light` by the semi-infinite hard shadow quad of edge `e0 e1` seen
+/// from `p` (Paper III §3.2.2): the covered area divided by the light area, in `[−1, 1]`,
+/// positive when `det(e0 − c, e1 − c, p − c) > 0` (module doc, "Sign"). Zero when `p` lies in
+/// the light's plane or in the plane of the quad.
+pub fn edge_coverage_exact(light: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
+    let sign = quad_side(light, p, e0, e1);
+    if sign == 0.0 {
+        return 0.0;
+    }
+    let Some(projection) = ProjectionFromPoint::new(light, p) else {
+        return 0.0;
+    };
+    // The local coordinates of e_i are also the ray directions e_i − c (the frame is centered
+    // at c), so the rays' ends at infinity are the same vectors with w = 0.
+    let l0 = light.local(e0);
+    let l1 = light.local(e1);
+    let quad = [
+        l0.extend(1.0),
+        l1.extend(1.0),
+        l1.extend(0.0),
+        l0.extend(0.0),
+    ];
+    let in_slab = projection.clip_to_slab(&quad);
+    let projected: Vec<DVec3> = in_slab.iter().map(|x| projection.apply(*x)).collect();
+    sign * clipped_area_fraction(&projected)
+}
+
+/// `+1`, `−1` or `0`: the sign of `det(e0 − c, e1 − c, p − c)` (module doc, "Sign"), the side of
+/// the quad's plane `p` is on.
+pub fn quad_side(light: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
+    let c = light.center;
+    let d = (e0 - c).cross(e1 - c).dot(p - c);
+    if d > 0.0 {
+        1.0
+    } else if d < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+
+/// The edge `e0 e1` projected from `p` onto the light and clipped to the light square, in light
+/// coordinates `(s, t) ∈ [−1, 1]²` — the 4-tuple `(x1, y1, x2, y2)` that indexes the 4D
+/// coverage texture (Paper III §3.3, Figure 8 right). The endpoints keep the edge's direction
+/// (`e0` side first). Only the part of the edge between `p` and the light plane is projected
+/// (module doc). `None` when nothing of the edge projects into the light.
+pub fn projected_edge_in_light(
+    light: &RectLight,
+    p: DVec3,
+    e0: DVec3,
+    e1: DVec3,
+) -> Option<[DVec2; 2]> {
+    let projection = ProjectionFromPoint::new(light, p)?;
+    let seg = [light.local(e0).extend(1.0), light.local(e1).extend(1.0)];
+    let mut a = seg[0];
+    let mut b = seg[1];
+    for plane in projection.slab_planes() {
+        clip_segment(&mut a, &mut b, |x| plane.dot(x))?;
+    }
+    let mut a = projection.apply(a);
+    let mut b = projection.apply(b);
+    for border in LIGHT_BORDERS {
+        clip_segment(&mut a, &mut b, border)?;
+    }
+    if a.z <= 0.0 || b.z <= 0.0 {
+        return None;
+    }
+    Some([a.truncate() / a.z, b.truncate() / b.z])
+}
+
+/// Unsigned coverage of the light square by the region beyond the segment `a b` (light
+/// coordinates inside `[−1, 1]²`) within the cone from the light center `(0, 0)` through it:
+/// the quad `a, b, b∞, a∞` clipped to the square, area / 4 (Paper III §3.3: the function
+/// `f(x1, y1, x2, y2)` the coverage texture stores). For a clipped projected edge from
+/// [`projected_edge_in_light`] this equals the magnitude of [`edge_coverage_exact`] whenever the
+/// edge lies entirely between `p` and the light plane.
+pub fn segment_coverage(a: DVec2, b: DVec2) -> f64 {
+    let quad = [a.extend(1.0), b.extend(1.0), b.extend(0.0), a.extend(0.0)];
+    clipped_area_fraction(&quad)
+}
+
+/// The central projection from a receiver point onto the light plane in the light frame
+/// (module doc, "Representation"), with `h_p > 0` (the frame is flipped for points below the
+/// light plane).
+struct ProjectionFromPoint {
+    /// `(p_s, p_t, h_p)` with `h_p > 0`.
+    p: DVec3,
+    /// `−1` when the `h` axis was flipped so that `h_p > 0`, else `1`.
+    flip: f64,
+}
+
+impl ProjectionFromPoint {
+    fn new(light: &RectLight, p: DVec3) -> Option<Self> {
+        let lp = light.local(p);
+        if lp.z == 0.0 || !lp.is_finite() {
+            return None;
+        }
+        let flip = lp.z.signum();
+        Some(ProjectionFromPoint {
+            p: DVec3::new(lp.x, lp.y, lp.z * flip),
+            flip,
+        })
+    }
+
+    /// The slab planes `h ≥ 0` and `h_p·w − h ≥ 0` as functionals on `(s, t, h, w)` with `h`
+    /// already in the caller's (unflipped) frame.
+    fn slab_planes(&self) -> [DVec4; 2] {
+        [
+            DVec4::new(0.0, 0.0, self.flip, 0.0),
+            DVec4::new(0.0, 0.0, -self.flip, self.p.z),
+        ]
+    }
+
+    fn clip_to_slab(&self, poly: &[DVec4]) -> Vec<DVec4> {
+        let mut out = poly.to_vec();
+        for plane in self.slab_planes() {
+            out = clip_polygon(&out, |x| plane.dot(x));
+        }
+        out
+    }
+
+    /// `(s, t, h, w) ↦ (S, T, W)`: homogeneous light-plane coordinates of the projection.
+    fn apply(&self, x: DVec4) -> DVec3 {
+        let h = x.z * self.flip;
+        DVec3::new(
+            x.x * self.p.z - self.p.x * h,
+            x.y * self.p.z - self.p.y * h,
+            x.w * self.p.z - h,
+        )
+    }
+}
+
+/// The four light borders `W − S ≥ 0`, `W + S ≥ 0`, `W − T ≥ 0`, `W + T ≥ 0` on homogeneous
+/// light-plane coordinates `(S, T, W)`.
+const LIGHT_BORDERS: [fn(DVec3) -> f64; 4] =
+    [|x| x.z - x.x, |x| x.z + x.x, |x| x.z - x.y, |x| x.z + x.y];
+
+/// Clip a homogeneous polygon `(S, T, W)` to the light square and return its area / 4 (the
+/// square's area in light coordinates), unsigned.
+fn clipped_area_fraction(poly: &[DVec3]) -> f64 {
+    let mut out = poly.to_vec();
+    for border in LIGHT_BORDERS {
+        out = clip_polygon(&out, border);
+        if out.is_empty() {
+            return 0.0;
+        }
+    }
+    let pts: Vec<DVec2> = out
+        .iter()
+        .filter(|x| x.z > 0.0)
+        .map(|x| x.truncate() / x.z)
+        .collect();
+    let n = pts.len();
+    let mut twice_area = 0.0;
+    for i in 0..n {
+        twice_area += pts[i].perp_dot(pts[(i + 1) % n]);
+    }
+    (0.5 * twice_area).abs() / 4.0
+}
+
+/// One Sutherland–Hodgman step: keep the part of `poly` where `dist ≥ 0`.
+fn clip_polygon<V, F>(poly: &[V], dist: F) -> Vec<V>
+where
+    V: Copy
+        + std::ops::Sub<Output = V>
+        + std::ops::Add<Output = V>
+        + std::ops::Mul<f64, Output = V>,
+    F: Fn(V) -> f64,
+{
+    let n = poly.len();
+    let mut out = Vec::with_capacity(n + 2);
+    for i in 0..n {
+        let a = poly[i];
+        let b = poly[(i + 1) % n];
+        let (da, db) = (dist(a), dist(b));
+        if da >= 0.0 {
+            out.push(a);
+        }
+        if (da >= 0.0) != (db >= 0.0) {
+            out.push(a + (b - a) * (da / (da - db)));
+        }
+    }
+    out
+}
+
+/// Clip the segment `a b` to `dist ≥ 0` in place; `None` when nothing is left.
+fn clip_segment<V, F>(a: &mut V, b: &mut V, dist: F) -> Option<()>
+where
+    V: Copy
+        + std::ops::Sub<Output = V>
+        + std::ops::Add<Output = V>
+        + std::ops::Mul<f64, Output = V>,
+    F: Fn(V) -> f64,
+{
+    let (da, db) = (dist(*a), dist(*b));
+    match (da >= 0.0, db >= 0.0) {
+        (true, true) => Some(()),
+        (false, false) => None,
+        (true, false) => {
+            *b = *a + (*b - *a) * (da / (da - db));
+            Some(())
+        }
+        (false, true) => {
+            *a = *a + (*b - *a) * (da / (da - db));
+            Some(())
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn unit_light() -> RectLight {
+        RectLight::new(DVec3::ZERO, DVec3::X, DVec3::Y)
+    }
+
+    #[test]
+    fn edge_projecting_to_a_strip_covers_the_strip() {
+        // An edge at height 1 along x = 0.25, seen from (0, 0, 2): it projects onto x = 0.5,
+        // and the region beyond it covers the strip x ∈ [0.5, 1] of the light: 1/4.
+        let l = unit_light();
+        let p = DVec3::new(0.0, 0.0, 2.0);
+        let e0 = DVec3::new(0.25, -10.0, 1.0);
+        let e1 = DVec3::new(0.25, 10.0, 1.0);
+        let c = edge_coverage_exact(&l, p, e0, e1);
+        assert!((c.abs() - 0.25).abs() < 1e-12, "{c}");
+        assert_eq!(edge_coverage_exact(&l, p, e1, e0), -c);
+    }
+
+    #[test]
+    fn projected_edge_matches_segment_coverage() {
+        let l = unit_light();
+        let p = DVec3::new(0.3, -0.2, 3.0);
+        let e0 = DVec3::new(0.5, -0.4, 1.0);
+        let e1 = DVec3::new(-0.2, 0.6, 1.2);
+        let [a, b] = projected_edge_in_light(&l, p, e0, e1).unwrap();
+        let exact = edge_coverage_exact(&l, p, e0, e1);
+        assert!((segment_coverage(a, b) - exact.abs()).abs() < 1e-12);
+    }
+}
