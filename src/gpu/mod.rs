@@ -5,15 +5,18 @@
 //! [`fixed`] (sub-pixel snapping), [`setup`] (edge functions, fill rule, facing, depth plane),
 //! [`tiling`] and [`raster`] (tile traversal, parallel draw), [`depth`] and [`stencil`]
 //! (fixed-function tests and ops), [`buffers`] (typed, counted per-tile storage and
-//! hierarchical Z), [`counters`].
+//! hierarchical Z), [`vbuffer`] (the V-buffer formats of Paper III §4), [`counters`].
 
 pub mod buffers;
 pub mod clip;
 pub mod counters;
 pub mod depth;
 pub mod fixed;
+pub mod li_buffer;
 pub mod raster;
 pub mod setup;
+pub mod split_blend;
 pub mod stencil;
 pub mod tiling;
 pub mod transform;
+pub mod vbuffer;
