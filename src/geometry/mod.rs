@@ -3,5 +3,8 @@
 
 pub mod adjacency;
 pub mod loops;
+pub mod penumbra_wedge;
 pub mod shadow_volume;
 pub mod silhouette;
+pub mod ssv_wedge;
+pub mod tight_wedge;

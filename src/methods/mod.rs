@@ -5,6 +5,7 @@ pub mod hard_sv;
 pub mod nsample;
 pub mod options;
 pub mod output;
+pub mod pw2002;
 pub mod raycast;
 
 use crate::error::InputError;
@@ -16,7 +17,7 @@ use output::{MethodOutput, MethodStats, PassStats};
 use std::time::Instant;
 
 /// Every method penumbra implements, in the order the default run shows them.
-pub const ALL: &[&str] = &["raycast", "nsample", "hard-sv"];
+pub const ALL: &[&str] = &["raycast", "nsample", "hard-sv", "pw2002"];
 
 /// The reference every other method's error is measured against.
 pub const REFERENCE: &str = "raycast";
@@ -29,6 +30,8 @@ pub fn supports(method: &str, shape: &LightShape) -> bool {
             let _ = shape;
             true
         }
+        // Penumbra wedges are built for spherical lights only (Paper I §4).
+        "pw2002" => matches!(shape, LightShape::Sphere { .. }),
         _ => false,
     }
 }
@@ -87,6 +90,7 @@ pub fn run(method: &str, frame: &Frame) -> Result<MethodOutput, InputError> {
         "hard-sv" => hard_sv::run(frame),
         "nsample" => nsample::run(frame),
         "raycast" => run_raycast(frame),
+        "pw2002" => pw2002::run(frame),
         _ => Err(InputError::at(
             &frame.scene.source,
             "methods",

@@ -1,0 +1,687 @@
+//! Penumbra wedges for a spherical light (Paper I §4.1, §4.2, §8; Paper II §3–§5).
+//!
+//! # Construction (Paper I §4.1)
+//! Silhouette edges are found from the light center c and walked into closed loops
+//! ([`super::loops::silhouette_loops`]), which gives each edge its two neighbours. For an edge
+//! a→b (oriented as in its light-facing triangle) with shadow-volume-quad normal `n` (pointing
+//! out of the hard shadow volume), the points `f = c − r·n` and `b' = c + r·n` define the
+//! **front** plane (through the edge and f) and the **back** plane (through the edge and b').
+//! Adjacent wedges share one **side** plane: it contains the intersection line of their two
+//! front planes and that of their two back planes. Each side plane carries a **ray direction**:
+//! the average of the two quad normals projected into the side plane and normalized (§4.1).
+//!
+//! Choices where the paper is silent (tested in `tests/penumbra_wedges.rs`):
+//! * **Finite wedges.** Each wedge is closed by a **bottom** plane (Paper II §5: "if the wedge
+//!   planes are of finite length, a capping bottom plane of the wedge must be added") through
+//!   the far points `P_v = v + far·d_v` of its two front lines `d_v` (the front–front
+//!   intersection lines, shared by neighbours), containing the quad normal. `far` is chosen by
+//!   the caller beyond every receiver and the eye ([`far_distance`]), so the bottom never cuts
+//!   a visible point out of a wedge, and the front faces of a loop meet exactly at the `P_v`:
+//!   front faces plus the occluder's light-facing triangles plus the far cap through the `P_v`
+//!   close the outer soft shadow volume (needed by z-fail, Paper II §5).
+//! * **Wedge = intersection of its five half-spaces.** Faces are found by enumerating plane
+//!   triples. When the side planes cross (large lights or far from the edge: Paper I Fig. 6)
+//!   this automatically yields the degenerate wedge the paper draws on the right of Fig. 6: the
+//!   back face shrinks to the triangle up to the crossing point, and the side faces meet
+//!   beyond it.
+//! * **Degenerate side planes.** When the two front (or back) planes are nearly parallel
+//!   (collinear neighbouring edges), their intersection line is ill-defined; the side plane is
+//!   then the plane through the vertex spanned by the light ray `v − c` and the averaged quad
+//!   normal.
+//! * **Acute corners (Fig. 7).** At a convex silhouette corner whose quad normals turn by more
+//!   than 90° (interior angle below 90°), `ceil(turn / 18°) − 1` extra wedges are inserted, with
+//!   zero-length edges at the vertex and quad normals interpolated (slerp) between the two
+//!   edges' normals — 6 extra wedges for the 60° corner of an equilateral triangle, as in Fig. 7.
+//! * **Near-parallel edges (§8).** An edge within [`PARALLEL_SIN`] (sine of the angle) of the
+//!   direction of the light ray through it is removed, and its two neighbours are shortened or
+//!   lengthened to meet at the removed edge's midpoint ("remove such edges, and shorten &
+//!   connect its neighbors"). The rule is optional so that a test can show what happens
+//!   without it.
+//!
+//! # Light intensity (Paper I §4.2, equations 1–3)
+//! [`light_intensity`]: s_l and s_r from the front/back distances along the left and right side
+//! directions, interpolated with the distances to the side planes along the edge direction;
+//! optionally the smoothstep s' = 3s² − 2s³. [`li_amount`] is the one place 255·s is rounded,
+//! shared by `pw2002` and `pw-restructured` so that both produce the same LI values.
+
+use super::adjacency::Adjacency;
+use super::loops::silhouette_loops;
+use super::silhouette::{light_facing, possible_silhouettes};
+use crate::gpu::transform::{ClipVertex, Projection};
+use crate::scene::{Mesh, Scene};
+use glam::{DMat3, DVec3, DVec4};
+
+/// Sine of the smallest angle an edge may make with the light ray through its first vertex
+/// before the near-parallel rule removes it (≈ 1.15°).
+pub const PARALLEL_SIN: f64 = 0.02;
+
+/// Interior angle below which a convex corner gets extra wedges: the quad normals turn by more
+/// than this (90°).
+pub const ACUTE_TURN: f64 = std::f64::consts::FRAC_PI_2;
+
+/// Angular step of the extra wedges at an acute corner (18°).
+pub const EXTRA_WEDGE_STEP: f64 = std::f64::consts::PI / 10.0;
+
+/// Relative tolerance for plane membership during face enumeration (times the far distance).
+const FACE_TOL: f64 = 1e-7;
+
+/// Cross products shorter than this are treated as degenerate (parallel planes).
+const DEGENERATE: f64 = 1e-6;
+
+/// A plane `n·x + d = 0` with unit normal `n`; the wedge's inside is `n·x + d ≤ 0`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plane {
+    /// Outward unit normal.
+    pub n: DVec3,
+    /// Offset.
+    pub d: f64,
+}
+
+impl Plane {
+    /// The plane through `p` with outward normal `n` (normalized here).
+    pub fn through(p: DVec3, n: DVec3) -> Self {
+        let n = n.normalize();
+        Self { n, d: -n.dot(p) }
+    }
+
+    /// Signed distance of `p` (positive outside).
+    #[inline]
+    pub fn eval(&self, p: DVec3) -> f64 {
+        self.n.dot(p) + self.d
+    }
+
+    /// Distance from `p` to the plane along the line through `p` with direction `dir` (either
+    /// way): the "positive intersection distance" of Paper I §4.2. Parallel lines give a huge
+    /// finite distance.
+    #[inline]
+    pub fn distance_along(&self, p: DVec3, dir: DVec3) -> f64 {
+        (self.eval(p) / self.n.dot(dir).abs().max(1e-12)).abs()
+    }
+
+    fn flipped(self) -> Self {
+        Self {
+            n: -self.n,
+            d: -self.d,
+        }
+    }
+}
+
+/// Which plane of a wedge a face lies in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+pub enum FaceKind {
+    /// Front plane (through f = c − r·n): the lit side.
+    Front,
+    /// Back plane (through c + r·n): the umbra side.
+    Back,
+    /// Side plane shared with the previous wedge of the loop.
+    Left,
+    /// Side plane shared with the next wedge of the loop.
+    Right,
+    /// Far capping plane.
+    Bottom,
+}
+
+/// The order planes are stored and faces submitted in.
+pub const FACE_ORDER: [FaceKind; 5] = [
+    FaceKind::Front,
+    FaceKind::Back,
+    FaceKind::Left,
+    FaceKind::Right,
+    FaceKind::Bottom,
+];
+
+/// One penumbra wedge.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Wedge {
+    /// Edge start (equal to `b` for an extra corner wedge).
+    pub a: DVec3,
+    /// Edge end.
+    pub b: DVec3,
+    /// Unit edge direction (for a corner wedge, the tangent of its virtual edge).
+    pub dir: DVec3,
+    /// Unit normal of the hard shadow-volume quad, pointing out of the volume.
+    pub n: DVec3,
+    /// True for an extra wedge at an acute corner (Fig. 7).
+    pub extra: bool,
+    /// Planes in [`FACE_ORDER`]: front, back, left, right, bottom.
+    pub planes: [Plane; 5],
+    /// Ray direction in the left side plane (§4.2).
+    pub left_dir: DVec3,
+    /// Ray direction in the right side plane.
+    pub right_dir: DVec3,
+    /// Far points of the left and right front lines (`P_a`, `P_b`).
+    pub far_front: [DVec3; 2],
+    /// Face polygons (counter-clockwise seen from outside), in [`FACE_ORDER`]; a plane that
+    /// does not bound the wedge has no face.
+    pub faces: Vec<(FaceKind, Vec<DVec3>)>,
+}
+
+impl Wedge {
+    /// The plane of `kind`.
+    pub fn plane(&self, kind: FaceKind) -> &Plane {
+        &self.planes[FACE_ORDER.iter().position(|k| *k == kind).unwrap_or(0)]
+    }
+
+    /// Whether `p` lies inside (or on) all five planes.
+    #[inline]
+    pub fn contains(&self, p: DVec3) -> bool {
+        self.planes.iter().all(|pl| pl.eval(p) <= 0.0)
+    }
+
+    /// The plane through which the ray `origin + t·dir` leaves the wedge: among the planes the
+    /// ray moves outward through (`n·dir > 0`), the one it reaches first (Paper I §6: "the exit
+    /// point is found by computing the intersection of the ray with all back facing planes,
+    /// and picking the closest").
+    pub fn exit_plane(&self, origin: DVec3, dir: DVec3) -> Option<FaceKind> {
+        let mut best: Option<(f64, FaceKind)> = None;
+        for (pl, kind) in self.planes.iter().zip(FACE_ORDER) {
+            let den = pl.n.dot(dir);
+            if den > 0.0 {
+                let t = -pl.eval(origin) / den;
+                if best.is_none_or(|(bt, _)| t < bt) {
+                    best = Some((t, kind));
+                }
+            }
+        }
+        best.map(|(_, k)| k)
+    }
+}
+
+/// Options of the wedge construction.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct WedgeOptions {
+    /// Light center.
+    pub center: DVec3,
+    /// Light radius.
+    pub radius: f64,
+    /// Distance of the far points from their vertices.
+    pub far: f64,
+    /// Insert extra wedges at acute convex corners (Fig. 7).
+    pub extra_corner_wedges: bool,
+    /// Apply the near-parallel-edge rule (§8).
+    pub parallel_rule: bool,
+}
+
+/// All wedges of a scene plus the caps that close the outer soft shadow volume.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct WedgeSet {
+    /// Wedges, mesh by mesh, loop by loop, in walk order.
+    pub wedges: Vec<Wedge>,
+    /// Top caps: the light-facing triangles of every mesh (outward = toward the light).
+    pub top_caps: Vec<[DVec3; 3]>,
+    /// Bottom caps: fans over the far points `P_v` of every loop, facing away from the light.
+    pub bottom_caps: Vec<[DVec3; 3]>,
+    /// Silhouette edges removed by the near-parallel rule.
+    pub removed_parallel: usize,
+    /// Extra corner wedges inserted.
+    pub extra_wedges: usize,
+}
+
+/// A distance beyond every point of the scene and the eye as seen from the light center (4×
+/// the largest such distance), used to place the far ends of wedges.
+pub fn far_distance(scene: &Scene) -> f64 {
+    let c = scene.light.center.as_dvec3();
+    let (lo, hi) = scene.bounds();
+    let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
+    let mut r = (scene.camera.eye - c).length();
+    for i in 0..8 {
+        let p = DVec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        );
+        r = r.max((p - c).length());
+    }
+    4.0 * r.max(1e-3)
+}
+
+/// The quad normal of edge a→b from light center c: out of the hard shadow volume.
+pub fn quad_normal(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+    (a - c).cross(b - a).normalize_or_zero()
+}
+
+/// Whether edge a→b is within [`PARALLEL_SIN`] of the light ray through a.
+pub fn nearly_parallel(a: DVec3, b: DVec3, c: DVec3) -> bool {
+    let e = (b - a).normalize_or_zero();
+    let l = (a - c).normalize_or_zero();
+    e.cross(l).length() < PARALLEL_SIN
+}
+
+/// Remove near-parallel edges of a closed loop of vertex positions, joining the neighbours at
+/// the removed edge's midpoint; returns the removed count.
+fn apply_parallel_rule(lp: &mut Vec<DVec3>, c: DVec3) -> usize {
+    let mut removed = 0;
+    while lp.len() >= 3 {
+        let m = lp.len();
+        let Some(i) = (0..m).find(|&i| nearly_parallel(lp[i], lp[(i + 1) % m], c)) else {
+            break;
+        };
+        let j = (i + 1) % m;
+        lp[i] = (lp[i] + lp[j]) * 0.5;
+        lp.remove(j);
+        removed += 1;
+    }
+    removed
+}
+
+/// An edge of the wedge loop before planes are built.
+#[derive(Debug, Clone, Copy)]
+struct LoopEdge {
+    a: DVec3,
+    b: DVec3,
+    dir: DVec3,
+    n: DVec3,
+    extra: bool,
+}
+
+fn front_back(e: &LoopEdge, c: DVec3, r: f64) -> (DVec3, DVec3) {
+    let f = c - e.n * r;
+    let bp = c + e.n * r;
+    let mut nf = e.dir.cross(f - e.a).normalize_or_zero();
+    if nf.dot(e.n) < 0.0 {
+        nf = -nf;
+    }
+    let mut nb = e.dir.cross(bp - e.a).normalize_or_zero();
+    if nb.dot(e.n) > 0.0 {
+        nb = -nb;
+    }
+    (nf, nb)
+}
+
+fn slerp(p: DVec3, q: DVec3, t: f64) -> DVec3 {
+    let ang = p.dot(q).clamp(-1.0, 1.0).acos();
+    if ang < 1e-9 {
+        return p;
+    }
+    ((p * ((1.0 - t) * ang).sin() + q * (t * ang).sin()) / ang.sin()).normalize()
+}
+
+/// Number of extra wedges at the corner between edges with quad normals n1 → n2 (`dir1` is the
+/// incoming edge direction): 0 unless convex and acute.
+pub fn extra_wedge_count(n1: DVec3, n2: DVec3, dir1: DVec3) -> usize {
+    let turn = n1.dot(n2).clamp(-1.0, 1.0).acos();
+    let convex = n2.dot(dir1) > 0.0;
+    if !convex || turn <= ACUTE_TURN {
+        return 0;
+    }
+    ((turn / EXTRA_WEDGE_STEP).ceil() as usize).saturating_sub(1)
+}
+
+/// Build the wedges of one loop of vertex positions (edge i = v_i → v_{i+1}).
+fn loop_wedges(lp: &[DVec3], o: &WedgeOptions, set: &mut WedgeSet) {
+    let c = o.center;
+    let m = lp.len();
+    let base: Vec<LoopEdge> = (0..m)
+        .map(|i| {
+            let (a, b) = (lp[i], lp[(i + 1) % m]);
+            LoopEdge {
+                a,
+                b,
+                dir: (b - a).normalize_or_zero(),
+                n: quad_normal(a, b, c),
+                extra: false,
+            }
+        })
+        .filter(|e| e.n != DVec3::ZERO && e.dir != DVec3::ZERO)
+        .collect();
+    let mut edges = Vec::new();
+    for (i, e) in base.iter().enumerate() {
+        edges.push(*e);
+        let next = &base[(i + 1) % base.len()];
+        if o.extra_corner_wedges {
+            let k = extra_wedge_count(e.n, next.n, e.dir);
+            for j in 1..=k {
+                let n = slerp(e.n, next.n, j as f64 / (k + 1) as f64);
+                let v = e.b;
+                let dir = n.cross(v - c).normalize_or_zero();
+                edges.push(LoopEdge {
+                    a: v,
+                    b: v,
+                    dir,
+                    n,
+                    extra: true,
+                });
+            }
+            set.extra_wedges += k;
+        }
+    }
+    let k = edges.len();
+    if k < 2 {
+        return;
+    }
+    let fb: Vec<(DVec3, DVec3)> = edges.iter().map(|e| front_back(e, c, o.radius)).collect();
+    // Side plane j sits between edge j and edge j+1 at vertex edges[j].b.
+    let mut sides = Vec::with_capacity(k);
+    for j in 0..k {
+        let (e1, e2) = (&edges[j], &edges[(j + 1) % k]);
+        let v = e1.b;
+        let (nf1, nb1) = fb[j];
+        let (nf2, nb2) = fb[(j + 1) % k];
+        let df = nf1.cross(nf2);
+        let db = nb1.cross(nb2);
+        let mut navg = (e1.n + e2.n).normalize_or_zero();
+        if navg == DVec3::ZERO {
+            navg = e1.n;
+        }
+        let ns = df.cross(db);
+        let mut normal = if df.length() > DEGENERATE
+            && db.length() > DEGENERATE
+            && ns.length() > DEGENERATE * DEGENERATE
+        {
+            ns.normalize()
+        } else {
+            (v - c).cross(navg).normalize_or_zero()
+        };
+        if normal.dot(e1.dir + e2.dir) < 0.0 {
+            normal = -normal;
+        }
+        let mut line = if df.length() > DEGENERATE {
+            df.normalize()
+        } else {
+            normal.cross(nf1).normalize_or_zero()
+        };
+        if line.dot(v - c) < 0.0 {
+            line = -line;
+        }
+        let sd = (navg - normal * navg.dot(normal)).normalize_or_zero();
+        sides.push((Plane::through(v, normal), sd, v + line * o.far));
+    }
+    let fars: Vec<DVec3> = sides.iter().map(|s| s.2).collect();
+    for j in 0..k {
+        let e = &edges[j];
+        let (nf, nb) = fb[j];
+        let prev = &sides[(j + k - 1) % k];
+        let next = &sides[j];
+        let (pa, pb) = (prev.2, next.2);
+        let mut zn = (pb - pa).cross(e.n);
+        if zn.length() < DEGENERATE {
+            zn = ((pa + pb) * 0.5 - c).normalize_or_zero();
+        }
+        let mut bottom = Plane::through(pa, zn);
+        if bottom.eval(e.a) > 0.0 {
+            bottom = bottom.flipped();
+        }
+        let planes = [
+            Plane::through(e.a, nf),
+            Plane::through(e.a, nb),
+            prev.0.flipped(),
+            next.0,
+            bottom,
+        ];
+        let canon = [e.a, e.b, pa, pb];
+        let faces = wedge_faces(&planes, &canon, o.far);
+        set.wedges.push(Wedge {
+            a: e.a,
+            b: e.b,
+            dir: e.dir,
+            n: e.n,
+            extra: e.extra,
+            planes,
+            left_dir: prev.1,
+            right_dir: next.1,
+            far_front: [pa, pb],
+            faces,
+        });
+    }
+    // Far cap: reverse loop order so shared edges P_a→P_b of the front faces are traversed
+    // oppositely (outward, away from the light).
+    for i in 1..k.saturating_sub(1) {
+        set.bottom_caps.push([fars[0], fars[i + 1], fars[i]]);
+    }
+}
+
+/// The faces of the intersection of five half-spaces, by vertex enumeration. Vertices within
+/// tolerance of a canonical point (edge ends, far points) are snapped to it so that neighbouring
+/// wedges share their vertices exactly.
+fn wedge_faces(planes: &[Plane; 5], canon: &[DVec3], far: f64) -> Vec<(FaceKind, Vec<DVec3>)> {
+    let tol = FACE_TOL * far;
+    let mut verts: Vec<DVec3> = Vec::new();
+    for i in 0..5 {
+        for j in i + 1..5 {
+            for k in j + 1..5 {
+                let (p, q, r) = (planes[i], planes[j], planes[k]);
+                let m = DMat3::from_cols(p.n, q.n, r.n).transpose();
+                let det = m.determinant();
+                if det.abs() < 1e-12 {
+                    continue;
+                }
+                let x = m.inverse() * DVec3::new(-p.d, -q.d, -r.d);
+                if !x.is_finite() || planes.iter().any(|pl| pl.eval(x) > tol) {
+                    continue;
+                }
+                let x = canon
+                    .iter()
+                    .copied()
+                    .find(|cp| (*cp - x).length() <= tol * 10.0)
+                    .unwrap_or(x);
+                if !verts.iter().any(|v| (*v - x).length() <= tol * 10.0) {
+                    verts.push(x);
+                }
+            }
+        }
+    }
+    let mut faces = Vec::new();
+    for (pl, kind) in planes.iter().zip(FACE_ORDER) {
+        let on: Vec<DVec3> = verts
+            .iter()
+            .copied()
+            .filter(|v| pl.eval(*v).abs() <= tol * 10.0)
+            .collect();
+        if on.len() < 3 {
+            continue;
+        }
+        let centroid = on.iter().copied().sum::<DVec3>() / on.len() as f64;
+        let u = pl.n.any_orthonormal_vector();
+        let w = pl.n.cross(u);
+        let mut sorted = on;
+        sorted.sort_by(|x, y| {
+            let ax = (*x - centroid).dot(w).atan2((*x - centroid).dot(u));
+            let ay = (*y - centroid).dot(w).atan2((*y - centroid).dot(u));
+            ax.total_cmp(&ay)
+        });
+        faces.push((kind, sorted));
+    }
+    faces
+}
+
+/// Build every wedge of `meshes` for a sphere light (center and radius in `o`): silhouettes from
+/// the center, loops, the near-parallel rule, extra corner wedges, planes, faces and caps.
+pub fn build_wedges(meshes: &[(&Mesh, &Adjacency)], o: &WedgeOptions) -> Result<WedgeSet, String> {
+    let mut set = WedgeSet::default();
+    let c32 = o.center.as_vec3();
+    for (mesh, adj) in meshes {
+        let facing = light_facing(mesh, c32);
+        for (t, f) in mesh.triangles.iter().zip(&facing) {
+            if *f {
+                set.top_caps
+                    .push(t.map(|i| mesh.positions[i as usize].as_dvec3()));
+            }
+        }
+        let sil = possible_silhouettes(mesh, adj, &facing);
+        for lp in silhouette_loops(&sil).map_err(|e| format!("mesh {}: {e}", mesh.name))? {
+            let mut pts: Vec<DVec3> = lp.iter().map(|&k| sil[k].a.as_dvec3()).collect();
+            if o.parallel_rule {
+                set.removed_parallel += apply_parallel_rule(&mut pts, o.center);
+            }
+            if pts.len() >= 2 {
+                loop_wedges(&pts, o, &mut set);
+            }
+        }
+    }
+    Ok(set)
+}
+
+/// Paper I §4.2, equations 1–3: the light intensity s ∈ [0, 1] at a point `p` inside wedge `w`
+/// (1 on the front plane, 0 on the back plane), optionally smoothed to 3s² − 2s³.
+pub fn light_intensity(w: &Wedge, p: DVec3, smooth: bool) -> f64 {
+    let [front, back, left, right, _] = &w.planes;
+    let side = |d: DVec3| {
+        let tf = front.distance_along(p, d);
+        let tb = back.distance_along(p, d);
+        if tf + tb > 0.0 {
+            tb / (tf + tb)
+        } else {
+            0.5
+        }
+    };
+    let sl = side(w.left_dir);
+    let sr = side(w.right_dir);
+    let tl = left.distance_along(p, w.dir);
+    let tr = right.distance_along(p, w.dir);
+    let s = if tl + tr > 0.0 {
+        (tr * sl + tl * sr) / (tr + tl)
+    } else {
+        0.5 * (sl + sr)
+    };
+    let s = if s.is_finite() {
+        s.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    if smooth {
+        s * s * (3.0 - 2.0 * s)
+    } else {
+        s
+    }
+}
+
+/// The LI amount of intensity `s` with `lights` lights: `round(255/n · s)`, rounding half up
+/// (`floor(x + 0.5)`). Paper I adds `round(255·(s_i − s_f))`; both penumbra-wedge methods here
+/// add `li_amount(s_i) − li_amount(s_f)` instead, which differs by at most 1 and makes integer
+/// sums independent of how contributions are grouped into passes (Paper I §7 for 255/n).
+#[inline]
+pub fn li_amount(s: f64, lights: u32) -> i32 {
+    (s * 255.0 / lights.max(1) as f64 + 0.5).floor() as i32
+}
+
+/// A triangle of wedge geometry to submit, with what it is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WedgeTriangle {
+    /// Clip-space vertices (world positions rounded to f32 first, as a vertex stage sees them).
+    pub clip: [ClipVertex; 3],
+    /// Wedge index, or `None` for a cap triangle.
+    pub wedge: Option<u32>,
+    /// Face kind (`None` for caps).
+    pub kind: Option<FaceKind>,
+}
+
+fn clip_of(proj: &Projection, p: DVec3) -> ClipVertex {
+    proj.clip_point(p.as_vec3())
+}
+
+/// The faces of every wedge as fan-triangulated clip-space triangles, wedge by wedge, faces in
+/// [`FACE_ORDER`] (the submission order of both penumbra-wedge methods).
+pub fn wedge_triangles(set: &WedgeSet, proj: &Projection) -> Vec<WedgeTriangle> {
+    let mut out = Vec::new();
+    for (wi, w) in set.wedges.iter().enumerate() {
+        for (kind, poly) in &w.faces {
+            for i in 1..poly.len() - 1 {
+                out.push(WedgeTriangle {
+                    clip: [poly[0], poly[i], poly[i + 1]].map(|p| clip_of(proj, p)),
+                    wedge: Some(wi as u32),
+                    kind: Some(*kind),
+                });
+            }
+        }
+    }
+    out
+}
+
+/// The cap triangles (top caps, then bottom caps) in clip space.
+pub fn cap_triangles(set: &WedgeSet, proj: &Projection) -> Vec<WedgeTriangle> {
+    set.top_caps
+        .iter()
+        .chain(&set.bottom_caps)
+        .map(|t| WedgeTriangle {
+            clip: t.map(|p| clip_of(proj, p)),
+            wedge: None,
+            kind: None,
+        })
+        .collect()
+}
+
+/// A wedge's screen-space setup for tile culling (Paper II §4): its planes in normalized device
+/// coordinates and its window-depth range.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScreenWedge {
+    /// Plane coefficients over (x_ndc, y_ndc, z_ndc, 1); positive = outside, valid for points in
+    /// front of the eye.
+    pub planes: [DVec4; 5],
+    /// Smallest and largest window depth of the wedge's vertices ([0, 1] if any vertex is not in
+    /// front of the eye).
+    pub z_range: [f64; 2],
+}
+
+/// Precompute the screen-space plane equations and depth range of a wedge (once per frame).
+pub fn screen_wedge(w: &Wedge, proj: &Projection) -> ScreenWedge {
+    let inv_t = proj.inv_view_proj.transpose();
+    let planes = w.planes.map(|pl| inv_t * pl.n.extend(pl.d));
+    let mut lo = f64::INFINITY;
+    let mut hi = f64::NEG_INFINITY;
+    let mut behind = false;
+    for (_, poly) in &w.faces {
+        for p in poly {
+            let h = proj.view_proj * p.extend(1.0);
+            if h.w <= 0.0 {
+                behind = true;
+            } else {
+                let z = (h.z / h.w) * 0.5 + 0.5;
+                lo = lo.min(z);
+                hi = hi.max(z);
+            }
+        }
+    }
+    let z_range = if behind || lo > hi {
+        [0.0, 1.0]
+    } else {
+        [lo.clamp(0.0, 1.0), hi.clamp(0.0, 1.0)]
+    };
+    ScreenWedge { planes, z_range }
+}
+
+impl ScreenWedge {
+    /// The n/p-vertex test (Paper II §4, Fig. 6): true when the screen-space box
+    /// `[x0,x1]×[y0,y1]` (pixel edges, row 0 at the top) × `[z0,z1]` (window depth) lies
+    /// entirely outside one wedge plane. Only the box vertex nearest to the inside of each plane
+    /// (its n-vertex) is tested.
+    pub fn box_outside(&self, px: [f64; 2], py: [f64; 2], z: [f64; 2], w: f64, h: f64) -> bool {
+        let xs = px.map(|x| x / w * 2.0 - 1.0);
+        let ys = py.map(|y| 1.0 - y / h * 2.0);
+        let zs = z.map(|z| z * 2.0 - 1.0);
+        let (xlo, xhi) = (xs[0].min(xs[1]), xs[0].max(xs[1]));
+        let (ylo, yhi) = (ys[0].min(ys[1]), ys[0].max(ys[1]));
+        let (zlo, zhi) = (zs[0].min(zs[1]), zs[0].max(zs[1]));
+        self.planes.iter().any(|q| {
+            let x = if q.x > 0.0 { xlo } else { xhi };
+            let y = if q.y > 0.0 { ylo } else { yhi };
+            let zz = if q.z > 0.0 { zlo } else { zhi };
+            q.x * x + q.y * y + q.z * zz + q.w > 0.0
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn extra_wedges_for_sixty_degree_corner() {
+        // Equilateral triangle corner: the outward normal turns by 120° (convex).
+        let n1 = DVec3::new(0.0, -1.0, 0.0);
+        let (sn, cs) = 120f64.to_radians().sin_cos();
+        let n2 = DVec3::new(sn, -cs, 0.0);
+        let dir1 = DVec3::X;
+        assert!((n1.dot(n2).acos().to_degrees() - 120.0).abs() < 1e-9);
+        assert_eq!(extra_wedge_count(n1, n2, dir1), 6);
+        // Concave corner (normal turns the other way): none.
+        assert_eq!(extra_wedge_count(n1, DVec3::new(-n2.x, n2.y, 0.0), dir1), 0);
+    }
+
+    #[test]
+    fn li_amount_rounds_half_up_and_scales_per_light() {
+        assert_eq!(li_amount(1.0, 1), 255);
+        assert_eq!(li_amount(0.5, 1), 128);
+        assert_eq!(li_amount(1.0, 2), 128);
+        assert_eq!(li_amount(0.0, 1), 0);
+    }
+}

@@ -1,0 +1,249 @@
+//! `pw2002`: soft shadows with penumbra wedges, Paper I (Akenine-Möller & Assarsson, EGWR
+//! 2002) §4 `rasterizeWedge`, §4.1 construction ([`crate::geometry::penumbra_wedge`]), §4.2
+//! interpolation, §5 (side-plane contributions cancel; front/back entries give 255/0).
+//!
+//! The LI buffer ([`crate::gpu::li_buffer`]) is cleared to 255. Every wedge face is submitted
+//! (wedge by wedge, faces front, back, left, right, bottom, each polygon as a fan), back faces
+//! are culled; each fragment of a front-facing wedge triangle that passes LESS against the
+//! scene depth (Paper I §4 line 2, "visible fragment") does:
+//! * `p = point(x, y, z)`: the pixel center un-projected at the stored depth
+//!   ([`crate::gpu::transform::Projection::unproject`], f64);
+//! * entry value `v_f`: 255 when the triangle lies in the front plane, 0 otherwise (back plane:
+//!   s = 0; side planes: §5, the entry and exit values on a shared side plane cancel between
+//!   neighbours, so both are taken as 0; bottom: s = 0);
+//! * `p_i`: p if it is inside the wedge, else the exit point, found as the nearest plane the
+//!   eye ray leaves through (Paper I §6); value `v_i = li_amount(s(p))` inside, 255 if the exit
+//!   is the front plane, 0 otherwise;
+//! * `addToLIBuffer(v_i − v_f)` (skipped when 0, so no write happens).
+//!
+//! Choice: Paper I writes `round(255·(s_i − s_f))`; we add `li_amount(s_i) − li_amount(s_f)`
+//! ([`crate::geometry::penumbra_wedge::li_amount`]), within 1 of it, so that `pw2002` and
+//! `pw-restructured` add literally the same integers. Background pixels (stored depth 1.0) have
+//! no point; their p is never inside a wedge. Visibility = clamp(LI, 0, 255)/255.
+//!
+//! Options (`[options.pw2002]`, shared with `pw-restructured` by [`read_wedge_settings`]):
+//! `li = 16|12|8` (bits), `overflow = wrap|saturate`, `falloff = linear|smoothstep`
+//! (s' = 3s² − 2s³, §4.2), `corner_wedges = on|off` (Fig. 7), `parallel_rule = on|off` (§8).
+//! The eye is assumed to be outside every shadow (Paper I §8); `pw-restructured` handles the
+//! other case.
+
+use super::options::OptionReader;
+use super::output::{MethodOutput, PassStats, Visibility};
+use crate::error::InputError;
+use crate::frame::{setup_all, Frame, BACKGROUND};
+use crate::geometry::penumbra_wedge::{
+    build_wedges, far_distance, li_amount, light_intensity, wedge_triangles, FaceKind,
+    WedgeOptions, WedgeSet,
+};
+use crate::gpu::buffers::alloc_tiles;
+use crate::gpu::depth::{DepthFunc, DepthState};
+use crate::gpu::li_buffer::{li_visibility, LiFormat, LiOverflow, LiTile};
+use crate::gpu::raster::{bin, draw, no_tile_culling};
+use crate::gpu::setup::CullMode;
+use crate::plan::{BufferPlan, MethodPlan};
+use crate::scene::LightShape;
+use std::time::Instant;
+
+/// Settings shared by both penumbra-wedge methods.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct WedgeSettings {
+    /// LI buffer format.
+    pub li: LiFormat,
+    /// LI overflow behaviour.
+    pub overflow: LiOverflow,
+    /// Smoothstep falloff s' = 3s² − 2s³.
+    pub smooth: bool,
+    /// Number of lights n (LI amounts scaled by 255/n, Paper I §7). Scenes hold one light.
+    pub lights: u32,
+    /// Wedge construction options.
+    pub wedge: WedgeOptions,
+}
+
+/// Read the options shared by both penumbra-wedge methods from `r`.
+pub fn read_wedge_settings(
+    r: &mut OptionReader,
+    frame: &Frame,
+) -> Result<WedgeSettings, InputError> {
+    let li = match r.choice("li", &["16", "12", "8"], "16")? {
+        "12" => LiFormat::Li12,
+        "8" => LiFormat::Li8,
+        _ => LiFormat::Li16,
+    };
+    let overflow = match r.choice("overflow", &["wrap", "saturate"], "wrap")? {
+        "saturate" => LiOverflow::Saturate,
+        _ => LiOverflow::Wrap,
+    };
+    let smooth = r.choice("falloff", &["linear", "smoothstep"], "linear")? == "smoothstep";
+    let corner = r.choice("corner_wedges", &["on", "off"], "on")? == "on";
+    let parallel = r.choice("parallel_rule", &["on", "off"], "on")? == "on";
+    let scene = frame.scene;
+    let radius = match scene.light.shape {
+        LightShape::Sphere { radius } => radius as f64,
+        _ => {
+            return Err(InputError::at(
+                &scene.source,
+                "light",
+                "penumbra wedges need a sphere light",
+            ))
+        }
+    };
+    Ok(WedgeSettings {
+        li,
+        overflow,
+        smooth,
+        lights: 1,
+        wedge: WedgeOptions {
+            center: scene.light.center.as_dvec3(),
+            radius,
+            far: far_distance(scene),
+            extra_corner_wedges: corner,
+            parallel_rule: parallel,
+        },
+    })
+}
+
+/// The wedges of every mesh of the frame's scene.
+pub fn frame_wedges(frame: &Frame, s: &WedgeSettings) -> Result<WedgeSet, InputError> {
+    let meshes: Vec<_> = frame.scene.meshes.iter().zip(&frame.adjacency).collect();
+    build_wedges(&meshes, &s.wedge).map_err(|e| InputError::at(&frame.scene.source, "meshes", e))
+}
+
+/// Row-major LI values of a tiled LI buffer.
+pub fn li_row_major(frame: &Frame, tiles: &[LiTile]) -> Vec<i32> {
+    let flat: Vec<i32> = tiles
+        .iter()
+        .flat_map(|t| t.values.iter().copied())
+        .collect();
+    frame.tiling.to_row_major(&flat)
+}
+
+/// Resolve LI values to visibility (background pixels are lit).
+pub fn resolve(frame: &Frame, li: &[i32]) -> Visibility {
+    let prims = frame.prim_ids();
+    Visibility::Gray(
+        li.iter()
+            .zip(&prims)
+            .map(|(v, p)| {
+                if *p == BACKGROUND {
+                    1.0
+                } else {
+                    li_visibility(*v)
+                }
+            })
+            .collect(),
+    )
+}
+
+/// The LI buffer of `pw2002` (tile-major) and its counters.
+pub fn render_li(
+    frame: &Frame,
+    set: &WedgeSet,
+    s: &WedgeSettings,
+) -> (Vec<LiTile>, crate::gpu::counters::Counters) {
+    let tris = wedge_triangles(set, &frame.proj);
+    let prims: Vec<_> = tris.iter().map(|t| t.clip).collect();
+    let tiling = &frame.tiling;
+    let (rt, mut counters) = setup_all(&prims, CullMode::Back, tiling);
+    let bins = bin(tiling, &rt);
+    let mut li = alloc_tiles(tiling, |_, len| LiTile::cleared(s.li, s.overflow, len));
+    let depth_state = DepthState {
+        func: DepthFunc::Less,
+        write: false,
+    };
+    let eye = frame.scene.camera.eye;
+    let full = li_amount(1.0, s.lights);
+    let far = frame.gpu.depth.far();
+    counters += draw(
+        tiling,
+        &mut li,
+        &rt,
+        &bins,
+        no_tile_culling,
+        |t, tile, tri, f, c| {
+            let depth = &frame.tiles[t].depth;
+            let (pass, _) = depth.test(&depth_state, &f, c);
+            if !pass {
+                return;
+            }
+            c.depth_passed += 1;
+            c.fragments_shaded += 1;
+            let wt = &tris[tri.prim as usize];
+            let (Some(wi), Some(kind)) = (wt.wedge, wt.kind) else {
+                return;
+            };
+            let w = &set.wedges[wi as usize];
+            let v_f = if kind == FaceKind::Front { full } else { 0 };
+            let stored = depth.values[f.local];
+            let p = frame
+                .proj
+                .unproject(f.x, f.y, frame.gpu.depth.to_window(stored));
+            let v_i = if stored != far && w.contains(p) {
+                li_amount(light_intensity(w, p, s.smooth), s.lights)
+            } else {
+                let dir = frame.proj.unproject(f.x, f.y, 0.5) - eye;
+                if w.exit_plane(eye, dir) == Some(FaceKind::Front) {
+                    full
+                } else {
+                    0
+                }
+            };
+            let delta = v_i - v_f;
+            if delta != 0 {
+                tile.add(f.local, delta, c);
+            }
+        },
+    );
+    (li, counters)
+}
+
+/// Run `pw2002` on a rendered frame.
+pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
+    let start = Instant::now();
+    let mut r = OptionReader::new(frame.scene, "pw2002");
+    let s = read_wedge_settings(&mut r, frame)?;
+    r.finish()?;
+    let pass_start = Instant::now();
+    let set = frame_wedges(frame, &s)?;
+    let (tiles, counters) = render_li(frame, &set, &s);
+    let pass = PassStats {
+        name: "wedges".into(),
+        wall_seconds: pass_start.elapsed().as_secs_f64(),
+        runs: 1,
+        counters,
+    };
+    let li = li_row_major(frame, &tiles);
+    let plan = MethodPlan {
+        method: "pw2002".into(),
+        passes: vec![frame.pass.name.clone(), "wedges".into()],
+        buffers: vec![
+            BufferPlan {
+                name: "depth".into(),
+                format: format!("{:?}", frame.gpu.depth),
+                bytes_per_sample: frame.gpu.depth.bytes() as u32,
+            },
+            BufferPlan {
+                name: "li".into(),
+                format: format!("{:?}", s.li),
+                bytes_per_sample: s.li.bytes() as u32,
+            },
+        ],
+        settings: serde_json::json!({
+            "settings": s,
+            "wedges": set.wedges.len(),
+            "extra_corner_wedges": set.extra_wedges,
+            "removed_parallel_edges": set.removed_parallel,
+            "gpu": frame.gpu,
+        }),
+    };
+    Ok(MethodOutput {
+        visibility: resolve(frame, &li),
+        raw_images: vec![],
+        stats: super::method_stats(
+            "pw2002",
+            frame,
+            start,
+            &plan,
+            vec![frame.pass.clone(), pass],
+        ),
+    })
+}
