@@ -6,7 +6,9 @@ pub mod nsample;
 pub mod options;
 pub mod output;
 pub mod pw2002;
+pub mod pw_restructured;
 pub mod raycast;
+pub mod ssv_optimized;
 
 use crate::error::InputError;
 use crate::frame::Frame;
@@ -17,7 +19,14 @@ use output::{MethodOutput, MethodStats, PassStats};
 use std::time::Instant;
 
 /// Every method penumbra implements, in the order the default run shows them.
-pub const ALL: &[&str] = &["raycast", "nsample", "hard-sv", "pw2002"];
+pub const ALL: &[&str] = &[
+    "raycast",
+    "nsample",
+    "hard-sv",
+    "pw2002",
+    "pw-restructured",
+    "ssv-optimized",
+];
 
 /// The reference every other method's error is measured against.
 pub const REFERENCE: &str = "raycast";
@@ -31,7 +40,9 @@ pub fn supports(method: &str, shape: &LightShape) -> bool {
             true
         }
         // Penumbra wedges are built for spherical lights only (Paper I §4).
-        "pw2002" => matches!(shape, LightShape::Sphere { .. }),
+        "pw2002" | "pw-restructured" => matches!(shape, LightShape::Sphere { .. }),
+        // Paper IV §4.2: the rectangular and the spherical shader.
+        "ssv-optimized" => matches!(shape, LightShape::Rect { .. } | LightShape::Sphere { .. }),
         _ => false,
     }
 }
@@ -90,7 +101,9 @@ pub fn run(method: &str, frame: &Frame) -> Result<MethodOutput, InputError> {
         "hard-sv" => hard_sv::run(frame),
         "nsample" => nsample::run(frame),
         "raycast" => run_raycast(frame),
+        "ssv-optimized" => ssv_optimized::run(frame),
         "pw2002" => pw2002::run(frame),
+        "pw-restructured" => pw_restructured::run(frame),
         _ => Err(InputError::at(
             &frame.scene.source,
             "methods",

@@ -1,0 +1,489 @@
+//! `pw-restructured`: the restructured penumbra-wedge algorithm of Paper II (Assarsson &
+//! Akenine-Möller) §3 (rasterizeUmbra / rasterizePenumbra), §4 (zmin/zmax tile occlusion
+//! culling), §5 (eye inside shadow: z-fail with top and bottom caps), §6.1 (three-pass) and
+//! §6.2 (single-pass). Wedges are those of `pw2002` ([`crate::geometry::penumbra_wedge`]).
+//!
+//! * **Umbra** (front planes, ±255): z-pass adds −255 for a front-facing front-plane fragment
+//!   that passes LESS and +255 for a back-facing one; z-fail (top caps, bottom caps and front
+//!   planes, rendered "in exactly the same way") adds +255 for front-facing and −255 for
+//!   back-facing fragments that *fail* LESS.
+//! * **Penumbra**: z-pass rasterizes the front-facing faces of every wedge, z-fail the
+//!   back-facing ones; a fragment adds `li_amount(s(p))` when the depth-buffer point p is
+//!   inside the wedge. Choices: the inside test is done in world space with the same
+//!   [`Wedge::contains`](crate::geometry::penumbra_wedge::Wedge::contains) as `pw2002` (the paper
+//!   does it in screen space to save a division; its screen-space plane equations are used here
+//!   for tile culling), and p counts as inside only if it also lies behind (z-pass) or in front
+//!   of (z-fail) the rasterized face by the depth test — implied in exact arithmetic, and it
+//!   makes the umbra and penumbra contributions agree on the discrete depth buffer, so that
+//!   with the eye outside all shadows this method and `pw2002` add the same integers.
+//! * **Three-pass** (§6.1): the front planes go to an 8-bit stencil cleared to 128 (the offset
+//!   trick for an unsigned, saturating stencil): front-facing fragments DECR, then back-facing
+//!   ones INCR (on depth pass for z-pass, depth fail for z-fail); a full-screen pass adds
+//!   `±255·(stencil − 128)` to the LI buffer (255 for z-pass, −255 for z-fail); then the
+//!   penumbra pass. **Single-pass** (§6.2): one pass over all wedge triangles; a front plane
+//!   that carries both umbra and penumbra (front-facing for z-pass, back-facing for z-fail) is
+//!   rasterized once: one depth read and at most one LI write per fragment.
+//! * **Culling** (§4), per (tile, triangle), counted in `tiles_culled_hiz` once per culled
+//!   contribution: umbra uses the hardware test of the triangle's depth range against the
+//!   tile's zmax (z-pass) or zmin (z-fail); penumbra uses `zmax` — the wedge's zmin behind the
+//!   tile's zmax — or `zmin+zmax` — that, the wedge's zmax in front of the tile's zmin, then the
+//!   n/p-vertex test of the tile's screen-space box against the wedge's five screen-space
+//!   planes. `off` culls nothing.
+//! * z-pass or z-fail: `mode = auto` picks z-fail when [`crate::plan::eye_in_shadow`] finds the
+//!   near plane in the shadow of a point of the light.
+//!
+//! Options: those of `pw2002` plus `passes = single|three`, `culling = zmin-zmax|zmax|off`,
+//! `mode = auto|zpass|zfail`.
+
+use super::options::OptionReader;
+use super::output::{MethodOutput, PassStats};
+use super::pw2002::{frame_wedges, li_row_major, read_wedge_settings, resolve, WedgeSettings};
+use crate::error::InputError;
+use crate::frame::{setup_all, Frame};
+use crate::geometry::penumbra_wedge::{
+    cap_triangles, li_amount, light_intensity, screen_wedge, wedge_triangles, FaceKind,
+    ScreenWedge, WedgeSet, WedgeTriangle,
+};
+use crate::gpu::buffers::{alloc_tiles, StencilTile};
+use crate::gpu::counters::Counters;
+use crate::gpu::li_buffer::LiTile;
+use crate::gpu::raster::{bin, draw, Fragment};
+use crate::gpu::setup::{CullMode, RasterTriangle};
+use crate::gpu::stencil::{StencilFace, StencilOp, StencilState};
+use crate::plan::{eye_in_shadow, representative_light_points, BufferPlan, MethodPlan};
+use std::time::Instant;
+
+/// Counting direction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum WedgeTest {
+    /// Boundaries between the eye and the point.
+    ZPass,
+    /// Boundaries between the point and infinity (caps, back-facing penumbra faces).
+    ZFail,
+}
+
+/// Pass structure (§6).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum Passes {
+    /// Umbra and penumbra of the shared front planes in one pass (§6.2).
+    Single,
+    /// Stencil front-facing, stencil back-facing, penumbra (§6.1).
+    Three,
+}
+
+/// Tile occlusion culling (§4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum Culling {
+    /// No culling.
+    Off,
+    /// Only the zmax quick rejection.
+    Zmax,
+    /// zmin and zmax quick rejection plus the n/p-vertex box test.
+    ZminZmax,
+}
+
+/// Settings of one `pw-restructured` render.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct RestructuredSettings {
+    /// Wedges and LI buffer.
+    pub wedge: WedgeSettings,
+    /// z-pass or z-fail.
+    pub test: WedgeTest,
+    /// Single or three passes.
+    pub passes: Passes,
+    /// Tile culling.
+    pub culling: Culling,
+}
+
+/// Read the options of `pw-restructured`.
+pub fn read_settings(frame: &Frame) -> Result<(RestructuredSettings, &'static str), InputError> {
+    let mut r = OptionReader::new(frame.scene, "pw-restructured");
+    let wedge = read_wedge_settings(&mut r, frame)?;
+    let passes = match r.choice("passes", &["single", "three"], "single")? {
+        "three" => Passes::Three,
+        _ => Passes::Single,
+    };
+    let culling = match r.choice("culling", &["zmin-zmax", "zmax", "off"], "zmin-zmax")? {
+        "zmax" => Culling::Zmax,
+        "off" => Culling::Off,
+        _ => Culling::ZminZmax,
+    };
+    let mode = r.choice("mode", &["auto", "zpass", "zfail"], "auto")?;
+    r.finish()?;
+    let test = match mode {
+        "zpass" => WedgeTest::ZPass,
+        "zfail" => WedgeTest::ZFail,
+        _ => {
+            let pts = representative_light_points(frame.scene);
+            if eye_in_shadow(frame.scene, frame.proj.near, &pts) {
+                WedgeTest::ZFail
+            } else {
+                WedgeTest::ZPass
+            }
+        }
+    };
+    Ok((
+        RestructuredSettings {
+            wedge,
+            test,
+            passes,
+            culling,
+        },
+        mode,
+    ))
+}
+
+/// What a rasterized triangle contributes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Roles {
+    umbra: bool,
+    penumbra: bool,
+}
+
+/// Per-frame data shared by the passes.
+struct Ctx<'a> {
+    frame: &'a Frame<'a>,
+    set: &'a WedgeSet,
+    screen: Vec<ScreenWedge>,
+    tris: Vec<WedgeTriangle>,
+    s: RestructuredSettings,
+}
+
+impl Ctx<'_> {
+    /// Umbra sign of a front-plane or cap fragment (per §3/§5): the LI amount it adds when its
+    /// depth condition holds.
+    fn umbra_value(&self, front_facing: bool) -> i32 {
+        let full = li_amount(1.0, self.s.wedge.lights);
+        match (self.s.test, front_facing) {
+            (WedgeTest::ZPass, true) | (WedgeTest::ZFail, false) => -full,
+            (WedgeTest::ZPass, false) | (WedgeTest::ZFail, true) => full,
+        }
+    }
+
+    fn roles(&self, tri: &RasterTriangle) -> Roles {
+        let wt = &self.tris[tri.prim as usize];
+        let penumbra_facing = match self.s.test {
+            WedgeTest::ZPass => tri.front_facing,
+            WedgeTest::ZFail => !tri.front_facing,
+        };
+        Roles {
+            umbra: wt.kind.is_none_or(|k| k == FaceKind::Front),
+            penumbra: wt.wedge.is_some() && penumbra_facing,
+        }
+    }
+
+    /// Whether the umbra contribution of `tri` is culled in tile `t` (hardware hierarchical Z).
+    fn umbra_culled(&self, t: usize, tri: &RasterTriangle) -> bool {
+        if self.s.culling == Culling::Off {
+            return false;
+        }
+        let d = &self.frame.tiles[t].depth;
+        match self.s.test {
+            // Every fragment at or behind every stored depth: none passes LESS.
+            WedgeTest::ZPass => d.rejects_less(tri),
+            // Every fragment in front of every stored depth: none fails LESS.
+            WedgeTest::ZFail => d.format.quantize(tri.z_range[1]) < d.zmin,
+        }
+    }
+
+    /// Whether the penumbra contribution of `tri` is culled in tile `t` (§4).
+    fn penumbra_culled(&self, t: usize, tri: &RasterTriangle) -> bool {
+        if self.s.culling == Culling::Off {
+            return false;
+        }
+        let Some(wi) = self.tris[tri.prim as usize].wedge else {
+            return true;
+        };
+        let sw = &self.screen[wi as usize];
+        let d = &self.frame.tiles[t].depth;
+        let fmt = d.format;
+        let (tz0, tz1) = (fmt.to_window(d.zmin), fmt.to_window(d.zmax));
+        // Quick rejection: the wedge lies behind every stored point.
+        if sw.z_range[0] > tz1 {
+            return true;
+        }
+        if self.s.culling == Culling::Zmax {
+            return false;
+        }
+        if sw.z_range[1] < tz0 {
+            return true;
+        }
+        let r = self.frame.tiling.rect(t);
+        sw.box_outside(
+            [r.x0 as f64, r.x1 as f64],
+            [r.y0 as f64, r.y1 as f64],
+            [tz0, tz1],
+            self.frame.scene.width as f64,
+            self.frame.scene.height as f64,
+        )
+    }
+
+    /// The penumbra amount of fragment `f` of `tri` given the stored depth and the depth test.
+    fn penumbra_amount(&self, tri: &RasterTriangle, f: &Fragment, stored: u32, pass: bool) -> i32 {
+        let behind_face = match self.s.test {
+            WedgeTest::ZPass => pass,
+            WedgeTest::ZFail => !pass,
+        };
+        let fmt = self.frame.gpu.depth;
+        if !behind_face || stored == fmt.far() {
+            return 0;
+        }
+        let Some(wi) = self.tris[tri.prim as usize].wedge else {
+            return 0;
+        };
+        let w = &self.set.wedges[wi as usize];
+        let p = self.frame.proj.unproject(f.x, f.y, fmt.to_window(stored));
+        if w.contains(p) {
+            li_amount(
+                light_intensity(w, p, self.s.wedge.smooth),
+                self.s.wedge.lights,
+            )
+        } else {
+            0
+        }
+    }
+}
+
+/// Per-tile storage: the LI buffer plus the cull decision of the triangle being drawn.
+struct RTile {
+    li: LiTile,
+    /// (triangle address, umbra culled, penumbra culled).
+    memo: (usize, bool, bool),
+}
+
+/// One draw over `rt` (filtered raster triangles) adding umbra and/or penumbra contributions
+/// directly into the LI buffer.
+fn li_pass(
+    ctx: &Ctx,
+    tiles: &mut [RTile],
+    rt: &[RasterTriangle],
+    umbra: bool,
+    penumbra: bool,
+) -> Counters {
+    let tiling = &ctx.frame.tiling;
+    let bins = bin(tiling, rt);
+    let culls = |t: usize, tri: &RasterTriangle| {
+        let roles = ctx.roles(tri);
+        let u = !(umbra && roles.umbra) || ctx.umbra_culled(t, tri);
+        let p = !(penumbra && roles.penumbra) || ctx.penumbra_culled(t, tri);
+        (u, p)
+    };
+    draw(
+        tiling,
+        tiles,
+        rt,
+        &bins,
+        |t, _, tri, c| {
+            let roles = ctx.roles(tri);
+            let (u, p) = culls(t, tri);
+            c.tiles_culled_hiz += (umbra && roles.umbra && u) as u64;
+            c.tiles_culled_hiz += (penumbra && roles.penumbra && p) as u64;
+            u && p
+        },
+        |t, tile, tri, f, c| {
+            let key = tri as *const RasterTriangle as usize;
+            if tile.memo.0 != key {
+                let (u, p) = culls(t, tri);
+                tile.memo = (key, u, p);
+            }
+            let (_, u_culled, p_culled) = tile.memo;
+            let depth = &ctx.frame.tiles[t].depth;
+            let stored = depth.read(f.local, c);
+            let pass = depth.format.quantize(f.z) < stored;
+            c.depth_passed += pass as u64;
+            let mut delta = 0;
+            if !u_culled {
+                let counts = match ctx.s.test {
+                    WedgeTest::ZPass => pass,
+                    WedgeTest::ZFail => !pass,
+                };
+                if counts {
+                    delta += ctx.umbra_value(tri.front_facing);
+                }
+            }
+            if !p_culled {
+                c.fragments_shaded += 1;
+                delta += ctx.penumbra_amount(tri, &f, stored, pass);
+            }
+            if delta != 0 {
+                tile.li.add(f.local, delta, c);
+            }
+        },
+    )
+}
+
+/// Setup of every wedge (and, for z-fail, cap) triangle, kept only if it has a role.
+fn raster_triangles(
+    ctx: &Ctx,
+    keep: impl Fn(Roles, &RasterTriangle) -> bool,
+) -> (Vec<RasterTriangle>, Counters) {
+    let prims: Vec<_> = ctx.tris.iter().map(|t| t.clip).collect();
+    let (mut rt, c) = setup_all(&prims, CullMode::None, &ctx.frame.tiling);
+    rt.retain(|t| keep(ctx.roles(t), t));
+    (rt, c)
+}
+
+/// Render the LI buffer of `pw-restructured` (tile-major); returns it with per-pass stats.
+pub fn render_li(
+    frame: &Frame,
+    set: &WedgeSet,
+    s: &RestructuredSettings,
+) -> (Vec<LiTile>, Vec<PassStats>) {
+    let mut tris = Vec::new();
+    if s.test == WedgeTest::ZFail {
+        tris.extend(cap_triangles(set, &frame.proj));
+    }
+    tris.extend(wedge_triangles(set, &frame.proj));
+    let ctx = Ctx {
+        frame,
+        set,
+        screen: set
+            .wedges
+            .iter()
+            .map(|w| screen_wedge(w, &frame.proj))
+            .collect(),
+        tris,
+        s: *s,
+    };
+    let tiling = &frame.tiling;
+    let mut tiles = alloc_tiles(tiling, |_, len| RTile {
+        li: LiTile::cleared(s.wedge.li, s.wedge.overflow, len),
+        memo: (0, false, false),
+    });
+    let mut stats = Vec::new();
+    let mut timed = |name: &str, f: &mut dyn FnMut() -> Counters| {
+        let start = Instant::now();
+        let counters = f();
+        stats.push(PassStats {
+            name: name.into(),
+            wall_seconds: start.elapsed().as_secs_f64(),
+            runs: 1,
+            counters,
+        });
+    };
+    match s.passes {
+        Passes::Single => timed("wedges-single-pass", &mut || {
+            let (rt, mut c) = raster_triangles(&ctx, |r, _| r.umbra || r.penumbra);
+            c += li_pass(&ctx, &mut tiles, &rt, true, true);
+            c
+        }),
+        Passes::Three => {
+            let mut stencil = alloc_tiles(tiling, |_, len| StencilTile::cleared(128, len));
+            for (name, front) in [("umbra-stencil-front", true), ("umbra-stencil-back", false)] {
+                timed(name, &mut || {
+                    let (rt, mut c) =
+                        raster_triangles(&ctx, |r, t| r.umbra && t.front_facing == front);
+                    c += stencil_pass(&ctx, &mut stencil, &rt);
+                    c
+                });
+            }
+            timed("umbra-to-li", &mut || {
+                let mult = match s.test {
+                    WedgeTest::ZPass => li_amount(1.0, s.wedge.lights),
+                    WedgeTest::ZFail => -li_amount(1.0, s.wedge.lights),
+                };
+                let mut c = Counters::default();
+                for (tile, st) in tiles.iter_mut().zip(&stencil) {
+                    for (i, v) in st.values.iter().enumerate() {
+                        c.stencil_read_bytes += 1;
+                        let d = mult * (*v as i32 - 128);
+                        if d != 0 {
+                            tile.li.add(i, d, &mut c);
+                        }
+                    }
+                }
+                c
+            });
+            timed("penumbra", &mut || {
+                let (rt, mut c) = raster_triangles(&ctx, |r, _| r.penumbra);
+                c += li_pass(&ctx, &mut tiles, &rt, false, true);
+                c
+            });
+        }
+    }
+    (tiles.into_iter().map(|t| t.li).collect(), stats)
+}
+
+/// One stencil pass of the three-pass umbra: DECR for front-facing, INCR for back-facing
+/// fragments, on depth pass (z-pass) or depth fail (z-fail), saturating (offset 128).
+fn stencil_pass(ctx: &Ctx, stencil: &mut [StencilTile], rt: &[RasterTriangle]) -> Counters {
+    let keep = StencilOp::Keep;
+    let state = match ctx.s.test {
+        WedgeTest::ZPass => StencilState {
+            front: StencilFace::always(keep, StencilOp::Decr),
+            back: StencilFace::always(keep, StencilOp::Incr),
+        },
+        WedgeTest::ZFail => StencilState {
+            front: StencilFace::always(StencilOp::Decr, keep),
+            back: StencilFace::always(StencilOp::Incr, keep),
+        },
+    };
+    let tiling = &ctx.frame.tiling;
+    let bins = bin(tiling, rt);
+    draw(
+        tiling,
+        stencil,
+        rt,
+        &bins,
+        |t, _, tri, c| {
+            let culled = ctx.umbra_culled(t, tri);
+            c.tiles_culled_hiz += culled as u64;
+            culled
+        },
+        |t, st, tri, f, c| {
+            let depth = &ctx.frame.tiles[t].depth;
+            let stored = depth.read(f.local, c);
+            let pass = depth.format.quantize(f.z) < stored;
+            c.depth_passed += pass as u64;
+            st.apply(&state, tri.front_facing, &f, pass, c);
+        },
+    )
+}
+
+/// Run `pw-restructured` on a rendered frame.
+pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
+    let start = Instant::now();
+    let (s, mode) = read_settings(frame)?;
+    let set = frame_wedges(frame, &s.wedge)?;
+    let (tiles, passes) = render_li(frame, &set, &s);
+    let li = li_row_major(frame, &tiles);
+    let mut names = vec![frame.pass.name.clone()];
+    names.extend(passes.iter().map(|p| p.name.clone()));
+    let mut buffers = vec![
+        BufferPlan {
+            name: "depth".into(),
+            format: format!("{:?}", frame.gpu.depth),
+            bytes_per_sample: frame.gpu.depth.bytes() as u32,
+        },
+        BufferPlan {
+            name: "li".into(),
+            format: format!("{:?}", s.wedge.li),
+            bytes_per_sample: s.wedge.li.bytes() as u32,
+        },
+    ];
+    if s.passes == Passes::Three {
+        buffers.push(BufferPlan {
+            name: "stencil".into(),
+            format: "S8 (offset 128)".into(),
+            bytes_per_sample: 1,
+        });
+    }
+    let plan = MethodPlan {
+        method: "pw-restructured".into(),
+        passes: names,
+        buffers,
+        settings: serde_json::json!({
+            "mode": mode,
+            "resolved": s,
+            "wedges": set.wedges.len(),
+            "gpu": frame.gpu,
+        }),
+    };
+    let mut all = vec![frame.pass.clone()];
+    all.extend(passes);
+    Ok(MethodOutput {
+        visibility: resolve(frame, &li),
+        raw_images: vec![],
+        stats: super::method_stats("pw-restructured", frame, start, &plan, all),
+    })
+}
