@@ -186,8 +186,33 @@ pub fn projected_edge_in_light(
 /// [`projected_edge_in_light`] this equals the magnitude of [`edge_coverage_exact`] whenever the
 /// edge lies entirely between `p` and the light plane.
 pub fn segment_coverage(a: DVec2, b: DVec2) -> f64 {
+    polygon_area(&segment_region(a, b)) / 4.0
+}
+
+/// The region whose area [`segment_coverage`] measures, as a convex polygon in light
+/// coordinates: the quad `a, b, b∞, a∞` clipped to the light square `[−1, 1]²` (Paper III
+/// §3.3; textured lights weight it by the light texture).
+pub fn segment_region(a: DVec2, b: DVec2) -> Vec<DVec2> {
     let quad = [a.extend(1.0), b.extend(1.0), b.extend(0.0), a.extend(0.0)];
-    clipped_area_fraction(&quad)
+    clip_to_light(&quad)
+}
+
+/// Unsigned area of a simple polygon (shoelace formula).
+pub fn polygon_area(poly: &[DVec2]) -> f64 {
+    let n = poly.len();
+    let mut twice_area = 0.0;
+    for i in 0..n {
+        twice_area += poly[i].perp_dot(poly[(i + 1) % n]);
+    }
+    (0.5 * twice_area).abs()
+}
+
+/// The part of a convex polygon inside the axis-aligned box `[lo, hi]` (Sutherland–Hodgman).
+pub fn clip_polygon_to_box(poly: &[DVec2], lo: DVec2, hi: DVec2) -> Vec<DVec2> {
+    let mut out = clip_polygon(poly, |p: DVec2| p.x - lo.x);
+    out = clip_polygon(&out, |p: DVec2| hi.x - p.x);
+    out = clip_polygon(&out, |p: DVec2| p.y - lo.y);
+    clip_polygon(&out, |p: DVec2| hi.y - p.y)
 }
 
 /// The central projection from a receiver point onto the light plane in the light frame
@@ -249,24 +274,23 @@ const LIGHT_BORDERS: [fn(DVec3) -> f64; 4] =
 /// Clip a homogeneous polygon `(S, T, W)` to the light square and return its area / 4 (the
 /// square's area in light coordinates), unsigned.
 fn clipped_area_fraction(poly: &[DVec3]) -> f64 {
+    polygon_area(&clip_to_light(poly)) / 4.0
+}
+
+/// Clip a homogeneous polygon `(S, T, W)` to the light square and dehomogenise it (vertices
+/// with `W = 0` left by the clip are the zero vector and are dropped).
+fn clip_to_light(poly: &[DVec3]) -> Vec<DVec2> {
     let mut out = poly.to_vec();
     for border in LIGHT_BORDERS {
         out = clip_polygon(&out, border);
         if out.is_empty() {
-            return 0.0;
+            return Vec::new();
         }
     }
-    let pts: Vec<DVec2> = out
-        .iter()
+    out.iter()
         .filter(|x| x.z > 0.0)
         .map(|x| x.truncate() / x.z)
-        .collect();
-    let n = pts.len();
-    let mut twice_area = 0.0;
-    for i in 0..n {
-        twice_area += pts[i].perp_dot(pts[(i + 1) % n]);
-    }
-    (0.5 * twice_area).abs() / 4.0
+        .collect()
 }
 
 /// One Sutherland–Hodgman step: keep the part of `poly` where `dist ≥ 0`.

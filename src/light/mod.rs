@@ -10,9 +10,10 @@
 //! - [`coverage`]: exact coverage of a rectangular light by the projected semi-infinite hard
 //!   shadow quad of one silhouette edge, by homogeneous clipping (Paper III §3.2.2).
 //!
-//! Analytic coverage and the coverage lookup tables (Papers III, IV) belong
-//! here too as they are added.
+//! - [`coverage_texture`]: the 4D coverage texture of Paper III §3.3 (grey and RGB for textured
+//!   lights), computed once per light shape and cached.
 
 pub mod coverage;
+pub mod coverage_texture;
 pub mod lookup_tables;
 pub mod sampling;

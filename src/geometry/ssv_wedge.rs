@@ -1,0 +1,230 @@
+//! Robust penumbra wedges of the soft shadow volume algorithm (Paper III §3.1, Figure 5) for a
+//! rectangular light.
+//!
+//! For a silhouette edge `e0 e1` and a light with center `c`:
+//!
+//! 1. The vertex nearer to `c` is the wedge's top vertex `A`; the other one is moved toward `c`
+//!    to the same distance, giving `B` (Figure 5a). `A B` is the wedge's top edge; the original
+//!    edge is still the one the coverage is computed from.
+//! 2. Front and back planes contain the line `A B` and are rotated about it until they barely
+//!    touch the light (Figure 5b): around the axis `A B`, the light's four corners span an
+//!    angular sector (the light is convex, so its corners bound it); the two planes through the
+//!    axis and the extreme corners bound the reflected sector, which is the wedge's cross-section.
+//! 3. The right plane contains `B` and the direction `k = (A − B) × (c − B)` perpendicular to
+//!    both the top edge and the direction to the light center, rotated about that axis until
+//!    it barely touches the light (Figure 5c): in the plane ⟂ `k` through `B`, spanned by the
+//!    outward edge direction `t` and the light direction `g`, it passes through the reflection
+//!    of the corner with the largest angle from `t`. The left plane is the same construction at
+//!    `A` with `t` pointing the other way.
+//!
+//! The wedge is the intersection of the four inner half spaces (Figure 5d); its faces are the
+//! front and back quads and the left and right triangles, each extended to infinity away from
+//! the light (vertices at w = 0, as the shadow volume quads, [`super::shadow_volume`]). Every
+//! wedge is built from its own edge only ("wedges independent of each other", §3.1).
+//!
+//! # Degenerate wedges (a choice the paper leaves open)
+//!
+//! When the light's corners span half a turn or more around the top edge or around a side
+//! axis (the edge is very close to a large light, or the line of the edge passes through the
+//! light), no four planes bound the penumbra volume as above. [`SsvWedge::new`] then returns
+//! `None` and the caller treats the whole space as inside the wedge — correct, because the
+//! coverage it then computes for every pixel is exactly 0 outside the real penumbra volume
+//! (Paper III §3.2.2 and [`crate::light::coverage`]), only slower.
+
+use crate::gpu::transform::{ClipVertex, Projection};
+use crate::light::coverage::RectLight;
+use glam::{DVec2, DVec3};
+
+/// A wedge vertex: a finite point or a direction at infinity (w = 0).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum WedgeVertex {
+    /// A finite world-space point.
+    Point(DVec3),
+    /// A world-space direction, the vertex at infinity (w = 0).
+    Direction(DVec3),
+}
+
+impl WedgeVertex {
+    /// Clip coordinates (points as [`Projection::clip_point`], directions as
+    /// [`Projection::clip_direction`]).
+    pub fn clip(&self, proj: &Projection) -> ClipVertex {
+        match self {
+            WedgeVertex::Point(p) => proj.clip_point(p.as_vec3()),
+            WedgeVertex::Direction(d) => proj.clip_direction(*d),
+        }
+    }
+}
+
+/// A plane `normal · (x − origin) ≥ 0` for the inside, `normal` of unit length.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HalfSpace {
+    /// A point of the plane.
+    pub origin: DVec3,
+    /// Unit normal pointing into the wedge.
+    pub normal: DVec3,
+}
+
+impl HalfSpace {
+    /// Signed distance of `x` to the plane, positive inside.
+    pub fn distance(&self, x: DVec3) -> f64 {
+        self.normal.dot(x - self.origin)
+    }
+}
+
+/// A penumbra wedge of Paper III §3.1 (module doc).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SsvWedge {
+    /// The top edge: `A` (the edge vertex nearer the light center) and the adjusted `B`.
+    pub top: [DVec3; 2],
+    /// Front, back, left, right planes, normals pointing inside.
+    pub planes: [HalfSpace; 4],
+    /// The six faces as triangles, wound counter-clockwise seen from outside (front-facing
+    /// when seen from outside the wedge).
+    pub triangles: [[WedgeVertex; 3]; 6],
+}
+
+impl SsvWedge {
+    /// The wedge of edge `e0 e1` under `light` (module doc); `None` when it is degenerate
+    /// (module doc, "Degenerate wedges").
+    pub fn new(light: &RectLight, e0: DVec3, e1: DVec3) -> Option<SsvWedge> {
+        let c = light.center;
+        let corners = [
+            c - light.u - light.v,
+            c + light.u - light.v,
+            c + light.u + light.v,
+            c - light.u + light.v,
+        ];
+        let (near, far) = if (e0 - c).length() <= (e1 - c).length() {
+            (e0, e1)
+        } else {
+            (e1, e0)
+        };
+        let a = near;
+        let b = c + (far - c) * ((a - c).length() / (far - c).length());
+        let d = (b - a).try_normalize()?;
+        // Front and back planes: the corners' sector around the axis A B (step 2).
+        let r0 = reject(c - a, d).try_normalize()?;
+        let r1 = d.cross(r0);
+        let local = |q: DVec3| DVec2::new((q - a).dot(r0), (q - a).dot(r1));
+        let (q_min, q_max) = angular_extremes(corners.map(local))?;
+        let front = HalfSpace {
+            origin: a,
+            normal: (r1 * q_max.x - r0 * q_max.y).try_normalize()?,
+        };
+        let back = HalfSpace {
+            origin: a,
+            normal: (r0 * q_min.y - r1 * q_min.x).try_normalize()?,
+        };
+        // Side planes (step 3).
+        let right = side_plane(b, b - a, c, &corners)?;
+        let left = side_plane(a, a - b, c, &corners)?;
+        let away = (a - c).normalize() + (b - c).normalize();
+        let edge_dir = |p: &HalfSpace, q: &HalfSpace| -> Option<DVec3> {
+            let l = p.normal.cross(q.normal).try_normalize()?;
+            Some(if l.dot(away) < 0.0 { -l } else { l })
+        };
+        let fl = edge_dir(&front, &left)?;
+        let fr = edge_dir(&front, &right)?;
+        let bl = edge_dir(&back, &left)?;
+        let br = edge_dir(&back, &right)?;
+        let scale = (b - a).length().max(1e-6);
+        let faces: [(Vec<(DVec3, WedgeVertex)>, &HalfSpace); 4] = [
+            (
+                vec![pt(a), pt(b), dir(b, fr, scale), dir(a, fl, scale)],
+                &front,
+            ),
+            (
+                vec![pt(a), pt(b), dir(b, br, scale), dir(a, bl, scale)],
+                &back,
+            ),
+            (vec![pt(a), dir(a, fl, scale), dir(a, bl, scale)], &left),
+            (vec![pt(b), dir(b, fr, scale), dir(b, br, scale)], &right),
+        ];
+        let mut triangles = Vec::with_capacity(6);
+        for (poly, plane) in faces {
+            let n = (poly[1].0 - poly[0].0).cross(poly[2].0 - poly[0].0);
+            let mut v: Vec<WedgeVertex> = poly.iter().map(|x| x.1).collect();
+            if n.dot(plane.normal) > 0.0 {
+                v.reverse();
+            }
+            for k in 1..v.len() - 1 {
+                triangles.push([v[0], v[k], v[k + 1]]);
+            }
+        }
+        Some(SsvWedge {
+            top: [a, b],
+            planes: [front, back, left, right],
+            triangles: triangles.try_into().ok()?,
+        })
+    }
+
+    /// Whether `p` is inside the wedge (Paper III §3.2.2 pseudo code line 4): inside all four
+    /// planes (points on a plane count as inside).
+    pub fn contains(&self, p: DVec3) -> bool {
+        self.planes.iter().all(|h| h.distance(p) >= 0.0)
+    }
+
+    /// Whether `p` is within distance `r` of the inside of every plane (a conservative test
+    /// for "`p` is near or inside the wedge").
+    pub fn contains_within(&self, p: DVec3, r: f64) -> bool {
+        self.planes.iter().all(|h| h.distance(p) >= -r)
+    }
+}
+
+fn pt(p: DVec3) -> (DVec3, WedgeVertex) {
+    (p, WedgeVertex::Point(p))
+}
+
+/// A vertex at infinity in direction `d` from `origin`, with a finite stand-in at `origin +
+/// scale·d` for the winding test.
+fn dir(origin: DVec3, d: DVec3, scale: f64) -> (DVec3, WedgeVertex) {
+    (origin + d * scale, WedgeVertex::Direction(d))
+}
+
+/// `x` minus its component along the unit vector `d`.
+fn reject(x: DVec3, d: DVec3) -> DVec3 {
+    x - d * x.dot(d)
+}
+
+/// The corners with the smallest and largest angle around the origin measured from the
+/// positive x axis, when they span less than half a turn (and none is at the origin).
+fn angular_extremes(q: [DVec2; 4]) -> Option<(DVec2, DVec2)> {
+    let ang: Vec<f64> = q.iter().map(|p| p.y.atan2(p.x)).collect();
+    let (mut lo, mut hi) = (0, 0);
+    for i in 1..4 {
+        if ang[i] < ang[lo] {
+            lo = i;
+        }
+        if ang[i] > ang[hi] {
+            hi = i;
+        }
+    }
+    let spans_half_turn = ang[hi] - ang[lo] >= std::f64::consts::PI;
+    if spans_half_turn || q.iter().any(|p| *p == DVec2::ZERO) {
+        return None;
+    }
+    Some((q[lo], q[hi]))
+}
+
+/// The side plane through `at` (module doc, step 3); `outward` points from the other top
+/// vertex to `at`.
+fn side_plane(at: DVec3, outward: DVec3, c: DVec3, corners: &[DVec3; 4]) -> Option<HalfSpace> {
+    let t = outward.try_normalize()?;
+    let g = reject(c - at, t).try_normalize()?;
+    let mut best: Option<DVec2> = None;
+    for q in corners {
+        let p = DVec2::new((*q - at).dot(t), (*q - at).dot(g));
+        if p.y <= 0.0 {
+            return None;
+        }
+        // Largest angle from t in (0, π): p is counter-clockwise of the best so far.
+        if best.is_none_or(|b| b.perp_dot(p) > 0.0) {
+            best = Some(p);
+        }
+    }
+    let q = best?;
+    Some(HalfSpace {
+        origin: at,
+        normal: (g * q.x - t * q.y).try_normalize()?,
+    })
+}

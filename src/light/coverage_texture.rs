@@ -1,0 +1,311 @@
+//! The 4D coverage texture of Paper III §3.3 (Figure 10): the coverage of a rectangular light
+//! as a function `f(x1, y1, x2, y2)` of the projected, clipped edge, discretized and stored as
+//! an 8-bit 2D texture of n×n sub-textures of n×n texels.
+//!
+//! # Representation
+//!
+//! The light square `[−1, 1]²` (light coordinates of [`crate::light::coverage`]) is discretized
+//! into n×n *texel positions* on a regular grid that includes the border:
+//! `s_i = −1 + 2i/(n − 1)`, `i = 0 … n − 1` (same for `t`). (The paper says "discretized into
+//! n×n texel positions"; putting the outermost positions on the border is our choice: the
+//! clipped endpoints of most projected edges lie on the border, where a grid of cell centers
+//! would need extrapolation.) Sub-texture `(a, b)` holds the first endpoint at `(s_a, t_b)`,
+//! its texel `(i, j)` the second endpoint at `(s_i, t_j)`; the sub-textures are tiled into one
+//! `n² × n²` texture, big-texture column `a·n + i`, row `b·n + j`. Each texel stores
+//! `round(255·f)` with `f` = [`segment_coverage`] computed by exact clipping (n = 32: 1024×1024
+//! bytes, 1 MB). The texture does not depend on the light's size or aspect: area ratios are
+//! affine invariant, so one texture per `n` serves every rectangular light.
+//!
+//! **Textured lights** (§3.3): the light's RGB texture is first resampled to n×n texels (nearest,
+//! at the texel-cell centers, with the convention of [`crate::light::sampling`]: texel (0,0) at
+//! the corner `center − u + v`). Each coverage texel then stores, per channel, the light-texture
+//! weighted area of the same region — the sum over light cells of `area(region ∩ cell) ·
+//! colour` — divided by that channel's total over the whole light, rounded to 8 bits: three
+//! bytes per texel, 3 MB at n = 32. A channel that emits nothing stores 0.
+//!
+//! # Lookup (§3.3)
+//!
+//! The clipped endpoints are mapped to grid coordinates `g = (s + 1)/2 · (n − 1)`.
+//! [`CoverageFilter::Nearest`] rounds both endpoints to the nearest position (half away from
+//! zero); [`CoverageFilter::Bilinear`] rounds the first and filters the second bilinearly inside
+//! its sub-texture; [`CoverageFilter::Quadrilinear`] filters the first endpoint bilinearly over
+//! the four nearest sub-textures, each looked up bilinearly ("quadlinear filtering"). Weights
+//! and sums are f64 on the texel values / 255.
+//!
+//! # Cache
+//!
+//! A texture is computed once per shape key — `n` and, for textured lights, the resampled
+//! light texture — and kept for the life of the process ([`coverage_texture`]); a video
+//! sequence that shows the same frame again re-uses its texture. The computation is a pure
+//! function of the key (texels computed in parallel, each independently), so the cache cannot
+//! change any bit.
+
+use crate::light::coverage::{clip_polygon_to_box, polygon_area, segment_region};
+use crate::scene::RgbTexture;
+use glam::DVec2;
+use rayon::prelude::*;
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// Smallest selectable `n`.
+pub const MIN_N: u32 = 8;
+/// Largest selectable `n`.
+pub const MAX_N: u32 = 64;
+/// The paper's `n` (§3.3: "In practice, we use n = 32").
+pub const DEFAULT_N: u32 = 32;
+
+/// How the coverage texture is sampled (module doc, "Lookup").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize)]
+pub enum CoverageFilter {
+    /// Nearest position for both endpoints.
+    Nearest,
+    /// Nearest sub-texture, bilinear inside it.
+    Bilinear,
+    /// Bilinear over the four nearest sub-textures, each bilinear.
+    Quadrilinear,
+}
+
+/// What a coverage texture is computed for (module doc, "Cache").
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct CoverageTextureKey {
+    /// Texel positions per side of the light.
+    pub n: u32,
+    /// The light texture resampled to n×n (row-major, row 0 at `t = +1`), as f32 bits; `None`
+    /// for a uniform light.
+    pub light_texels: Option<Vec<[u32; 3]>>,
+}
+
+impl CoverageTextureKey {
+    /// The key of a uniform rectangular light.
+    pub fn uniform(n: u32) -> Self {
+        CoverageTextureKey {
+            n,
+            light_texels: None,
+        }
+    }
+
+    /// The key of a textured light: its texture resampled to n×n (module doc).
+    pub fn textured(n: u32, texture: &RgbTexture) -> Self {
+        let mut texels = Vec::with_capacity((n * n) as usize);
+        for row in 0..n {
+            for col in 0..n {
+                let tx = (((col as f64 + 0.5) / n as f64 * texture.width as f64) as u32)
+                    .min(texture.width - 1);
+                let ty = (((row as f64 + 0.5) / n as f64 * texture.height as f64) as u32)
+                    .min(texture.height - 1);
+                let c = texture.texels[(ty * texture.width + tx) as usize];
+                texels.push(c.map(f32::to_bits));
+            }
+        }
+        CoverageTextureKey {
+            n,
+            light_texels: Some(texels),
+        }
+    }
+}
+
+/// A computed 4D coverage texture (module doc, "Representation").
+#[derive(Debug, Clone, PartialEq)]
+pub struct CoverageTexture {
+    /// Texel positions per side.
+    pub n: u32,
+    /// 1 (uniform light) or 3 (RGB) channels per texel.
+    pub channels: u32,
+    /// The `n² × n²` texture, row-major, `channels` bytes per texel.
+    pub texels: Vec<u8>,
+}
+
+impl CoverageTexture {
+    /// Compute the texture for `key` (module doc). `key.n` must be in `MIN_N..=MAX_N`.
+    pub fn compute(key: &CoverageTextureKey) -> CoverageTexture {
+        let n = key.n as usize;
+        assert!((MIN_N as usize..=MAX_N as usize).contains(&n));
+        let side = n * n;
+        let weights = key.light_texels.as_ref().map(|t| LightWeights::new(n, t));
+        let channels = if weights.is_some() { 3 } else { 1 };
+        let texels: Vec<u8> = (0..side)
+            .into_par_iter()
+            .flat_map_iter(|row| {
+                let (b, j) = (row / n, row % n);
+                let weights = &weights;
+                (0..side).flat_map(move |col| {
+                    let (a, i) = (col / n, col % n);
+                    let region = segment_region(grid_point(n, a, b), grid_point(n, i, j));
+                    let values: Vec<f64> = match weights {
+                        None => vec![polygon_area(&region) / 4.0],
+                        Some(w) => w.coverage(&region).to_vec(),
+                    };
+                    values.into_iter().map(|f| (f * 255.0).round() as u8)
+                })
+            })
+            .collect();
+        CoverageTexture {
+            n: key.n,
+            channels,
+            texels,
+        }
+    }
+
+    /// Bytes of storage (n = 32: 1 MB grey, 3 MB RGB).
+    pub fn bytes(&self) -> usize {
+        self.texels.len()
+    }
+
+    /// The coverage of the clipped edge `p1 → p2` (light coordinates in `[−1, 1]²`) per
+    /// channel, looked up with `filter` (module doc, "Lookup"); unsigned. Grey textures
+    /// replicate their channel.
+    pub fn lookup(&self, p1: DVec2, p2: DVec2, filter: CoverageFilter) -> [f64; 3] {
+        let g1 = self.grid(p1);
+        let g2 = self.grid(p2);
+        match filter {
+            CoverageFilter::Nearest => self.texel(nearest(g1), nearest(g2)),
+            CoverageFilter::Bilinear => self.bilinear_second(nearest(g1), g2),
+            CoverageFilter::Quadrilinear => {
+                let mut sum = [0.0; 3];
+                for (first, w) in self.bilinear_taps(g1) {
+                    let v = self.bilinear_second(first, g2);
+                    for k in 0..3 {
+                        sum[k] += w * v[k];
+                    }
+                }
+                sum
+            }
+        }
+    }
+
+    fn grid(&self, p: DVec2) -> DVec2 {
+        let m = (self.n - 1) as f64;
+        ((p + DVec2::ONE) * 0.5 * m).clamp(DVec2::ZERO, DVec2::splat(m))
+    }
+
+    /// The four grid positions around `g` with their bilinear weights, in a fixed order.
+    fn bilinear_taps(&self, g: DVec2) -> [([usize; 2], f64); 4] {
+        let last = self.n as usize - 2;
+        let x0 = (g.x.floor() as usize).min(last);
+        let y0 = (g.y.floor() as usize).min(last);
+        let fx = g.x - x0 as f64;
+        let fy = g.y - y0 as f64;
+        [
+            ([x0, y0], (1.0 - fx) * (1.0 - fy)),
+            ([x0 + 1, y0], fx * (1.0 - fy)),
+            ([x0, y0 + 1], (1.0 - fx) * fy),
+            ([x0 + 1, y0 + 1], fx * fy),
+        ]
+    }
+
+    fn bilinear_second(&self, first: [usize; 2], g2: DVec2) -> [f64; 3] {
+        let mut sum = [0.0; 3];
+        for (second, w) in self.bilinear_taps(g2) {
+            let v = self.texel(first, second);
+            for k in 0..3 {
+                sum[k] += w * v[k];
+            }
+        }
+        sum
+    }
+
+    fn texel(&self, first: [usize; 2], second: [usize; 2]) -> [f64; 3] {
+        let n = self.n as usize;
+        let row = first[1] * n + second[1];
+        let col = first[0] * n + second[0];
+        let ch = self.channels as usize;
+        let at = (row * n * n + col) * ch;
+        let v = |k: usize| self.texels[at + k.min(ch - 1)] as f64 / 255.0;
+        [v(0), v(1), v(2)]
+    }
+}
+
+/// The process-wide cached texture for `key` (module doc, "Cache"), computed on first use.
+pub fn coverage_texture(key: &CoverageTextureKey) -> Arc<CoverageTexture> {
+    static CACHE: OnceLock<Mutex<HashMap<CoverageTextureKey, Arc<CoverageTexture>>>> =
+        OnceLock::new();
+    let cache = CACHE.get_or_init(|| Mutex::new(HashMap::new()));
+    if let Some(t) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(key) {
+        return t.clone();
+    }
+    // Computed outside the lock (it takes a while); a concurrent computation of the same key
+    // yields the same bits, and the first one stored wins.
+    let t = Arc::new(CoverageTexture::compute(key));
+    cache
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .entry(key.clone())
+        .or_insert(t)
+        .clone()
+}
+
+/// Grid position `(s_a, t_b)` (module doc).
+fn grid_point(n: usize, a: usize, b: usize) -> DVec2 {
+    let m = (n - 1) as f64;
+    DVec2::new(-1.0 + 2.0 * a as f64 / m, -1.0 + 2.0 * b as f64 / m)
+}
+
+fn nearest(g: DVec2) -> [usize; 2] {
+    [g.x.round() as usize, g.y.round() as usize]
+}
+
+/// The resampled light texture as per-cell weights (module doc, "Textured lights").
+struct LightWeights {
+    n: usize,
+    /// Row-major, row 0 at `t = +1`.
+    colour: Vec<[f64; 3]>,
+    /// Per channel: the sum of colour × cell area over the light.
+    total: [f64; 3],
+}
+
+impl LightWeights {
+    fn new(n: usize, texels: &[[u32; 3]]) -> Self {
+        let colour: Vec<[f64; 3]> = texels
+            .iter()
+            .map(|c| c.map(|b| f32::from_bits(b) as f64))
+            .collect();
+        let cell = 4.0 / (n * n) as f64;
+        let mut total = [0.0; 3];
+        for c in &colour {
+            for k in 0..3 {
+                total[k] += c[k] * cell;
+            }
+        }
+        LightWeights { n, colour, total }
+    }
+
+    /// Per channel, the colour-weighted area of `region` over the light's total.
+    fn coverage(&self, region: &[DVec2]) -> [f64; 3] {
+        let mut sum = [0.0; 3];
+        if region.len() < 3 {
+            return sum;
+        }
+        let step = 2.0 / self.n as f64;
+        for row in 0..self.n {
+            let top = 1.0 - step * row as f64;
+            let strip =
+                clip_polygon_to_box(region, DVec2::new(-1.0, top - step), DVec2::new(1.0, top));
+            if strip.len() < 3 {
+                continue;
+            }
+            for col in 0..self.n {
+                let left = -1.0 + step * col as f64;
+                let cell = clip_polygon_to_box(
+                    &strip,
+                    DVec2::new(left, top - step),
+                    DVec2::new(left + step, top),
+                );
+                if cell.len() < 3 {
+                    continue;
+                }
+                let area = polygon_area(&cell);
+                let c = self.colour[row * self.n + col];
+                for k in 0..3 {
+                    sum[k] += area * c[k];
+                }
+            }
+        }
+        let mut out = [0.0; 3];
+        for k in 0..3 {
+            if self.total[k] > 0.0 {
+                out[k] = (sum[k] / self.total[k]).min(1.0);
+            }
+        }
+        out
+    }
+}
