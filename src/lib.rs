@@ -11,6 +11,7 @@
 //! See `../shared/DESIGN.md` for the bit-exactness contract the [`gpu`] module implements.
 
 pub mod error;
+pub mod experiment;
 pub mod frame;
 pub mod geometry;
 pub mod golden;

@@ -29,6 +29,17 @@ enum Cmd {
     Render(RenderArgs),
     /// Print the built-in scenes and the methods, one per line.
     List,
+    /// Run an experiment (Paper II §7): `experiment tile-size SCENE [--out DIR]`.
+    Experiment {
+        /// The experiment: `tile-size`.
+        #[arg(value_parser = ["tile-size"])]
+        name: String,
+        /// Scene file or built-in name (sphere light).
+        scene: String,
+        /// Output directory for the CSV and the SVG plot.
+        #[arg(long, default_value = "out/experiment")]
+        out: PathBuf,
+    },
     /// Check (or with --bless rewrite) the golden outputs under golden/.
     Golden {
         /// Rewrite the goldens instead of checking them.
@@ -117,14 +128,38 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
             .build_global()?;
     }
     match cli.cmd {
-        None => render(&RenderArgs {
-            scene: builtin::DEFAULT.into(),
-            methods: None,
-            width: None,
-            height: None,
-            out: "out".into(),
-            opts: vec![],
-        }),
+        // The default scene, then its sphere-light twin so that the sphere-only methods
+        // (penumbra wedges) appear in a table too.
+        None => [builtin::DEFAULT, "cube-of-spheres-sphere"]
+            .into_iter()
+            .try_for_each(|scene| {
+                render(&RenderArgs {
+                    scene: scene.into(),
+                    methods: None,
+                    width: None,
+                    height: None,
+                    out: if scene == builtin::DEFAULT {
+                        "out".into()
+                    } else {
+                        format!("out/{scene}").into()
+                    },
+                    opts: vec![],
+                })
+            }),
+        Some(Cmd::Experiment {
+            name: _,
+            scene,
+            out,
+        }) => {
+            let scene = file::resolve(&scene)?;
+            validate::validate(&scene)?;
+            print!("{}", penumbra::experiment::tile_size::run(&scene, &out)?);
+            println!(
+                "outputs: {0}/tile_size.csv, {0}/tile_size.svg",
+                out.display()
+            );
+            Ok(())
+        }
         Some(Cmd::Render(a)) => render(&a),
         Some(Cmd::List) => {
             println!("# built-in scenes");

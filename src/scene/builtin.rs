@@ -11,6 +11,10 @@
 //! | `cylinder` | capped cylinder, 24 segments, r 0.35, h 1, floating at y = 0.4 | sphere r 0.3 | 108 |
 //! | `eye-in-shadow` | a 4×3 slab above the camera + a floating box in the lit region | rect ½-extents 0.4 | 36 |
 //! | `overlap-stress` | 300 stacked 1.2×1.2 two-sided quads, spacing 0.002 | point | 1212 |
+//! | `cube-of-spheres-sphere` | as `cube-of-spheres` | sphere r 0.5 at the same center | 4548 |
+//! | `pw-columns` | Paper II Fig. 9 analogue: 2×4 columns (16 segments, r 0.15, h 1.6) | sphere r 0.3 | 780 |
+//! | `pw-fractal` | Paper II Fig. 10 analogue: closed 24×24 midpoint-displacement landscape | sphere r 0.4 | 1250 |
+//! | `pw-2002` | Paper II Fig. 11 analogue: "2002" in seven-segment boxes at y = 0.9 | sphere r 0.25 | 216 |
 
 use super::procedural::{box_mesh, cylinder, two_sided_quad, uv_sphere};
 use super::{Camera, Light, LightShape, Mesh, RawOptions, Scene};
@@ -26,6 +30,10 @@ const NAMES: &[&str] = &[
     "cylinder",
     "eye-in-shadow",
     "overlap-stress",
+    "cube-of-spheres-sphere",
+    "pw-columns",
+    "pw-fractal",
+    "pw-2002",
 ];
 
 /// Names of all built-in scenes.
@@ -41,6 +49,10 @@ pub fn load(name: &str) -> Option<Scene> {
         "cylinder" => cylinder_scene(),
         "eye-in-shadow" => eye_in_shadow(),
         "overlap-stress" => overlap_stress(),
+        "cube-of-spheres-sphere" => cube_of_spheres_sphere(),
+        "pw-columns" => pw_columns(),
+        "pw-fractal" => pw_fractal(),
+        "pw-2002" => pw_2002(),
         _ => return None,
     };
     Some(Scene {
@@ -221,6 +233,203 @@ fn overlap_stress() -> Scene {
         Light {
             center: Vec3::new(0.0, 4.0, 0.0),
             shape: LightShape::Point,
+        },
+        meshes,
+    )
+}
+
+/// `cube-of-spheres` under a sphere light of radius 0.5 at the same center: the sphere-light
+/// twin that the penumbra-wedge methods (sphere lights only) render in the default run.
+fn cube_of_spheres_sphere() -> Scene {
+    let mut s = cube_of_spheres();
+    s.light.shape = LightShape::Sphere { radius: 0.5 };
+    s
+}
+
+/// Paper II Fig. 9 analogue ("column scene"): two rows of four columns on a floor, lit from
+/// above and to the side so their long shadows and penumbrae overlap on the floor.
+fn pw_columns() -> Scene {
+    let mut meshes = vec![floor([-4.0, 4.0], [-4.0, 4.0])];
+    for row in 0..2 {
+        for i in 0..4 {
+            let base = Vec3::new(-1.2 + 0.8 * i as f32, 0.0, -0.5 + 1.0 * row as f32);
+            let name = format!("column[{row},{i}]");
+            meshes.push(cylinder(&name, base, 0.15, 1.6, 16, OCCLUDER));
+        }
+    }
+    scene(
+        camera([0.5, 3.2, 5.0], [0.0, 0.4, -0.3], 50.0),
+        Light {
+            center: Vec3::new(2.5, 4.0, 1.5),
+            shape: LightShape::Sphere { radius: 0.3 },
+        },
+        meshes,
+    )
+}
+
+/// Side of the `pw-fractal` height grid (cells).
+const FRACTAL_N: usize = 24;
+
+/// Paper II Fig. 10 analogue ("fractal scene"): a closed heightfield landscape made by
+/// midpoint displacement (deterministic LCG, roughness 0.55) that shadows itself.
+fn pw_fractal() -> Scene {
+    let n = 32; // power-of-two grid for midpoint displacement, sampled down to FRACTAL_N
+    let mut h = vec![vec![0.0f64; n + 1]; n + 1];
+    let mut seed = 0x2002_u64;
+    let mut rnd = move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    };
+    let mut step = n;
+    let mut amp = 0.9;
+    while step > 1 {
+        let half = step / 2;
+        for y in (0..n).step_by(step) {
+            for x in (0..n).step_by(step) {
+                let avg = (h[y][x] + h[y][x + step] + h[y + step][x] + h[y + step][x + step]) / 4.0;
+                h[y + half][x + half] = avg + amp * rnd();
+            }
+        }
+        for y in (0..=n).step_by(half) {
+            let x0 = if (y / half) % 2 == 0 { half } else { 0 };
+            for x in (x0..=n).step_by(step) {
+                let mut sum = 0.0;
+                let mut k = 0.0;
+                for (dx, dy) in [(-1i64, 0i64), (1, 0), (0, -1), (0, 1)] {
+                    let (xx, yy) = (x as i64 + dx * half as i64, y as i64 + dy * half as i64);
+                    if (0..=n as i64).contains(&xx) && (0..=n as i64).contains(&yy) {
+                        sum += h[yy as usize][xx as usize];
+                        k += 1.0;
+                    }
+                }
+                h[y][x] = sum / k + amp * rnd();
+            }
+        }
+        step = half;
+        amp *= 0.55;
+    }
+    let m = FRACTAL_N;
+    let heights: Vec<Vec<f64>> = (0..=m)
+        .map(|j| {
+            (0..=m)
+                .map(|i| 0.3 + h[j * n / m][i * n / m].max(-0.25))
+                .collect()
+        })
+        .collect();
+    scene(
+        camera([0.0, 3.0, 4.6], [0.0, 0.2, 0.0], 50.0),
+        Light {
+            center: Vec3::new(-2.0, 3.5, -1.5),
+            shape: LightShape::Sphere { radius: 0.4 },
+        },
+        vec![heightfield("landscape", &heights, 4.0, -0.1)],
+    )
+}
+
+/// A closed heightfield over the square [−size/2, size/2]² (x, z): the top grid of
+/// `heights[row][col]`, vertical side walls down to `base_y` and a flat bottom fanned from its
+/// center. Every triangle is oriented outward (top +y, sides away from the center, bottom −y).
+fn heightfield(name: &str, heights: &[Vec<f64>], size: f64, base_y: f64) -> Mesh {
+    let m = heights.len() - 1;
+    let coord = |i: usize| -size / 2.0 + size * i as f64 / m as f64;
+    let mut pos: Vec<DVec3> = Vec::new();
+    for (j, row) in heights.iter().enumerate() {
+        for (i, y) in row.iter().enumerate() {
+            pos.push(DVec3::new(coord(i), *y, coord(j)));
+        }
+    }
+    let top = |i: usize, j: usize| (j * (m + 1) + i) as u32;
+    let mut tris: Vec<([u32; 3], DVec3)> = Vec::new();
+    for j in 0..m {
+        for i in 0..m {
+            let (a, b, c, d) = (top(i, j), top(i + 1, j), top(i + 1, j + 1), top(i, j + 1));
+            tris.push(([a, b, c], DVec3::Y));
+            tris.push(([a, c, d], DVec3::Y));
+        }
+    }
+    // Boundary ring of top vertices, counter-clockwise seen from above.
+    let mut ring = Vec::new();
+    ring.extend((0..m).map(|i| (i, 0)));
+    ring.extend((0..m).map(|j| (m, j)));
+    ring.extend((0..m).map(|i| (m - i, m)));
+    ring.extend((0..m).map(|j| (0, m - j)));
+    let bottom0 = pos.len() as u32;
+    for &(i, j) in &ring {
+        pos.push(DVec3::new(coord(i), base_y, coord(j)));
+    }
+    let center = pos.len() as u32;
+    pos.push(DVec3::new(0.0, base_y, 0.0));
+    let k = ring.len();
+    for r in 0..k {
+        let (t0, t1) = (
+            top(ring[r].0, ring[r].1),
+            top(ring[(r + 1) % k].0, ring[(r + 1) % k].1),
+        );
+        let (b0, b1) = (bottom0 + r as u32, bottom0 + ((r + 1) % k) as u32);
+        let mid = (pos[t0 as usize] + pos[t1 as usize]) * 0.5;
+        let out = DVec3::new(mid.x, 0.0, mid.z);
+        tris.push(([t0, b0, b1], out));
+        tris.push(([t0, b1, t1], out));
+        tris.push(([center, b1, b0], -DVec3::Y));
+    }
+    let triangles = tris
+        .into_iter()
+        .map(|([a, b, c], out)| {
+            let (pa, pb, pc) = (pos[a as usize], pos[b as usize], pos[c as usize]);
+            if (pb - pa).cross(pc - pa).dot(out) < 0.0 {
+                [a, c, b]
+            } else {
+                [a, b, c]
+            }
+        })
+        .collect();
+    Mesh {
+        name: name.to_string(),
+        positions: pos.iter().map(|p| p.as_vec3()).collect(),
+        triangles,
+        color: OCCLUDER,
+    }
+}
+
+/// Paper II Fig. 11 analogue ("2002 scene"): the digits 2, 0, 0, 2 as seven-segment boxes
+/// lying flat at y = 0.9, casting a soft "2002" onto the floor.
+fn pw_2002() -> Scene {
+    // Segments a..g as (x0, z0, x1, z1) in a 0.5 × 0.9 digit cell (z grows toward the camera).
+    let seg = |k: usize| -> [f32; 4] {
+        let (w, t, h) = (0.5f32, 0.09f32, 0.9f32);
+        match k {
+            0 => [0.0, 0.0, w, t],                       // a: top
+            1 => [w - t, 0.0, w, h / 2.0],               // b: top right
+            2 => [w - t, h / 2.0, w, h],                 // c: bottom right
+            3 => [0.0, h - t, w, h],                     // d: bottom
+            4 => [0.0, h / 2.0, t, h],                   // e: bottom left
+            5 => [0.0, 0.0, t, h / 2.0],                 // f: top left
+            _ => [0.0, (h - t) / 2.0, w, (h + t) / 2.0], // g: middle
+        }
+    };
+    let two = [0, 1, 6, 4, 3];
+    let zero = [0, 1, 2, 3, 4, 5];
+    let digits: [&[usize]; 4] = [&two, &zero, &zero, &two];
+    let mut meshes = vec![floor([-3.0, 3.0], [-3.0, 3.0])];
+    for (d, segs) in digits.iter().enumerate() {
+        let x0 = -1.3 + 0.7 * d as f32;
+        for &k in segs.iter() {
+            let [a, b, c, e] = seg(k);
+            meshes.push(box_mesh(
+                &format!("digit[{d}].segment[{k}]"),
+                Vec3::new(x0 + a, 0.9, -0.45 + b),
+                Vec3::new(x0 + c, 0.98, -0.45 + e),
+                OCCLUDER,
+            ));
+        }
+    }
+    scene(
+        camera([0.0, 3.0, 3.2], [0.0, 0.2, 0.0], 50.0),
+        Light {
+            center: Vec3::new(0.4, 3.2, -0.6),
+            shape: LightShape::Sphere { radius: 0.25 },
         },
         meshes,
     )

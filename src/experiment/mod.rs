@@ -1,0 +1,4 @@
+//! Experiments that sweep a parameter and report counters (DESIGN.md "report/": sweeps,
+//! CSV, plots).
+
+pub mod tile_size;
