@@ -200,7 +200,7 @@ fn angular_extremes(q: [DVec2; 4]) -> Option<(DVec2, DVec2)> {
         }
     }
     let spans_half_turn = ang[hi] - ang[lo] >= std::f64::consts::PI;
-    if spans_half_turn || q.iter().any(|p| *p == DVec2::ZERO) {
+    if spans_half_turn || q.contains(&DVec2::ZERO) {
         return None;
     }
     Some((q[lo], q[hi]))

@@ -8,6 +8,7 @@ pub mod output;
 pub mod pw2002;
 pub mod pw_restructured;
 pub mod raycast;
+pub mod ssv;
 pub mod ssv_optimized;
 
 use crate::error::InputError;
@@ -26,6 +27,7 @@ pub const ALL: &[&str] = &[
     "pw2002",
     "pw-restructured",
     "ssv-optimized",
+    "ssv",
 ];
 
 /// The reference every other method's error is measured against.
@@ -43,6 +45,8 @@ pub fn supports(method: &str, shape: &LightShape) -> bool {
         "pw2002" | "pw-restructured" => matches!(shape, LightShape::Sphere { .. }),
         // Paper IV §4.2: the rectangular and the spherical shader.
         "ssv-optimized" => matches!(shape, LightShape::Rect { .. } | LightShape::Sphere { .. }),
+        // Paper III §3.2.2, §3.3: rectangular and textured rectangular lights.
+        "ssv" => matches!(shape, LightShape::Rect { .. } | LightShape::TexturedRect { .. }),
         _ => false,
     }
 }
@@ -102,6 +106,7 @@ pub fn run(method: &str, frame: &Frame) -> Result<MethodOutput, InputError> {
         "nsample" => nsample::run(frame),
         "raycast" => run_raycast(frame),
         "ssv-optimized" => ssv_optimized::run(frame),
+        "ssv" => ssv::run(frame),
         "pw2002" => pw2002::run(frame),
         "pw-restructured" => pw_restructured::run(frame),
         _ => Err(InputError::at(

@@ -1,0 +1,483 @@
+//! `ssv`: the geometry-based soft shadow volume algorithm (Paper III, Assarsson &
+//! Akenine-Möller, SIGGRAPH 2003) for rectangular and textured rectangular lights.
+//!
+//! * **Pass 1** (§3.2.1): the hard shadow quads from the light center
+//!   ([`shadow_volume_triangles`], its submission order) add −1.0 (entering, front-facing) and
+//!   +1.0 (leaving, back-facing) to a V-buffer cleared to 1.0, exactly as the stencil counts of
+//!   `hard-sv` (z-pass; z-fail with caps when the eye is in shadow, chosen as `hard-sv` does).
+//! * **Pass 2** (§3.2.2): one wedge per possible silhouette edge of the same edges, in the same
+//!   order ([`SsvWedge`], §3.1). For every pixel covered by the wedge's front-facing triangles,
+//!   the receiver point `p` is tested against the wedge's four planes; inside, the signed
+//!   coverage of the edge's semi-infinite hard shadow quad is added — positive when `p` is on
+//!   the umbra side of the quad (the paper's "negative half space"). The sum over the
+//!   silhouette is Green's theorem: exact for occluders without the single-silhouette or
+//!   overlap artifacts (§5.3).
+//! * **Coverage** (`coverage`): `exact` clips the projected quad against the light
+//!   ([`edge_coverage_exact`], §3.2.2); `texture` looks the clipped projected edge up in the 4D
+//!   coverage texture (§3.3) of `texture-n` (8…64, default 32) with `filter`
+//!   (`nearest` (default; the paper: "for normal scenes, this filtering is not necessary"),
+//!   `bilinear`, `quadrilinear`).
+//! * **V-buffer** (`vbuffer`, [`crate::gpu::vbuffer`]): `f32` (default), `f16`, and `8bit`
+//!   (§4.2): pass 1 goes to the 8-bit stencil ([`stencil_shadow`], wrap) and pass 2 to the
+//!   saturating R (add) / G (subtract) channels; resolved as `1 − stencil + (R − G)/63`.
+//! * **Textured lights** (§3.3, §4.1): the coverage texture is RGB (the light texture resampled
+//!   to n×n), the V-buffer RGB f32, and the visibility RGB. `coverage = texture` is required
+//!   and is the default for them; the 8-bit V-buffer is grey only ("only one component could be
+//!   used", §4.2) and is rejected for textured lights.
+//!
+//! Choices where the paper is silent:
+//! * The receiver point of a pixel is the depth-buffer point ([`Frame::receivers`]), the same
+//!   one `raycast` uses by default, so the error against the reference is the method's own.
+//! * The eye in or near a wedge: the paper rasterizes front faces only. When the eye lies
+//!   within the near-plane radius of a wedge (so front faces could be missing or clipped by the
+//!   near plane), that wedge is drawn as a full-screen quad instead; the inside test still
+//!   decides per pixel, so the result is the same, only more pixels are tested. Degenerate
+//!   wedges ([`SsvWedge::new`] returns `None`) are handled the same way.
+//! * Sphere lights: §5.3 says pass 2 is "trivial to modify" for a sphere, with the
+//!   computations in the shader and no coverage texture; that variant is not implemented here
+//!   (`ssv` supports `rect` and `textured_rect`; Paper IV's spherical shader is in
+//!   `ssv-optimized`).
+//! * Final visibility: the resolved V-buffer clamped to [0, 1] (overlapping occluders can
+//!   drive the Green's sum below 0, §5.3 "object overlap artifact"); background pixels are 1.
+
+use super::hard_sv::{stencil_row_major, stencil_shadow, ShadowTest, StencilOverflow};
+use super::hard_sv::{StencilShadowSettings, Submission};
+use super::options::OptionReader;
+use super::output::{MethodOutput, PassStats, Visibility};
+use crate::error::InputError;
+use crate::frame::{setup_all, Frame, Receiver};
+use crate::geometry::shadow_volume::{shadow_volume_triangles, Capping};
+use crate::geometry::silhouette::{light_facing, possible_silhouettes};
+use crate::geometry::ssv_wedge::SsvWedge;
+use crate::gpu::counters::Counters;
+use crate::gpu::depth::{DepthFunc, DepthState};
+use crate::gpu::raster::{bin, draw, no_tile_culling};
+use crate::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
+use crate::gpu::transform::ClipVertex;
+use crate::gpu::vbuffer::{
+    VBuffer8Tile, VBufferF16Tile, VBufferF32Tile, VBufferFormat, VBufferRgbTile, VBufferTile,
+};
+use crate::light::coverage::{edge_coverage_exact, projected_edge_in_light, quad_side, RectLight};
+use crate::light::coverage_texture::{
+    coverage_texture, CoverageFilter, CoverageTexture, CoverageTextureKey, DEFAULT_N, MAX_N, MIN_N,
+};
+use crate::plan::{eye_in_shadow, BufferPlan, MethodPlan};
+use crate::scene::LightShape;
+use glam::DVec3;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// How the coverage of an edge is computed (module doc, "Coverage").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum CoverageMode {
+    /// Exact clipping (§3.2.2).
+    Exact,
+    /// The 4D coverage texture of `n` with `filter` (§3.3).
+    Texture {
+        /// Texel positions per light side.
+        n: u32,
+        /// Lookup filter.
+        filter: CoverageFilter,
+    },
+}
+
+/// The settings of one `ssv` render.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct SsvSettings {
+    /// Coverage computation.
+    pub coverage: CoverageMode,
+    /// V-buffer format (RGB f32 for textured lights).
+    pub vbuffer: VBufferFormat,
+    /// z-pass or z-fail for pass 1.
+    pub test: ShadowTest,
+}
+
+/// Read the `ssv` options (module doc) for `frame`.
+pub fn read_settings(frame: &Frame) -> Result<(SsvSettings, &'static str), InputError> {
+    let scene = frame.scene;
+    let textured = matches!(scene.light.shape, LightShape::TexturedRect { .. });
+    let mut r = OptionReader::new(scene, "ssv");
+    let mode = r.choice("mode", &["auto", "zpass", "zfail"], "auto")?;
+    let coverage = r.choice(
+        "coverage",
+        &["exact", "texture"],
+        if textured { "texture" } else { "exact" },
+    )?;
+    let n = r.uint("texture-n", DEFAULT_N as u64, MIN_N as u64..=MAX_N as u64)? as u32;
+    let filter = match r.choice(
+        "filter",
+        &["nearest", "bilinear", "quadrilinear"],
+        "nearest",
+    )? {
+        "nearest" => CoverageFilter::Nearest,
+        "bilinear" => CoverageFilter::Bilinear,
+        _ => CoverageFilter::Quadrilinear,
+    };
+    let vbuffer = match r.choice("vbuffer", &["f32", "f16", "8bit"], "f32")? {
+        "f32" if textured => VBufferFormat::RgbF32,
+        "f32" => VBufferFormat::F32,
+        "f16" => VBufferFormat::F16,
+        _ => VBufferFormat::Split8,
+    };
+    r.finish()?;
+    let bad =
+        |key: &str, msg: &str| InputError::at(&scene.source, format!("options.ssv.{key}"), msg);
+    if textured && coverage == "exact" {
+        return Err(bad(
+            "coverage",
+            "textured lights need coverage = \"texture\" (the RGB coverage texture, Paper III §3.3)",
+        ));
+    }
+    if textured && vbuffer != VBufferFormat::RgbF32 {
+        return Err(bad(
+            "vbuffer",
+            "textured lights need the RGB f32 V-buffer (vbuffer = \"f32\"); f16 and 8bit are grey",
+        ));
+    }
+    let center = scene.light.center;
+    let test = match mode {
+        "zpass" => ShadowTest::ZPass,
+        "zfail" => ShadowTest::ZFail,
+        _ if eye_in_shadow(scene, frame.proj.near, &[center]) => ShadowTest::ZFail,
+        _ => ShadowTest::ZPass,
+    };
+    let coverage = match coverage {
+        "exact" => CoverageMode::Exact,
+        _ => CoverageMode::Texture { n, filter },
+    };
+    Ok((
+        SsvSettings {
+            coverage,
+            vbuffer,
+            test,
+        },
+        mode,
+    ))
+}
+
+/// One silhouette edge with its wedge: the edge oriented so that the coverage sign convention
+/// of [`crate::light::coverage`] gives "+ on the umbra side", and `None` for a wedge drawn
+/// full-screen (module doc).
+struct EdgeWedge {
+    e0: DVec3,
+    e1: DVec3,
+    wedge: Option<SsvWedge>,
+}
+
+/// Everything pass 2 needs per fragment.
+struct CoverageSource<'a> {
+    light: RectLight,
+    mode: CoverageMode,
+    texture: Option<Arc<CoverageTexture>>,
+    receivers: &'a [Option<Receiver>],
+    width: u32,
+}
+
+impl CoverageSource<'_> {
+    /// The signed per-channel coverage of edge `w` at `p` (module doc).
+    fn coverage(&self, w: &EdgeWedge, p: DVec3) -> [f32; 3] {
+        match (self.mode, &self.texture) {
+            (CoverageMode::Texture { filter, .. }, Some(t)) => {
+                let Some([a, b]) = projected_edge_in_light(&self.light, p, w.e0, w.e1) else {
+                    return [0.0; 3];
+                };
+                let s = quad_side(&self.light, p, w.e0, w.e1);
+                t.lookup(a, b, filter).map(|v| (s * v) as f32)
+            }
+            _ => [edge_coverage_exact(&self.light, p, w.e0, w.e1) as f32; 3],
+        }
+    }
+}
+
+/// The result of the two passes.
+pub struct SsvRender {
+    /// Visibility per pixel, row-major, clamped to [0, 1]; background 1.
+    pub visibility: Visibility,
+    /// Pass 1 counters.
+    pub pass1: Counters,
+    /// Pass 2 counters.
+    pub pass2: Counters,
+    /// Number of wedges, and how many of them were drawn full-screen.
+    pub wedges: (usize, usize),
+    /// Wall time of pass 1 and of pass 2 (with the resolve), informational.
+    pub seconds: [f64; 2],
+}
+
+/// Render `ssv` with `settings` on `frame` (the light must be a rectangle).
+pub fn render(frame: &Frame, settings: &SsvSettings) -> SsvRender {
+    match settings.vbuffer {
+        VBufferFormat::F32 => render_with::<VBufferF32Tile>(frame, settings),
+        VBufferFormat::F16 => render_with::<VBufferF16Tile>(frame, settings),
+        VBufferFormat::RgbF32 => render_with::<VBufferRgbTile>(frame, settings),
+        VBufferFormat::Split8 => render_with::<VBuffer8Tile>(frame, settings),
+    }
+}
+
+fn render_with<V: VBufferTile>(frame: &Frame, settings: &SsvSettings) -> SsvRender {
+    let scene = frame.scene;
+    let tiling = &frame.tiling;
+    let light = RectLight::from_light(&scene.light).expect("ssv supports rectangular lights");
+    let center = scene.light.center;
+    let mut vbuf: Vec<V> = (0..tiling.tile_count())
+        .map(|_| V::cleared(tiling.tile_len()))
+        .collect();
+
+    // Pass 1: hard shadow quads, ±1 (float V-buffers) or the stencil (8-bit version).
+    let t1 = Instant::now();
+    let mut stencil = None;
+    let pass1 = if V::FORMAT == VBufferFormat::Split8 {
+        let s = StencilShadowSettings {
+            test: settings.test,
+            overflow: StencilOverflow::Wrap,
+            submission: Submission::TwoSided,
+        };
+        let (tiles, c) = stencil_shadow(frame, center, &s);
+        stencil = Some(stencil_row_major(frame, &tiles));
+        c
+    } else {
+        hard_quads_pass(frame, settings.test, &mut vbuf)
+    };
+
+    // Pass 2: wedges.
+    let t2 = Instant::now();
+    let pass1_seconds = t2.duration_since(t1).as_secs_f64();
+    let edges = edge_wedges(frame, &light);
+    let eye_radius = near_radius(frame);
+    let eye = scene.camera.eye;
+    let mut prims: Vec<[ClipVertex; 3]> = Vec::new();
+    let mut owner: Vec<u32> = Vec::new();
+    let mut full_screen = 0;
+    let mut tris: Vec<RasterTriangle> = Vec::new();
+    let mut pass2 = Counters::default();
+    for (k, ew) in edges.iter().enumerate() {
+        let (faces, cull): (Vec<[ClipVertex; 3]>, CullMode) = match &ew.wedge {
+            Some(w) if !w.contains_within(eye, eye_radius) => (
+                w.triangles
+                    .iter()
+                    .map(|t| t.map(|v| v.clip(&frame.proj)))
+                    .collect(),
+                CullMode::Back,
+            ),
+            _ => {
+                full_screen += 1;
+                (FULL_SCREEN.to_vec(), CullMode::None)
+            }
+        };
+        for f in faces {
+            setup_triangle(
+                &f,
+                prims.len() as u32,
+                cull,
+                tiling.width,
+                tiling.height,
+                &mut tris,
+                &mut pass2,
+            );
+            prims.push(f);
+            owner.push(k as u32);
+        }
+    }
+    let receivers = frame.receivers(false);
+    let texture = match settings.coverage {
+        CoverageMode::Exact => None,
+        CoverageMode::Texture { n, .. } => Some(coverage_texture(&match &scene.light.shape {
+            LightShape::TexturedRect { texture, .. } => CoverageTextureKey::textured(n, texture),
+            _ => CoverageTextureKey::uniform(n),
+        })),
+    };
+    let source = CoverageSource {
+        light,
+        mode: settings.coverage,
+        texture,
+        receivers: &receivers,
+        width: scene.width,
+    };
+    let bins = bin(tiling, &tris);
+    pass2 += draw(
+        tiling,
+        &mut vbuf,
+        &tris,
+        &bins,
+        no_tile_culling,
+        |t, vb, tri, f, c| {
+            frame.tiles[t].depth.read(f.local, c);
+            let Some(rcv) = source.receivers[(f.y * source.width + f.x) as usize] else {
+                return;
+            };
+            let p = rcv.point.as_dvec3();
+            let ew = &edges[owner[tri.prim as usize] as usize];
+            if ew.wedge.as_ref().is_some_and(|w| !w.contains(p)) {
+                return;
+            }
+            c.fragments_shaded += 1;
+            vb.add(f.local, source.coverage(ew, p), c);
+        },
+    );
+
+    // Resolve.
+    let flat: Vec<[f32; 3]> = vbuf
+        .iter()
+        .flat_map(|t| (0..tiling.tile_len()).map(move |i| t.resolve(i)))
+        .collect();
+    let values = tiling.to_row_major(&flat);
+    let rgb: Vec<[f32; 3]> = values
+        .iter()
+        .enumerate()
+        .map(|(i, v)| {
+            if receivers[i].is_none() {
+                return [1.0; 3];
+            }
+            let umbra = stencil.as_ref().map_or(0.0, |s| 1.0 - s[i] as f32);
+            v.map(|x| (x + umbra).clamp(0.0, 1.0))
+        })
+        .collect();
+    let visibility = if V::FORMAT == VBufferFormat::RgbF32 {
+        Visibility::Rgb(rgb)
+    } else {
+        Visibility::Gray(rgb.iter().map(|v| v[0]).collect())
+    };
+    SsvRender {
+        visibility,
+        pass1,
+        pass2,
+        wedges: (edges.len(), full_screen),
+        seconds: [pass1_seconds, t2.elapsed().as_secs_f64()],
+    }
+}
+
+/// Two triangles covering the viewport (front-facing), for wedges drawn full-screen.
+const FULL_SCREEN: [[ClipVertex; 3]; 2] = [
+    [
+        ClipVertex([-1.0, -1.0, 0.0, 1.0]),
+        ClipVertex([1.0, -1.0, 0.0, 1.0]),
+        ClipVertex([1.0, 1.0, 0.0, 1.0]),
+    ],
+    [
+        ClipVertex([-1.0, -1.0, 0.0, 1.0]),
+        ClipVertex([1.0, 1.0, 0.0, 1.0]),
+        ClipVertex([-1.0, 1.0, 0.0, 1.0]),
+    ],
+];
+
+/// The distance from the eye to the corners of the near-plane rectangle.
+fn near_radius(frame: &Frame) -> f64 {
+    let cam = &frame.scene.camera;
+    let near = frame.proj.near;
+    let half_h = near * (cam.vfov_deg.to_radians() * 0.5).tan();
+    let half_w = half_h * frame.scene.width as f64 / frame.scene.height as f64;
+    (near * near + half_h * half_h + half_w * half_w).sqrt()
+}
+
+/// The possible silhouette edges of every mesh from the light center, in the submission order
+/// of [`shadow_volume_triangles`], with their wedges. A silhouette edge `a → b` (oriented along
+/// its light-facing triangle) has the shadow quad `b, a, a∞` whose normal points out of the
+/// volume, so `e0 = b`, `e1 = a` puts the umbra on the positive side of
+/// [`crate::light::coverage`]'s sign.
+fn edge_wedges(frame: &Frame, light: &RectLight) -> Vec<EdgeWedge> {
+    let center = frame.scene.light.center;
+    let mut out = Vec::new();
+    for (mesh, adj) in frame.scene.meshes.iter().zip(&frame.adjacency) {
+        let facing = light_facing(mesh, center);
+        for e in possible_silhouettes(mesh, adj, &facing) {
+            let (e0, e1) = (e.b.as_dvec3(), e.a.as_dvec3());
+            out.push(EdgeWedge {
+                e0,
+                e1,
+                wedge: SsvWedge::new(light, e0, e1),
+            });
+        }
+    }
+    out
+}
+
+/// Pass 1 into a float V-buffer: hard shadow quads from the light center, −1 entering, +1
+/// leaving (§3.2.1), z-pass or z-fail with caps, one pass with both facings in the order of
+/// [`shadow_volume_triangles`].
+fn hard_quads_pass<V: VBufferTile>(frame: &Frame, test: ShadowTest, vbuf: &mut [V]) -> Counters {
+    let capping = match test {
+        ShadowTest::ZPass => Capping::Open,
+        ShadowTest::ZFail => Capping::Capped,
+    };
+    let meshes: Vec<_> = frame.scene.meshes.iter().zip(&frame.adjacency).collect();
+    let prims = shadow_volume_triangles(&meshes, frame.scene.light.center, &frame.proj, capping);
+    let (tris, mut counters) = setup_all(&prims, CullMode::None, &frame.tiling);
+    let bins = bin(&frame.tiling, &tris);
+    let depth = DepthState {
+        func: DepthFunc::Less,
+        write: false,
+    };
+    counters += draw(
+        &frame.tiling,
+        vbuf,
+        &tris,
+        &bins,
+        no_tile_culling,
+        |t, vb, tri, f, c| {
+            let (pass, _) = frame.tiles[t].depth.test(&depth, &f, c);
+            c.depth_passed += pass as u64;
+            let delta = match (test, pass, tri.front_facing) {
+                (ShadowTest::ZPass, true, true) | (ShadowTest::ZFail, false, false) => -1.0,
+                (ShadowTest::ZPass, true, false) | (ShadowTest::ZFail, false, true) => 1.0,
+                _ => return,
+            };
+            vb.add(f.local, [delta; 3], c);
+        },
+    );
+    counters
+}
+
+/// Run `ssv` on a rendered frame.
+pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
+    let start = Instant::now();
+    let (settings, mode) = read_settings(frame)?;
+    let r = render(frame, &settings);
+    let passes = vec![
+        frame.pass.clone(),
+        PassStats {
+            name: "ssv-hard-quads".into(),
+            wall_seconds: r.seconds[0],
+            runs: 1,
+            counters: r.pass1,
+        },
+        PassStats {
+            name: "ssv-wedges".into(),
+            wall_seconds: r.seconds[1],
+            runs: 1,
+            counters: r.pass2,
+        },
+    ];
+    let mut buffers = vec![BufferPlan {
+        name: "depth".into(),
+        format: format!("{:?}", frame.gpu.depth),
+        bytes_per_sample: frame.gpu.depth.bytes() as u32,
+    }];
+    if settings.vbuffer == VBufferFormat::Split8 {
+        buffers.push(BufferPlan {
+            name: "stencil".into(),
+            format: "S8".into(),
+            bytes_per_sample: 1,
+        });
+    }
+    buffers.push(BufferPlan {
+        name: "vbuffer".into(),
+        format: format!("{:?}", settings.vbuffer),
+        bytes_per_sample: settings.vbuffer.bytes(),
+    });
+    let plan = MethodPlan {
+        method: "ssv".into(),
+        passes: passes.iter().map(|p| p.name.clone()).collect(),
+        buffers,
+        settings: serde_json::json!({
+            "mode": mode,
+            "resolved": settings,
+            "wedges": r.wedges.0,
+            "wedges_full_screen": r.wedges.1,
+            "gpu": frame.gpu,
+        }),
+    };
+    Ok(MethodOutput {
+        visibility: r.visibility,
+        raw_images: vec![],
+        stats: super::method_stats("ssv", frame, start, &plan, passes),
+    })
+}
