@@ -211,6 +211,10 @@ impl Atan2CubeMap {
         } else {
             cube_face([x, y, 0.0])
         };
+        // Cube-map faces are addressed CLAMP_TO_EDGE: s or t = 1.0 (|x| = |y|) is the last
+        // texel, not the first.
+        let edge = (ATAN2_FACE_SIZE as f64 - 0.5) / ATAN2_FACE_SIZE as f64;
+        let (s, t) = (s.clamp(0.0, edge), t.clamp(0.0, edge));
         angle_of(self.faces[face].sample(s, t, TableFilter::Nearest))
     }
 }
@@ -385,6 +389,15 @@ mod tests {
         // One texel spans at most (π/2)/128·... of angle: atan's slope ≤ 1 on [−1,1] and a texel
         // is 2/128 wide, so half a texel is ≤ 1/128 rad.
         assert!(worst <= 1.0 / 128.0 + 1e-4, "{worst}");
+    }
+
+    #[test]
+    fn atan2_map_on_the_face_diagonals() {
+        let map = Atan2CubeMap::get();
+        for (y, x) in [(-0.2, 0.2), (0.2, 0.2), (0.2, -0.2), (-0.2, -0.2)] {
+            let e = (map.atan2(y, x) - f64::atan2(y, x)).abs();
+            assert!(e <= 1.0 / 128.0, "({y}, {x}): {e}");
+        }
     }
 
     #[test]

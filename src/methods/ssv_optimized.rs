@@ -1,0 +1,783 @@
+//! `ssv-optimized`: the optimized soft shadow volume algorithm of Paper IV (Assarsson,
+//! Dougherty, Mounier, Akenine-Möller, Graphics Hardware 2003).
+//!
+//! Per light (or per piece of a split light, §5.2):
+//! 1. **Pass 1** (Paper III §3.2.1, Paper IV §4.2): the hard shadow quads from the light center
+//!    ([`crate::geometry::shadow_volume`]) blend a full value into the split V-buffer
+//!    ([`crate::gpu::split_blend`], §4.3): the additive buffer where the V-buffer would be
+//!    incremented, the subtractive one where it would be decremented. The V-buffer starts at 1.0
+//!    (the additive buffer is cleared to the split of the full value). z-fail (with caps) is
+//!    chosen like `hard-sv` does when the eye is in shadow.
+//! 2. **Pass 2** (§4.2, §4.4): every silhouette edge's wedge ([`crate::geometry::tight_wedge`],
+//!    §4.1) is cut by the hard-quad plane into an inner and an outer half, and **each half is
+//!    rendered separately with stencil and depth tests** (§4.4): its front faces set the stencil
+//!    to the half's reference where the receiver lies behind them (depth LESS), then its back
+//!    faces run the shader where the stencil equals the reference and the receiver lies in front
+//!    of them (depth GEQUAL). The shader computes the coverage of the light by the projected
+//!    hard shadow quad and blends it through the split table into the additive buffer (inner half)
+//!    or the subtractive one (outer half). `split = "plane"` instead renders the whole wedge and
+//!    classifies the receiver by the hard-quad plane equation in f32 in the shader — the
+//!    approach §4.4 abandoned for its precision errors near the plane.
+//! 3. **Resolve**: `V = (add − sub) / full`, clamped to [0, 1].
+//!
+//! Coverage (the shaders of §4.2): **rectangular lights** (§4.2.2) — the edge is clipped to the
+//! light in homogeneous coordinates and projected ([`coverage::projected_edge_in_light`]); the
+//! coverage is the light's area between the rays from the light center through the clipped
+//! endpoints (area table at the two atan2 angles) minus the triangle (center, p0, p1).
+//! **Spherical lights** (§4.2.1) — light space with the receiver at the origin, the light center
+//! at z = 1 and radius 1; the edge is clipped to the cone x² + y² = z² (z ≥ 0), projected to
+//! z = 1, and the same sector-minus-triangle on the unit disk. `coverage = "tables"` uses the
+//! paper's tables ([`crate::light::lookup_tables`]); `"exact"` uses f64 `atan2` and the exact
+//! sector area for the sphere, and exact clipping ([`coverage::edge_coverage_exact`]) for the
+//! rectangle.
+//!
+//! Improvements (§5): `overlap = "loops"` renders every silhouette loop
+//! ([`crate::geometry::loops::silhouette_loops`]) into its own V-buffer and combines the loops'
+//! coverages `c = max(c_A, c_B) + ½·min(c_A, c_B)` (eq. 1), folded over the loops in order;
+//! `light_split = k` splits a rectangular light into k×k equal pieces, each with its own
+//! silhouettes, and averages their visibilities (§5.2).
+//!
+//! Choices where the paper is silent or ambiguous:
+//! - §4.4 names `GL_GREATER` for the front faces and `GL_LESS` for the back faces but describes
+//!   the opposite comparisons ("only passing for fragments with points farther away than the
+//!   front-facing triangles"); with our LESS-is-closer depth we implement the description:
+//!   front faces LESS, back faces GEQUAL (so a receiver exactly on the shared cut polygon belongs
+//!   to exactly one half).
+//! - The stencil is not reset per half: each half uses its own reference 1…255 and the stencil
+//!   is cleared (counted) every 255 halves.
+//! - A half that reaches in front of the near plane (or contains the eye) cannot use the
+//!   front-face stencil test; its back faces are drawn without it and the shader tests the
+//!   receiver against the half's face planes.
+//! - Which half goes to which buffer: §4.3 says "back half → additive, front half →
+//!   subtractive"; §3 says the inner half (toward the umbra) adds. We use inner → additive.
+//! - Receiver points are the depth-buffer points in f64 (like every method here), not the
+//!   paper's 16-bit float position texture.
+//! - The overlap approximation renders each loop's quads z-pass (per-loop caps do not exist);
+//!   it is refused when the eye is in shadow. Light splitting is for rectangular lights only.
+
+use super::options::OptionReader;
+use super::output::{MethodOutput, PassStats, Visibility};
+use crate::error::InputError;
+use crate::frame::{setup_all, Frame, BACKGROUND};
+use crate::geometry::loops::silhouette_loops;
+use crate::geometry::shadow_volume::{shadow_volume_triangles, Capping};
+use crate::geometry::silhouette::{away_from_light, light_facing, possible_silhouettes};
+use crate::geometry::tight_wedge::{wedge_halves, whole_wedge, ConvexPolyhedron};
+use crate::gpu::buffers::{alloc_tiles, StencilTile};
+use crate::gpu::counters::Counters;
+use crate::gpu::depth::{DepthFunc, DepthState};
+use crate::gpu::raster::{bin, draw, no_tile_culling};
+use crate::gpu::setup::CullMode;
+use crate::gpu::split_blend::{SplitFormat, SplitTarget, SplitVTile};
+use crate::gpu::stencil::{StencilFace, StencilFunc, StencilOp, StencilState};
+use crate::gpu::transform::ClipVertex;
+use crate::light::coverage::{self, RectLight};
+use crate::light::lookup_tables::{AreaShape, AreaTable, Atan2CubeMap, SplitTable, TableFilter};
+use crate::plan::{eye_in_shadow, BufferPlan, MethodPlan};
+use crate::scene::LightShape;
+use glam::{DVec2, DVec3, Vec3};
+use std::f64::consts::PI;
+use std::time::Instant;
+
+/// How the shaders compute coverage.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum CoverageMode {
+    /// The paper's lookup tables (atan2 cube map, area table) with the given area filter.
+    Tables(TableFilter),
+    /// Exact arithmetic.
+    Exact,
+}
+
+/// How a receiver is assigned to the inner or outer wedge half.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum HalfSplit {
+    /// Each half rendered separately with stencil and depth tests (§4.4).
+    Stencil,
+    /// The whole wedge rendered; the hard-quad plane equation in f32 in the shader.
+    Plane,
+}
+
+/// All settings of one `ssv-optimized` run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct Settings {
+    /// Coverage computation.
+    pub coverage: CoverageMode,
+    /// Inner/outer split.
+    pub split: HalfSplit,
+    /// Overlap approximation per silhouette loop (§5.1).
+    pub overlap: bool,
+    /// The light is split into k×k pieces (§5.2).
+    pub light_split: u32,
+    /// The split V-buffer layout (§4.3).
+    pub format: SplitFormat,
+    /// Use z-fail (with caps) for pass 1.
+    pub zfail: bool,
+}
+
+/// A light (or a piece of one) as the shaders see it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LightModel {
+    /// A rectangle.
+    Rect(RectLight),
+    /// A sphere.
+    Sphere {
+        /// Center.
+        center: DVec3,
+        /// Radius.
+        radius: f64,
+    },
+}
+
+impl LightModel {
+    /// The model of a scene light; `None` for shapes `ssv-optimized` does not support.
+    pub fn from_shape(center: Vec3, shape: &LightShape) -> Option<Self> {
+        match shape {
+            LightShape::Rect { u, v } => Some(LightModel::Rect(RectLight::new(
+                center.as_dvec3(),
+                u.as_dvec3(),
+                v.as_dvec3(),
+            ))),
+            LightShape::Sphere { radius } => Some(LightModel::Sphere {
+                center: center.as_dvec3(),
+                radius: *radius as f64,
+            }),
+            _ => None,
+        }
+    }
+
+    /// The light center (the point silhouettes and hard quads are built from).
+    pub fn center(&self) -> DVec3 {
+        match self {
+            LightModel::Rect(r) => r.center,
+            LightModel::Sphere { center, .. } => *center,
+        }
+    }
+
+    /// The corners the wedge encloses (tight_wedge: the rectangle's four corners, the sphere's
+    /// bounding cube).
+    pub fn corners(&self) -> Vec<DVec3> {
+        match self {
+            LightModel::Rect(r) => [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                .iter()
+                .map(|(s, t)| r.center + r.u * *s + r.v * *t)
+                .collect(),
+            LightModel::Sphere { center, radius } => (0..8)
+                .map(|i| {
+                    let s = |b: usize| if i & b == 0 { -1.0 } else { 1.0 };
+                    *center + DVec3::new(s(1), s(2), s(4)) * *radius
+                })
+                .collect(),
+        }
+    }
+
+    /// The k×k pieces of a rectangle (§5.2), row by row; a sphere only for k = 1.
+    pub fn pieces(&self, k: u32) -> Option<Vec<LightModel>> {
+        match self {
+            _ if k == 1 => Some(vec![*self]),
+            LightModel::Rect(r) => {
+                let kf = k as f64;
+                let mut out = Vec::new();
+                for j in 0..k {
+                    for i in 0..k {
+                        let s = (2 * i + 1) as f64 / kf - 1.0;
+                        let t = (2 * j + 1) as f64 / kf - 1.0;
+                        out.push(LightModel::Rect(RectLight::new(
+                            r.center + r.u * s + r.v * t,
+                            r.u / kf,
+                            r.v / kf,
+                        )));
+                    }
+                }
+                Some(out)
+            }
+            LightModel::Sphere { .. } => None,
+        }
+    }
+
+    /// Unsigned coverage of the light by the projected hard shadow quad of edge `e0 e1` seen
+    /// from `p` (Paper IV §4.2.1, §4.2.2), in [0, 1].
+    pub fn coverage(&self, p: DVec3, e0: DVec3, e1: DVec3, mode: CoverageMode) -> f64 {
+        match (self, mode) {
+            (LightModel::Rect(r), CoverageMode::Exact) => {
+                coverage::edge_coverage_exact(r, p, e0, e1).abs().min(1.0)
+            }
+            (LightModel::Rect(r), CoverageMode::Tables(_)) => {
+                match coverage::projected_edge_in_light(r, p, e0, e1) {
+                    Some([a, b]) => sector_minus_triangle(a, b, AreaShape::Square, mode),
+                    None => 0.0,
+                }
+            }
+            (LightModel::Sphere { center, radius }, _) => {
+                match clip_to_light_cone(*center, *radius, p, e0, e1) {
+                    Some([a, b]) => sector_minus_triangle(a, b, AreaShape::Disk, mode),
+                    None => 0.0,
+                }
+            }
+        }
+    }
+}
+
+/// The analytic coverage of §4.2.2 Fig. 6a (and §4.2.1 Fig. 5a): the area of the light
+/// (`shape`, centered at the origin) between the rays through `a` and `b` minus the triangle
+/// (origin, a, b), as a fraction of the light's area, clamped to [0, 1].
+pub fn sector_minus_triangle(a: DVec2, b: DVec2, shape: AreaShape, mode: CoverageMode) -> f64 {
+    let sector = match mode {
+        CoverageMode::Exact => shape.sector_fraction(a.y.atan2(a.x), b.y.atan2(b.x)),
+        CoverageMode::Tables(filter) => {
+            let map = Atan2CubeMap::get();
+            AreaTable::get(shape).sector_fraction(map.atan2(a.y, a.x), map.atan2(b.y, b.x), filter)
+        }
+    };
+    let total = match shape {
+        AreaShape::Square => 4.0,
+        AreaShape::Disk => PI,
+    };
+    let triangle = 0.5 * a.perp_dot(b).abs() / total;
+    (sector - triangle).clamp(0.0, 1.0)
+}
+
+/// §4.2.1: the edge `e0 e1` in the light space of receiver `p` (p at the origin, the light
+/// center at z = 1, radius 1), clipped to the cone x² + y² ≤ z², z ≥ 0, and projected to z = 1.
+/// `None` when nothing of the edge is inside the cone (or `p` is inside the light).
+pub fn clip_to_light_cone(
+    center: DVec3,
+    radius: f64,
+    p: DVec3,
+    e0: DVec3,
+    e1: DVec3,
+) -> Option<[DVec2; 2]> {
+    let w = center - p;
+    let dist = w.length();
+    if dist <= radius || !dist.is_finite() {
+        return None;
+    }
+    let z = w / dist;
+    let x = z.any_orthonormal_vector();
+    let y = z.cross(x);
+    let to_light = |e: DVec3| {
+        let d = e - p;
+        DVec3::new(d.dot(x) / radius, d.dot(y) / radius, d.dot(z) / dist)
+    };
+    let (q0, q1) = (to_light(e0), to_light(e1));
+    let d = q1 - q0;
+    let g = |t: f64| {
+        let q = q0 + d * t;
+        q.x * q.x + q.y * q.y - q.z * q.z
+    };
+    // Breakpoints: roots of g (the cone) and of z in (0, 1).
+    let qa = d.x * d.x + d.y * d.y - d.z * d.z;
+    let qb = q0.x * d.x + q0.y * d.y - q0.z * d.z;
+    let qc = q0.x * q0.x + q0.y * q0.y - q0.z * q0.z;
+    let mut ts = vec![0.0, 1.0];
+    if qa.abs() > 1e-300 {
+        let disc = qb * qb - qa * qc;
+        if disc >= 0.0 {
+            let s = disc.sqrt();
+            let r = -(qb + qb.signum() * s);
+            if r != 0.0 {
+                ts.push(r / qa);
+                ts.push(qc / r);
+            }
+        }
+    } else if qb != 0.0 {
+        ts.push(-qc / (2.0 * qb));
+    }
+    if d.z != 0.0 {
+        ts.push(-q0.z / d.z);
+    }
+    ts.retain(|t| (0.0..=1.0).contains(t));
+    ts.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    let mut span: Option<(f64, f64)> = None;
+    for k in 0..ts.len() - 1 {
+        let (t0, t1) = (ts[k], ts[k + 1]);
+        let m = 0.5 * (t0 + t1);
+        if t1 > t0 && g(m) <= 0.0 && (q0 + d * m).z > 0.0 {
+            span = Some(match span {
+                None => (t0, t1),
+                Some((s0, _)) => (s0, t1),
+            });
+        }
+    }
+    let (t0, t1) = span?;
+    let project = |t: f64| {
+        let q = q0 + d * t;
+        DVec2::new(q.x / q.z, q.y / q.z)
+    };
+    let (a, b) = (project(t0), project(t1));
+    (a.is_finite() && b.is_finite()).then_some([a, b])
+}
+
+/// Read the `ssv-optimized` options (module doc).
+pub fn read_settings(r: &mut OptionReader, frame: &Frame) -> Result<Settings, InputError> {
+    let coverage = r.choice("coverage", &["tables", "exact"], "tables")?;
+    let filter = match r.choice("filter", &["bilinear", "nearest"], "bilinear")? {
+        "nearest" => TableFilter::Nearest,
+        _ => TableFilter::Bilinear,
+    };
+    let coverage = match coverage {
+        "exact" => CoverageMode::Exact,
+        _ => CoverageMode::Tables(filter),
+    };
+    let split = match r.choice("split", &["stencil", "plane"], "stencil")? {
+        "plane" => HalfSplit::Plane,
+        _ => HalfSplit::Stencil,
+    };
+    let overlap = r.choice("overlap", &["off", "loops"], "off")? == "loops";
+    let light_split = r.uint("light_split", 1, 1..=4)? as u32;
+    let reserved = r.uint("reserved_bits", 5, 1..=7)? as u32;
+    let format = SplitFormat::new(reserved).map_err(|e| {
+        InputError::at(
+            &frame.scene.source,
+            "options.ssv-optimized.reserved_bits",
+            e,
+        )
+    })?;
+    let mode = r.choice("mode", &["auto", "zpass", "zfail"], "auto")?;
+    let model = LightModel::from_shape(frame.scene.light.center, &frame.scene.light.shape)
+        .ok_or_else(|| {
+            InputError::at(
+                &frame.scene.source,
+                "light",
+                "ssv-optimized supports rect and sphere lights",
+            )
+        })?;
+    let pieces = model.pieces(light_split).ok_or_else(|| {
+        InputError::at(
+            &frame.scene.source,
+            "options.ssv-optimized.light_split",
+            "light splitting (Paper IV §5.2) is for rectangular lights",
+        )
+    })?;
+    let centers: Vec<Vec3> = pieces.iter().map(|p| p.center().as_vec3()).collect();
+    let zfail = match mode {
+        "zpass" => false,
+        "zfail" => true,
+        _ => eye_in_shadow(frame.scene, frame.proj.near, &centers),
+    };
+    if overlap && zfail {
+        return Err(InputError::at(
+            &frame.scene.source,
+            "options.ssv-optimized.overlap",
+            "the overlap approximation renders each silhouette loop z-pass; the eye is in shadow \
+             (or mode = zfail)",
+        ));
+    }
+    Ok(Settings {
+        coverage,
+        split,
+        overlap,
+        light_split,
+        format,
+        zfail,
+    })
+}
+
+/// What a submitted triangle does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Role {
+    /// A pass-1 hard shadow volume triangle.
+    Quad,
+    /// A face of wedge half `h`: front faces mark the stencil.
+    Mark(u32),
+    /// A face of wedge half `h`: back faces shade where the stencil is marked.
+    Shade(u32),
+    /// A face of wedge half `h`: back faces shade, inside test in the shader (near plane).
+    ShadeTested(u32),
+}
+
+/// One wedge (half) to shade.
+struct HalfJob {
+    /// Silhouette edge, oriented as in its light-facing triangle.
+    edge: [DVec3; 2],
+    /// Target buffer, or `None` to classify by the plane equation in the shader.
+    target: Option<SplitTarget>,
+    /// Stencil reference.
+    reference: u8,
+    /// The polyhedron (for the shader's inside test when the stencil cannot be used).
+    shape: ConvexPolyhedron,
+}
+
+/// Per-tile storage of the method.
+struct OptTile {
+    v: SplitVTile,
+    stencil: StencilTile,
+}
+
+/// Halves per stencil clear (references 1…255).
+const HALVES_PER_CLEAR: usize = 255;
+
+/// The silhouette edges (a, b) of every mesh from light point `c`, and their loops.
+fn silhouettes(frame: &Frame, c: Vec3) -> Result<Vec<Vec<[DVec3; 2]>>, InputError> {
+    let mut loops = Vec::new();
+    for (mi, (mesh, adj)) in frame.scene.meshes.iter().zip(&frame.adjacency).enumerate() {
+        let facing = light_facing(mesh, c);
+        let edges = possible_silhouettes(mesh, adj, &facing);
+        let mesh_loops = silhouette_loops(&edges)
+            .map_err(|e| InputError::at(&frame.scene.source, format!("meshes[{mi}]"), e))?;
+        for l in mesh_loops {
+            loops.push(
+                l.iter()
+                    .map(|&k| [edges[k].a.as_dvec3(), edges[k].b.as_dvec3()])
+                    .collect(),
+            );
+        }
+    }
+    Ok(loops)
+}
+
+/// The hard shadow quad of one silhouette edge a → b from light point `c`, exactly as
+/// [`shadow_volume_triangles`] builds it: `(b, a, a∞)`, `(b, a∞, b∞)`.
+fn edge_quad(frame: &Frame, c: Vec3, e: &[DVec3; 2]) -> [[ClipVertex; 3]; 2] {
+    let (a, b) = (e[0].as_vec3(), e[1].as_vec3());
+    let near = |x: Vec3| frame.proj.clip_point(x);
+    let far = |x: Vec3| frame.proj.clip_direction(away_from_light(x, c));
+    [[near(b), near(a), far(a)], [near(b), far(a), far(b)]]
+}
+
+/// Render one group (pass 1 quads + the wedges of `edges`) for light piece `light` into a
+/// fresh split V-buffer; returns the resolved, clamped visibility per pixel (row-major) and the
+/// counters.
+fn render_group(
+    frame: &Frame,
+    light: &LightModel,
+    quads: Vec<[ClipVertex; 3]>,
+    edges: &[[DVec3; 2]],
+    s: &Settings,
+    receivers: &[Vec<Option<DVec3>>],
+) -> (Vec<f32>, Counters) {
+    let tiling = &frame.tiling;
+    let format = s.format;
+    let table = SplitTable::get(format);
+    let full = format.split(format.full());
+    let mut tiles = alloc_tiles(tiling, |_, len| OptTile {
+        v: SplitVTile::cleared(full, len),
+        stencil: StencilTile::cleared(0, len),
+    });
+    let (lo, hi) = frame.scene.bounds();
+    let margin = (hi - lo).length() as f64 * 0.01 + 1e-3;
+    let (lo, hi) = (lo.as_dvec3() - margin, hi.as_dvec3() + margin);
+    let corners = light.corners();
+    let c = light.center();
+
+    // Wedge halves in edge order (inner, then outer).
+    let mut jobs: Vec<HalfJob> = Vec::new();
+    for e in edges {
+        match s.split {
+            HalfSplit::Stencil => {
+                let [inner, outer] = wedge_halves(c, &corners, e[0], e[1], lo, hi);
+                for (shape, target) in [(inner, SplitTarget::Add), (outer, SplitTarget::Sub)] {
+                    if !shape.is_empty() {
+                        jobs.push(HalfJob {
+                            edge: *e,
+                            target: Some(target),
+                            reference: 0,
+                            shape,
+                        });
+                    }
+                }
+            }
+            HalfSplit::Plane => {
+                let shape = whole_wedge(c, &corners, e[0], e[1], lo, hi);
+                if !shape.is_empty() {
+                    jobs.push(HalfJob {
+                        edge: *e,
+                        target: None,
+                        reference: 0,
+                        shape,
+                    });
+                }
+            }
+        }
+    }
+    for (k, j) in jobs.iter_mut().enumerate() {
+        j.reference = (k % HALVES_PER_CLEAR) as u8 + 1;
+    }
+
+    let mut counters = Counters::default();
+    let chunks: Vec<&[HalfJob]> = if jobs.is_empty() {
+        vec![&[]]
+    } else {
+        jobs.chunks(HALVES_PER_CLEAR).collect()
+    };
+    for (ci, chunk) in chunks.iter().enumerate() {
+        let base = ci * HALVES_PER_CLEAR;
+        let mut prims: Vec<[ClipVertex; 3]> = Vec::new();
+        let mut roles: Vec<Role> = Vec::new();
+        if ci == 0 {
+            roles.extend(std::iter::repeat_n(Role::Quad, quads.len()));
+            prims.extend(quads.iter().copied());
+        } else {
+            // Clear the stencil for the next 255 references (counted as written bytes).
+            for t in tiles.iter_mut() {
+                t.stencil.values.fill(0);
+            }
+            counters.stencil_write_bytes += frame.pixel_count() as u64;
+        }
+        for (k, j) in chunk.iter().enumerate() {
+            let h = (base + k) as u32;
+            let tris: Vec<[ClipVertex; 3]> = j
+                .shape
+                .faces
+                .iter()
+                .flat_map(|f| {
+                    (1..f.len() - 1).map(move |i| {
+                        [f[0], f[i], f[i + 1]].map(|x| frame.proj.clip_point(x.as_vec3()))
+                    })
+                })
+                .collect();
+            let near_crossing = tris
+                .iter()
+                .flatten()
+                .any(|v| v.0[3] <= 0.0 || v.0[2] < -v.0[3]);
+            if near_crossing {
+                roles.extend(std::iter::repeat_n(Role::ShadeTested(h), tris.len()));
+                prims.extend(tris);
+            } else {
+                roles.extend(std::iter::repeat_n(Role::Mark(h), tris.len()));
+                prims.extend(tris.iter().copied());
+                roles.extend(std::iter::repeat_n(Role::Shade(h), tris.len()));
+                prims.extend(tris);
+            }
+        }
+        let (tris, c_setup) = setup_all(&prims, CullMode::None, tiling);
+        counters += c_setup;
+        let bins = bin(tiling, &tris);
+        let less = DepthState {
+            func: DepthFunc::Less,
+            write: false,
+        };
+        let gequal = DepthState {
+            func: DepthFunc::GEqual,
+            write: false,
+        };
+        let zfail = s.zfail;
+        counters += draw(
+            tiling,
+            &mut tiles,
+            &tris,
+            &bins,
+            no_tile_culling,
+            |t, st, tri, f, cnt| match roles[tri.prim as usize] {
+                Role::Quad => {
+                    let (pass, _) = frame.tiles[t].depth.test(&less, &f, cnt);
+                    cnt.depth_passed += pass as u64;
+                    // z-pass: front faces passing decrement, back faces increment.
+                    // z-fail: back faces failing decrement, front faces failing increment.
+                    let target = match (zfail, pass, tri.front_facing) {
+                        (false, true, true) | (true, false, false) => Some(SplitTarget::Sub),
+                        (false, true, false) | (true, false, true) => Some(SplitTarget::Add),
+                        _ => None,
+                    };
+                    if let Some(target) = target {
+                        st.v.blend(target, f.local, full, cnt);
+                    }
+                }
+                Role::Mark(h) => {
+                    if !tri.front_facing {
+                        return;
+                    }
+                    let job = &jobs[h as usize];
+                    let (pass, _) = frame.tiles[t].depth.test(&less, &f, cnt);
+                    let face = StencilFace {
+                        func: StencilFunc::Always,
+                        reference: job.reference,
+                        read_mask: 0xFF,
+                        write_mask: 0xFF,
+                        stencil_fail: StencilOp::Keep,
+                        depth_fail: StencilOp::Keep,
+                        depth_pass: StencilOp::Replace,
+                    };
+                    let state = StencilState {
+                        front: face,
+                        back: face,
+                    };
+                    st.stencil.apply(&state, true, &f, pass, cnt);
+                }
+                Role::Shade(h) | Role::ShadeTested(h) => {
+                    if tri.front_facing {
+                        return;
+                    }
+                    let job = &jobs[h as usize];
+                    let tested = matches!(roles[tri.prim as usize], Role::ShadeTested(_));
+                    if !tested {
+                        cnt.stencil_read_bytes += 1;
+                        if st.stencil.values[f.local] != job.reference {
+                            return;
+                        }
+                    }
+                    let (pass, _) = frame.tiles[t].depth.test(&gequal, &f, cnt);
+                    if !pass {
+                        return;
+                    }
+                    cnt.depth_passed += 1;
+                    let Some(p) = receivers[t][f.local] else {
+                        return;
+                    };
+                    if tested && !job.shape.contains(p, 0.0) {
+                        return;
+                    }
+                    cnt.fragments_shaded += 1;
+                    let target = job
+                        .target
+                        .unwrap_or_else(|| plane_split_target(light.center(), &job.edge, p));
+                    let cov = light.coverage(p, job.edge[0], job.edge[1], s.coverage);
+                    st.v.blend(target, f.local, table.lookup(cov), cnt);
+                }
+            },
+        );
+    }
+    let flat: Vec<f32> = tiles
+        .iter()
+        .flat_map(|t| (0..t.v.add.len()).map(|i| t.v.resolve(format, i).clamp(0.0, 1.0) as f32))
+        .collect();
+    (tiling.to_row_major(&flat), counters)
+}
+
+/// The plane-equation split (§4.4's first approach): the sign of the hard-quad plane equation
+/// evaluated in f32 at the receiver; inner (≤ 0, see
+/// [`crate::geometry::tight_wedge::quad_inner_halfspace`]) adds.
+fn plane_split_target(c: DVec3, e: &[DVec3; 2], p: DVec3) -> SplitTarget {
+    let (c, a, b, p) = (c.as_vec3(), e[0].as_vec3(), e[1].as_vec3(), p.as_vec3());
+    let n = (a - c).cross(b - c);
+    if n.dot(p - c) <= 0.0 {
+        SplitTarget::Add
+    } else {
+        SplitTarget::Sub
+    }
+}
+
+/// The receiver point of every sample, tile-major (`None` for background): the pixel center
+/// un-projected at its stored depth, in f64.
+fn receiver_tiles(frame: &Frame) -> Vec<Vec<Option<DVec3>>> {
+    let tiling = &frame.tiling;
+    (0..tiling.tile_count())
+        .map(|t| {
+            let r = tiling.rect(t);
+            let mut out = vec![None; tiling.tile_len()];
+            for y in r.y0..r.y1 {
+                for x in r.x0..r.x1 {
+                    let i = tiling.local(x, y);
+                    if frame.tiles[t].prim[i] != BACKGROUND {
+                        let z = frame.gpu.depth.to_window(frame.tiles[t].depth.values[i]);
+                        out[i] = Some(frame.proj.unproject(x, y, z));
+                    }
+                }
+            }
+            out
+        })
+        .collect()
+}
+
+/// The visibility of one light piece (row-major, clamped) with the settings' overlap mode.
+fn piece_visibility(
+    frame: &Frame,
+    light: &LightModel,
+    s: &Settings,
+    receivers: &[Vec<Option<DVec3>>],
+) -> Result<(Vec<f32>, Counters), InputError> {
+    let c = light.center().as_vec3();
+    let loops = silhouettes(frame, c)?;
+    if !s.overlap {
+        let meshes: Vec<_> = frame.scene.meshes.iter().zip(&frame.adjacency).collect();
+        let capping = if s.zfail {
+            Capping::Capped
+        } else {
+            Capping::Open
+        };
+        let quads = shadow_volume_triangles(&meshes, c, &frame.proj, capping);
+        let edges: Vec<[DVec3; 2]> = loops.into_iter().flatten().collect();
+        return Ok(render_group(frame, light, quads, &edges, s, receivers));
+    }
+    // §5.1: per loop, coverage c_l = 1 − V_l, combined c = max + ½·min, folded in loop order.
+    let mut covered = vec![0.0f32; frame.pixel_count()];
+    let mut counters = Counters::default();
+    for l in &loops {
+        let quads: Vec<[ClipVertex; 3]> = l.iter().flat_map(|e| edge_quad(frame, c, e)).collect();
+        let (v, cnt) = render_group(frame, light, quads, l, s, receivers);
+        counters += cnt;
+        for (acc, v) in covered.iter_mut().zip(&v) {
+            *acc = overlap_combine(*acc, 1.0 - v);
+        }
+    }
+    Ok((covered.iter().map(|c| 1.0 - c.min(1.0)).collect(), counters))
+}
+
+/// Paper IV §5.1 eq. 1: `c = max(c_A, c_B) + ½·min(c_A, c_B)`.
+pub fn overlap_combine(a: f32, b: f32) -> f32 {
+    a.max(b) + 0.5 * a.min(b)
+}
+
+/// Run `ssv-optimized` on a rendered frame.
+pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
+    let start = Instant::now();
+    let mut r = OptionReader::new(frame.scene, "ssv-optimized");
+    let s = read_settings(&mut r, frame)?;
+    r.finish()?;
+    let model = LightModel::from_shape(frame.scene.light.center, &frame.scene.light.shape)
+        .expect("read_settings checked the shape");
+    let pieces = model
+        .pieces(s.light_split)
+        .expect("read_settings checked the split");
+    let pass_start = Instant::now();
+    let receivers = receiver_tiles(frame);
+    let mut sum = vec![0.0f32; frame.pixel_count()];
+    let mut counters = Counters::default();
+    for piece in &pieces {
+        let (v, c) = piece_visibility(frame, piece, &s, &receivers)?;
+        counters += c;
+        for (acc, v) in sum.iter_mut().zip(&v) {
+            *acc += v;
+        }
+    }
+    let n = pieces.len() as f32;
+    let prims = frame.prim_ids();
+    let vis: Vec<f32> = sum
+        .iter()
+        .zip(&prims)
+        .map(|(v, p)| {
+            if *p == BACKGROUND {
+                1.0
+            } else {
+                (v / n).clamp(0.0, 1.0)
+            }
+        })
+        .collect();
+    let pass = PassStats {
+        name: "soft-shadow-volumes".into(),
+        wall_seconds: pass_start.elapsed().as_secs_f64(),
+        runs: pieces.len() as u64,
+        counters,
+    };
+    let plan = MethodPlan {
+        method: "ssv-optimized".into(),
+        passes: vec![frame.pass.name.clone(), "soft-shadow-volumes".into()],
+        buffers: vec![
+            BufferPlan {
+                name: "depth".into(),
+                format: format!("{:?}", frame.gpu.depth),
+                bytes_per_sample: frame.gpu.depth.bytes() as u32,
+            },
+            BufferPlan {
+                name: "stencil".into(),
+                format: "S8".into(),
+                bytes_per_sample: 1,
+            },
+            BufferPlan {
+                name: "v-buffer".into(),
+                format: format!(
+                    "2×RGBA8 split {}-bit ({} carry bits per channel)",
+                    s.format.value_bits(),
+                    s.format.reserved_bits
+                ),
+                bytes_per_sample: 8,
+            },
+        ],
+        settings: serde_json::json!({ "resolved": s, "gpu": frame.gpu }),
+    };
+    let passes = vec![frame.pass.clone(), pass];
+    Ok(MethodOutput {
+        visibility: Visibility::Gray(vis),
+        raw_images: vec![],
+        stats: super::method_stats("ssv-optimized", frame, start, &plan, passes),
+    })
+}
