@@ -122,19 +122,56 @@ pub fn stratified(
             &squares,
             uniform,
         ),
-        LightShape::Sphere { radius } => {
-            // Paper IV §4.2.1: the disk through the center facing the receiver point. A
-            // receiver exactly at the center has no view direction; +Z is used then.
-            let view = toward.as_dvec3() - center;
-            let normal = if view.length_squared() > 0.0 {
-                view
-            } else {
-                DVec3::Z
-            };
-            disk_samples(center, f64::from(*radius), normal, &squares, uniform)
-        }
+        LightShape::Sphere { radius } => disk_samples(
+            center,
+            f64::from(*radius),
+            sphere_disk_normal(center, toward),
+            &squares,
+            uniform,
+        ),
     };
     Ok(samples)
+}
+
+/// A convex quadrilateral, corners in order around it, that contains every sample
+/// [`stratified`] returns for `light` seen from `toward` (up to the f32 rounding of the sample
+/// positions); `None` for a point light. Rectangles give their own corners, disks and spheres
+/// the square circumscribing their (facing) disk in the basis of [`orthonormal_basis`]. The
+/// ray-cast reference culls with the convex hull of a receiver and this quadrilateral.
+pub fn bounding_quad(light: &Light, toward: Vec3) -> Option<[DVec3; 4]> {
+    let center = light.center.as_dvec3();
+    let (u, v) = match &light.shape {
+        LightShape::Point => return None,
+        LightShape::Rect { u, v } | LightShape::TexturedRect { u, v, .. } => {
+            (u.as_dvec3(), v.as_dvec3())
+        }
+        LightShape::Disk { radius, normal } => {
+            let (b1, b2) = orthonormal_basis(normal.as_dvec3());
+            (f64::from(*radius) * b1, f64::from(*radius) * b2)
+        }
+        LightShape::Sphere { radius } => {
+            let (b1, b2) = orthonormal_basis(sphere_disk_normal(center, toward));
+            (f64::from(*radius) * b1, f64::from(*radius) * b2)
+        }
+    };
+    Some([
+        center - u - v,
+        center + u - v,
+        center + u + v,
+        center - u + v,
+    ])
+}
+
+/// The normal of the disk that stands for a sphere light seen from `toward` (Paper IV
+/// §4.2.1: the disk through the center perpendicular to the view direction). A point exactly
+/// at the center has no view direction; +Z is used then.
+fn sphere_disk_normal(center: DVec3, toward: Vec3) -> DVec3 {
+    let view = toward.as_dvec3() - center;
+    if view.length_squared() > 0.0 {
+        view
+    } else {
+        DVec3::Z
+    }
 }
 
 /// `k` with `k·k = n`, `k ≥ 1`, or an error naming `n`.
@@ -406,6 +443,44 @@ mod tests {
                 assert!(max_r > 0.65, "samples should reach the rim, max {max_r}");
             }
         }
+    }
+
+    #[test]
+    fn bounding_quad_contains_every_sample() {
+        let toward = Vec3::new(2.0, -3.0, 0.5);
+        let lights = [
+            rect_light(),
+            Light {
+                center: Vec3::new(0.0, 4.0, 1.0),
+                shape: LightShape::Disk {
+                    radius: 0.7,
+                    normal: Vec3::new(0.3, -1.0, 0.2).normalize(),
+                },
+            },
+            Light {
+                center: Vec3::new(0.0, 4.0, 1.0),
+                shape: LightShape::Sphere { radius: 0.7 },
+            },
+        ];
+        for light in &lights {
+            let q = bounding_quad(light, toward).unwrap();
+            // The quad's inward edge normals within its plane.
+            let n = (q[1] - q[0]).cross(q[3] - q[0]);
+            for x in stratified(light, 256, Pattern::Jittered { seed: 4 }, toward).unwrap() {
+                let p = x.position.as_dvec3();
+                assert!((p - q[0]).dot(n.normalize()).abs() < 1e-5);
+                for i in 0..4 {
+                    let (a, b) = (q[i], q[(i + 1) % 4]);
+                    let inward = n.cross(b - a);
+                    assert!((p - a).dot(inward.normalize()) > -1e-5, "{:?}", light.shape);
+                }
+            }
+        }
+        let point = Light {
+            center: Vec3::ONE,
+            shape: LightShape::Point,
+        };
+        assert_eq!(bounding_quad(&point, Vec3::ZERO), None);
     }
 
     #[test]

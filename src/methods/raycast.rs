@@ -18,36 +18,54 @@
 //! # Shadow rays
 //!
 //! The ray from the receiver `p` to the sample `s` starts at `o = p + δ·n`, with `n` the
-//! receiver's camera-side normal and `δ = `[`ORIGIN_OFFSET`]` × ` the scene diagonal (of
-//! [`Scene::bounds`]), so that a receiver read back from a quantized depth buffer does not
-//! shadow itself. It is blocked when it hits any triangle at a parameter `t ∈ (ε, 1 − ε)` of
-//! the segment `o + t·(s − o)`, `ε = `[`SEGMENT_EPSILON`]` (the far end keeps a light that lies
-//! on a surface from being blocked by that surface).
+//! receiver's camera-side normal and `δ = `[`ORIGIN_OFFSET`]` ×` the length (f32) of the
+//! diagonal of [`Scene::bounds`], so that a receiver read back from a quantized depth buffer
+//! does not shadow itself. The ray is blocked when it hits any triangle at a parameter
+//! `t ∈ (ε, 1 − ε)` of the segment `o + t·(s − o)`, `ε = `[`SEGMENT_EPSILON`] (the far end
+//! keeps a light that lies on a surface from being blocked by that surface).
 //!
 //! Each ray–triangle test is Möller–Trumbore in f64 on the f32 vertices, edges and vertices
 //! inclusive (a ray through a shared edge of a closed mesh cannot leak), no back-face culling.
 //! It is a pure function of the ray and the triangle, and a ray is blocked if *any* triangle
-//! blocks it, so the result does not depend on the order in which the BVH offers candidates.
+//! blocks it. Everything below only decides which triangles are tested; it never changes the
+//! answer, so the result depends neither on the BVH's shape nor on its traversal order.
 //!
-//! # Acceleration
+//! # Acceleration (exact)
 //!
-//! A bounding volume hierarchy is built once per scene by [`ShadowRayCaster::new`] with the
-//! `bvh` crate (0.10: binned SAH, one leaf per triangle, deterministic). Its tree is then
-//! flattened into a depth-first array of glam boxes ([`FlatNode`]) that shadow rays traverse
-//! any-hit with early exit, clipped to the segment `t ∈ [0, 1]`: the crate's own traversal
-//! iterator follows the ray to infinity (past the light), goes through nalgebra, and its
-//! strict box test (`t_far > t_near`) skips the flat box of an axis-aligned triangle; the
-//! flattened traversal is about 4× faster here and has none of those problems.
+//! Everything here only decides *which* triangles a ray is tested against, never the answer;
+//! a test checks that it gives the same bits as testing every ray through the whole tree.
 //!
-//! Every triangle's box is padded by [`BOX_PADDING`]` × ` the scene diagonal, which keeps the
-//! f32 box tests conservative with respect to the exact f64 triangle test: the f32 rounding
-//! of the origin and of the slab parameters moves a box by about 1e-7 of the scene size, far
-//! less than the padding, and a ray parallel to a slab that grazes a padded face exactly
-//! (where `0·∞` gives NaN and the box is rejected) cannot touch a triangle, which lies at
-//! least the padding inside. A box the exact test needs is therefore never culled, and the
-//! blocked/unblocked answer of every ray is the exact one.
+//! 1. A bounding volume hierarchy is built once per scene by [`ShadowRayCaster::new`] with
+//!    the `bvh` crate (0.10: binned SAH, one triangle per leaf, deterministic) and flattened
+//!    into a depth-first array of glam boxes. (The crate's own iterator follows a ray to
+//!    infinity, past the light, and its strict box test `t_far > t_near` skips the flat box
+//!    of an axis-aligned triangle; the flattened any-hit traversal, clipped to `t ∈ [0, 1]`,
+//!    avoids both.)
+//! 2. Per receiver, the *shaft* (Haines & Wallace, "Shaft Culling for Efficient Ray-Traced
+//!    Radiosity", 1991) — the convex hull of the ray origin and a quadrilateral containing
+//!    every light sample ([`sampling::bounding_quad`]) — collects from the tree the triangles
+//!    whose boxes it may meet: no other triangle can block any of the receiver's rays. None:
+//!    the receiver sees every sample.
+//! 3. Each candidate is clipped to the depths a blocking hit can have (`> ε·h/2`, `h` the
+//!    distance of the light plane from the origin), projected from the origin onto the light
+//!    plane and binned by its bounding box into a 16×16 grid over the quadrilateral. A ray
+//!    blocked by a triangle crosses the light plane inside that triangle's projection, so
+//!    each ray is tested only against the triangles of the cell its crossing point falls in
+//!    (plus those covering the whole grid), with the exact test above.
 //!
-//! There is no per-pixel shortcut: every sample of every pixel is traced.
+//! Point lights and degenerate shafts (the origin in the light's plane) trace each ray through
+//! the whole tree instead.
+//!
+//! Conservativeness: with `D` the diagonal of the bounds of the meshes and the whole light and
+//! `M` the largest coordinate magnitude in them, every triangle's box is padded by
+//! `pad = `[`BOX_PADDING`]` × D + 4·ε_f32 × M`, and the shaft is widened by `pad` too. The f32
+//! rounding of the ray origin, of the sample positions and of the slab parameters moves a
+//! ray by at most a few ulps of M (plus ~1e-7 D), far less than the padding, so a box that
+//! holds a blocking triangle is never culled; a ray parallel to a slab that grazes a padded
+//! face exactly (where `0·∞` gives NaN and the box may be rejected) cannot touch a triangle,
+//! which lies at least `pad` inside. The bins are widened by [`BIN_MARGIN`]` × (D + M)`,
+//! which covers the f64 rounding of the projections; the clip depth `ε·h/2` keeps half of
+//! `ε` to spare.
 //!
 //! # Determinism
 //!
@@ -66,16 +84,16 @@ use glam::{DVec3, Vec3};
 use nalgebra::Point3;
 use rayon::prelude::*;
 
-/// Receiver-origin offset along the normal, relative to the scene diagonal (module doc,
+/// Ray-origin offset along the receiver normal, relative to the scene diagonal (module doc,
 /// "Shadow rays").
 pub const ORIGIN_OFFSET: f64 = 1e-4;
 
 /// The open parameter interval `(ε, 1 − ε)` of the shadow segment in which a hit blocks it.
 pub const SEGMENT_EPSILON: f64 = 1e-6;
 
-/// Padding of every triangle's BVH box, relative to the scene diagonal (module doc,
-/// "Acceleration").
-pub const BOX_PADDING: f32 = 1e-5;
+/// Padding of every triangle's BVH box and of every shaft, relative to the scene diagonal
+/// (module doc, "Acceleration").
+pub const BOX_PADDING: f64 = 1e-5;
 
 /// The default number of light samples per pixel (issue 2: 1024, the papers' reference count,
 /// Paper III §5.1).
@@ -92,13 +110,13 @@ pub struct Receiver {
     pub normal: Vec3,
 }
 
-/// Options of the `raycast` method.
+/// Options of the `raycast` method (issue 2, `raycast`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct RaycastSettings {
     /// Light samples per receiver: a perfect square k×k ([`sampling::stratified`]); default
     /// [`DEFAULT_SAMPLES`].
     pub samples: u32,
-    /// Seed of the jitter ([`Pattern::Jittered`]).
+    /// Seed of the jitter ([`Pattern::Jittered`]); default 0.
     pub seed: u64,
 }
 
@@ -160,7 +178,7 @@ impl Triangle {
     }
 }
 
-/// The BVH primitive: one triangle's padded box and its index.
+/// The primitive handed to the `bvh` crate: one triangle's padded box and its index.
 #[derive(Debug, Clone)]
 struct BoxedTriangle {
     aabb: Aabb<f32, 3>,
@@ -185,7 +203,7 @@ impl BHShape<f32, 3> for BoxedTriangle {
 }
 
 /// One node of the flattened BVH, in depth-first order: an inner node's first child is the
-/// next node, its second child is at `second`; a leaf holds one triangle.
+/// next node, its second child is at `index`; a leaf holds one triangle.
 #[derive(Debug, Clone, Copy)]
 struct FlatNode {
     lo: Vec3,
@@ -196,7 +214,7 @@ struct FlatNode {
 }
 
 /// Flattens the crate's tree below `node` (whose box is `aabb`) into `out`, depth first;
-/// returns the depth of the subtree.
+/// returns the depth of the subtree (a leaf has depth 0).
 fn flatten(
     bvh: &Bvh<f32, 3>,
     shapes: &[BoxedTriangle],
@@ -209,10 +227,11 @@ fn flatten(
     let at = out.len();
     match &bvh.nodes[node] {
         BvhNode::Leaf { shape_index, .. } => {
+            let index = shapes[*shape_index].triangle as u32;
             out.push(FlatNode {
                 lo,
                 hi,
-                index: shapes[*shape_index].triangle as u32,
+                index,
                 leaf: true,
             });
             0
@@ -238,6 +257,137 @@ fn flatten(
     }
 }
 
+/// The convex hull of a ray origin and a light quadrilateral, widened by the padding
+/// (module doc, "Acceleration"): its bounding box and its five face planes `n·x ≤ d`
+/// (unit `n`): four through the origin and a quadrilateral edge, one through the
+/// quadrilateral.
+struct Shaft {
+    lo: DVec3,
+    hi: DVec3,
+    planes: [(DVec3, f64); 5],
+}
+
+impl Shaft {
+    /// The shaft from `o` to `quad`, or `None` when it is degenerate (the origin in the plane
+    /// of the quadrilateral or on the line of one of its edges).
+    fn new(o: DVec3, quad: &[DVec3; 4], pad: f64) -> Option<Self> {
+        let centroid = (quad[0] + quad[1] + quad[2] + quad[3]) * 0.25;
+        let inner = (centroid + o) * 0.5;
+        let plane = |a: DVec3, b: DVec3, c: DVec3| -> Option<(DVec3, f64)> {
+            let n = (b - a).cross(c - a).try_normalize()?;
+            // Orient the plane so that a point strictly inside the hull is inside it.
+            let n = if n.dot(inner - a) > 0.0 { -n } else { n };
+            let d = n.dot(a);
+            (n.dot(inner) < d).then_some((n, d + pad))
+        };
+        let mut planes = [(DVec3::ZERO, 0.0); 5];
+        for i in 0..4 {
+            planes[i] = plane(o, quad[i], quad[(i + 1) % 4])?;
+        }
+        planes[4] = plane(quad[0], quad[1], quad[3])?;
+        let lo = quad.iter().fold(o, |m, q| m.min(*q)) - pad;
+        let hi = quad.iter().fold(o, |m, q| m.max(*q)) + pad;
+        Some(Self { lo, hi, planes })
+    }
+
+    /// Whether the box `[lo, hi]` may meet the shaft: false when a face plane of the shaft or
+    /// of the shaft's bounding box separates them (then they are disjoint).
+    #[inline]
+    fn may_meet(&self, lo: Vec3, hi: Vec3) -> bool {
+        let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
+        if lo.cmpgt(self.hi).any() || hi.cmplt(self.lo).any() {
+            return false;
+        }
+        self.planes
+            .iter()
+            .all(|&(n, d)| n.dot(DVec3::select(n.cmpge(DVec3::ZERO), lo, hi)) <= d)
+    }
+}
+
+/// The plane of a light quadrilateral `c ± U ± V` with coordinates `(a, b)`, `x = c + a·U +
+/// b·V` (the quadrilateral is `[-1,1]²`), computed with the dual basis so that `U` and `V`
+/// need not be orthogonal.
+struct LightPlane {
+    center: DVec3,
+    normal: DVec3,
+    dual_u: DVec3,
+    dual_v: DVec3,
+    /// The binning margin in plane coordinates: [`BIN_MARGIN`] × the scene scale, mapped
+    /// through the dual basis.
+    margin: f64,
+}
+
+impl LightPlane {
+    /// The plane of `quad` (corners `c−U−V, c+U−V, c+U+V, c−U+V`), `None` if it is degenerate;
+    /// `scale` is the scene's size plus its distance from the origin.
+    fn new(quad: &[DVec3; 4], scale: f64) -> Option<Self> {
+        let center = (quad[0] + quad[1] + quad[2] + quad[3]) * 0.25;
+        let u = (quad[1] - quad[0]) * 0.5;
+        let v = (quad[3] - quad[0]) * 0.5;
+        let normal = u.cross(v).try_normalize()?;
+        let (uu, uv, vv) = (u.dot(u), u.dot(v), v.dot(v));
+        let det = uu * vv - uv * uv;
+        if det.is_nan() || det <= 0.0 {
+            return None;
+        }
+        let dual_u = (vv * u - uv * v) / det;
+        let dual_v = (uu * v - uv * u) / det;
+        let margin = BIN_MARGIN * scale * dual_u.length().max(dual_v.length());
+        Some(Self {
+            center,
+            normal,
+            dual_u,
+            dual_v,
+            margin,
+        })
+    }
+
+    /// `(a, b)` of a point of the plane.
+    #[inline]
+    fn coords(&self, x: DVec3) -> (f64, f64) {
+        let d = x - self.center;
+        (d.dot(self.dual_u), d.dot(self.dual_v))
+    }
+}
+
+/// Cells per side of the light-plane grid the candidate triangles are binned into (module
+/// doc, "Acceleration"); at most the sample grid's side.
+const GRID: usize = 16;
+
+/// Binning margin in world units relative to the scene scale (module doc, "Acceleration"):
+/// projecting a vertex near the clip depth `ε·h/2` magnifies its f64 rounding (≈ 1e-16 of
+/// the scale) by up to `2/ε = 2e6`; 1e-7 leaves a factor of more than 100 to spare.
+const BIN_MARGIN: f64 = 1e-7;
+
+/// Per-thread buffers reused from receiver to receiver (their contents never outlive one
+/// receiver, so the results do not depend on which thread ran which pixel).
+#[derive(Default)]
+struct Scratch {
+    stack: Vec<u32>,
+    candidates: Vec<u32>,
+    /// Per binned candidate: triangle index and its cell range `i0, i1, j0, j1`.
+    binned: Vec<(u32, [u16; 4])>,
+    /// Triangles whose projection covers the whole grid (tested for every sample).
+    global: Vec<u32>,
+    /// Compressed cell lists: cell `c` holds `cell_items[cell_start[c]..cell_start[c + 1]]`.
+    cell_start: Vec<u32>,
+    cell_items: Vec<u32>,
+    /// Per sample: lit or not.
+    lit: Vec<bool>,
+}
+
+/// The grid cell of light-plane coordinate `x` on a grid of `g` cells over `[-1, 1]`
+/// (clamped, monotone in `x`).
+#[inline]
+fn cell_of(x: f64, g: usize) -> usize {
+    let c = ((x + 1.0) * 0.5 * g as f64).floor();
+    if c >= 0.0 {
+        (c as usize).min(g - 1)
+    } else {
+        0
+    }
+}
+
 /// Casts shadow rays against all triangles of a scene; builds the BVH once per scene
 /// (module doc, "Acceleration").
 pub struct ShadowRayCaster {
@@ -245,27 +395,50 @@ pub struct ShadowRayCaster {
     nodes: Vec<FlatNode>,
     /// Depth of the tree (a single leaf has depth 0).
     depth: usize,
-    /// `δ` of the module doc: the receiver-origin offset in world units.
+    /// `δ` of the module doc: the ray-origin offset in world units.
     origin_offset: f64,
+    /// The box and shaft padding in world units.
+    pad: f64,
+    /// The scene's diagonal plus its largest coordinate magnitude (scale of rounding errors).
+    scale: f64,
 }
 
 impl ShadowRayCaster {
     /// Collects the triangles of every mesh of `scene` and builds the BVH over them.
     pub fn new(scene: &Scene) -> Self {
-        let (lo, hi) = scene.bounds();
-        let diagonal = f64::from((hi - lo).length());
+        let (bounds_lo, bounds_hi) = scene.bounds();
+        // δ uses the diagonal of `Scene::bounds` (meshes and light center) as an f32 length.
+        let bounds_diagonal = f64::from((bounds_hi - bounds_lo).length());
+        let bounds_diagonal = if bounds_diagonal.is_finite() && bounds_diagonal > 0.0 {
+            bounds_diagonal
+        } else {
+            1.0
+        };
+        // Padding and margins use the bounds of meshes and the whole light.
+        let (mut lo, mut hi) = (bounds_lo.as_dvec3(), bounds_hi.as_dvec3());
+        for q in sampling::bounding_quad(&scene.light, scene.light.center)
+            .into_iter()
+            .flatten()
+        {
+            lo = lo.min(q);
+            hi = hi.max(q);
+        }
+        let diagonal = (hi - lo).length();
         let diagonal = if diagonal.is_finite() && diagonal > 0.0 {
             diagonal
         } else {
             1.0
         };
-        let pad = BOX_PADDING * diagonal as f32;
+        let magnitude = lo.abs().max(hi.abs()).max_element();
+        let pad = BOX_PADDING * diagonal + 4.0 * f64::from(f32::EPSILON) * magnitude;
         let mut triangles = Vec::new();
         let mut shapes = Vec::new();
         for mesh in &scene.meshes {
             for tri in &mesh.triangles {
-                let [a, b, c] = tri.map(|i| mesh.positions[i as usize]);
-                let (lo, hi) = (a.min(b).min(c) - pad, a.max(b).max(c) + pad);
+                let [a, b, c] = tri.map(|i| mesh.positions[i as usize].as_dvec3());
+                // f32 rounding moves the box by half an ulp, far less than `pad`.
+                let lo = (a.min(b).min(c) - pad).as_vec3();
+                let hi = (a.max(b).max(c) + pad).as_vec3();
                 shapes.push(BoxedTriangle {
                     aabb: Aabb::with_bounds(
                         Point3::new(lo.x, lo.y, lo.z),
@@ -274,11 +447,10 @@ impl ShadowRayCaster {
                     triangle: triangles.len(),
                     node_index: 0,
                 });
-                let v0 = a.as_dvec3();
                 triangles.push(Triangle {
-                    v0,
-                    e1: b.as_dvec3() - v0,
-                    e2: c.as_dvec3() - v0,
+                    v0: a,
+                    e1: b - a,
+                    e2: c - a,
                 });
             }
         }
@@ -293,7 +465,9 @@ impl ShadowRayCaster {
             triangles,
             nodes,
             depth,
-            origin_offset: ORIGIN_OFFSET * diagonal,
+            origin_offset: ORIGIN_OFFSET * bounds_diagonal,
+            pad,
+            scale: diagonal + magnitude,
         }
     }
 
@@ -311,27 +485,209 @@ impl ShadowRayCaster {
     /// when the options are parsed).
     pub fn visibility(&self, light: &Light, r: &Receiver, settings: &RaycastSettings) -> [f32; 3] {
         let samples = light_samples(light, r.point, settings);
-        self.visibility_of_samples(r, &samples)
+        let quad = sampling::bounding_quad(light, r.point);
+        self.visibility_of_samples(r, &samples, quad.as_ref(), &mut Scratch::default())
     }
 
-    /// True when the shadow segment from `origin` to `target` is blocked by any triangle.
-    fn blocked(&self, origin: DVec3, target: DVec3) -> bool {
-        let d = target - origin;
-        if self.nodes.is_empty() || d == DVec3::ZERO {
+    /// The visibility of `r` for an explicit sample set contained in `quad` (shared by
+    /// [`Self::visibility`] and [`raycast_visibility`], which computes the sample set once
+    /// when it does not depend on the receiver). `quad = None` traces every ray through the
+    /// whole tree.
+    fn visibility_of_samples(
+        &self,
+        r: &Receiver,
+        samples: &[LightSample],
+        quad: Option<&[DVec3; 4]>,
+        scratch: &mut Scratch,
+    ) -> [f32; 3] {
+        let origin = r.point.as_dvec3() + self.origin_offset * r.normal.as_dvec3();
+        scratch.lit.clear();
+        scratch.lit.resize(samples.len(), true);
+        if !self.nodes.is_empty() && !self.trace_binned(origin, samples, quad, scratch) {
+            self.trace_each(origin, samples, scratch);
+        }
+        let mut visible = [0.0f64; 3];
+        let mut total = [0.0f64; 3];
+        for (s, &lit) in samples.iter().zip(&scratch.lit) {
+            for c in 0..3 {
+                let w = f64::from(s.weight[c]);
+                total[c] += w;
+                if lit {
+                    visible[c] += w;
+                }
+            }
+        }
+        std::array::from_fn(|c| {
+            if total[c] > 0.0 {
+                (visible[c] / total[c]) as f32
+            } else {
+                0.0
+            }
+        })
+    }
+
+    /// Every ray through the whole tree (point lights, degenerate shafts, and the reference
+    /// the binned path is tested against).
+    fn trace_each(&self, origin: DVec3, samples: &[LightSample], scratch: &mut Scratch) {
+        scratch.stack.resize(self.depth + 2, 0);
+        for (s, lit) in samples.iter().zip(scratch.lit.iter_mut()) {
+            *lit = !self.blocked(origin, s.position.as_dvec3(), &mut scratch.stack);
+        }
+    }
+
+    /// The per-receiver path of the module doc ("Acceleration"): shaft candidates binned by
+    /// their projection on the light plane, each ray tested against its cell's triangles.
+    /// Returns false (and leaves `scratch.lit` alone) when it does not apply.
+    fn trace_binned(
+        &self,
+        origin: DVec3,
+        samples: &[LightSample],
+        quad: Option<&[DVec3; 4]>,
+        scratch: &mut Scratch,
+    ) -> bool {
+        let Some(quad) = quad else { return false };
+        let (Some(shaft), Some(plane)) = (
+            Shaft::new(origin, quad, self.pad),
+            LightPlane::new(quad, self.scale),
+        ) else {
+            return false;
+        };
+        // Signed distance of the light plane from the origin along the plane normal; every
+        // ray point at parameter t lies at t·h.
+        let h = plane.normal.dot(plane.center - origin);
+        if h.abs() <= self.pad {
             return false;
         }
-        // A depth-first traversal holds at most one pending sibling per level.
-        if self.depth < 64 {
-            self.any_hit(origin, d, &mut [0; 64])
+        let (n, h) = if h > 0.0 {
+            (plane.normal, h)
         } else {
-            self.any_hit(origin, d, &mut vec![0; self.depth + 1])
+            (-plane.normal, -h)
+        };
+        self.shaft_candidates(&shaft, scratch);
+        if scratch.candidates.is_empty() {
+            return true;
+        }
+        let g = GRID.min(samples.len().isqrt()).max(1);
+        // A hit at t > ε lies at depth > ε·h; half of that keeps rounding on the safe side.
+        let near = 0.5 * SEGMENT_EPSILON * h;
+        let far = h * (1.0 + 1e-6) + self.pad;
+        scratch.binned.clear();
+        scratch.global.clear();
+        for &ti in &scratch.candidates {
+            let t = &self.triangles[ti as usize];
+            let v = [t.v0, t.v0 + t.e1, t.v0 + t.e2];
+            let q = v.map(|x| n.dot(x - origin));
+            if q.iter().all(|&x| x < near) || q.iter().all(|&x| x > far) {
+                continue; // entirely behind the rays' start or beyond the light plane
+            }
+            // Clip to depth ≥ near (Sutherland–Hodgman, one plane) and project from the
+            // origin onto the light plane.
+            let (mut a0, mut a1, mut b0, mut b1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+            let mut project = |x: DVec3, qx: f64| {
+                let (a, b) = plane.coords(origin + (x - origin) * (h / qx));
+                (a0, a1, b0, b1) = (a0.min(a), a1.max(a), b0.min(b), b1.max(b));
+            };
+            for i in 0..3 {
+                let (x, y, qx, qy) = (v[i], v[(i + 1) % 3], q[i], q[(i + 1) % 3]);
+                if qx >= near {
+                    project(x, qx);
+                }
+                if (qx >= near) != (qy >= near) {
+                    let s = (near - qx) / (qy - qx);
+                    project(x + (y - x) * s, near);
+                }
+            }
+            let range = [
+                cell_of(a0 - plane.margin, g),
+                cell_of(a1 + plane.margin, g),
+                cell_of(b0 - plane.margin, g),
+                cell_of(b1 + plane.margin, g),
+            ];
+            if !(a0 <= a1 && b0 <= b1) || range == [0, g - 1, 0, g - 1] {
+                scratch.global.push(ti); // NaN-safe: anything odd is tested for every ray
+            } else {
+                scratch.binned.push((ti, range.map(|x| x as u16)));
+            }
+        }
+        // Compressed cell lists (counting sort by cell, candidates in BVH order).
+        let cells = g * g;
+        scratch.cell_start.clear();
+        scratch.cell_start.resize(cells + 1, 0);
+        for (_, [i0, i1, j0, j1]) in &scratch.binned {
+            for j in *j0..=*j1 {
+                for i in *i0..=*i1 {
+                    scratch.cell_start[j as usize * g + i as usize + 1] += 1;
+                }
+            }
+        }
+        for c in 0..cells {
+            scratch.cell_start[c + 1] += scratch.cell_start[c];
+        }
+        scratch.cell_items.clear();
+        scratch
+            .cell_items
+            .resize(scratch.cell_start[cells] as usize, 0);
+        let mut fill = scratch.cell_start.clone();
+        for &(ti, [i0, i1, j0, j1]) in &scratch.binned {
+            for j in j0..=j1 {
+                for i in i0..=i1 {
+                    let c = j as usize * g + i as usize;
+                    scratch.cell_items[fill[c] as usize] = ti;
+                    fill[c] += 1;
+                }
+            }
+        }
+        // Each ray: the plane point it passes through gives its cell.
+        for (s, lit) in samples.iter().zip(scratch.lit.iter_mut()) {
+            let target = s.position.as_dvec3();
+            let d = target - origin;
+            let qs = n.dot(d);
+            if qs.is_nan() || qs <= 0.0 {
+                // Cannot happen for a sample on the light plane; trace it fully if it does.
+                scratch.stack.resize(self.depth + 2, 0);
+                *lit = !self.blocked(origin, target, &mut scratch.stack);
+                continue;
+            }
+            let (a, b) = plane.coords(origin + d * (h / qs));
+            let c = cell_of(b, g) * g + cell_of(a, g);
+            let cell = &scratch.cell_items
+                [scratch.cell_start[c] as usize..scratch.cell_start[c + 1] as usize];
+            *lit = !scratch
+                .global
+                .iter()
+                .chain(cell)
+                .any(|&ti| self.triangles[ti as usize].blocks(origin, d));
+        }
+        true
+    }
+
+    /// The triangles in leaves whose boxes may meet `shaft`, in depth-first order.
+    fn shaft_candidates(&self, shaft: &Shaft, scratch: &mut Scratch) {
+        scratch.candidates.clear();
+        scratch.stack.clear();
+        scratch.stack.push(0);
+        while let Some(at) = scratch.stack.pop() {
+            let node = &self.nodes[at as usize];
+            if !shaft.may_meet(node.lo, node.hi) {
+                continue;
+            }
+            if node.leaf {
+                scratch.candidates.push(node.index);
+            } else {
+                scratch.stack.push(node.index);
+                scratch.stack.push(at + 1);
+            }
         }
     }
 
-    /// Depth-first any-hit traversal of the flattened BVH from `origin` along `d`, boxes
-    /// clipped to the segment `t ∈ [0, 1]`; `stack` has room for the tree's depth.
-    #[inline]
-    fn any_hit(&self, origin: DVec3, d: DVec3, stack: &mut [u32]) -> bool {
+    /// True when the segment from `origin` to `target` is blocked by any triangle:
+    /// depth-first any-hit traversal of the whole tree, boxes clipped to `t ∈ [0, 1]`;
+    /// `stack` holds at least the tree's depth + 1 entries.
+    fn blocked(&self, origin: DVec3, target: DVec3, stack: &mut [u32]) -> bool {
+        let d = target - origin;
+        if d == DVec3::ZERO || self.nodes.is_empty() {
+            return false;
+        }
         let o = origin.as_vec3();
         let inv = d.as_vec3().recip();
         stack[0] = 0;
@@ -342,7 +698,7 @@ impl ShadowRayCaster {
             let node = &self.nodes[at as usize];
             let t0 = (node.lo - o) * inv;
             let t1 = (node.hi - o) * inv;
-            // f32::min/max ignore a NaN operand (see the module doc, "Acceleration").
+            // f32::min/max ignore a NaN operand (module doc, "Acceleration").
             let near =
                 t0.x.min(t1.x)
                     .max(t0.y.min(t1.y))
@@ -367,33 +723,6 @@ impl ShadowRayCaster {
             }
         }
         false
-    }
-
-    /// The visibility of `r` for an explicit sample set (shared by [`Self::visibility`] and
-    /// [`raycast_visibility`], which computes the sample set once when it does not depend on
-    /// the receiver).
-    fn visibility_of_samples(&self, r: &Receiver, samples: &[LightSample]) -> [f32; 3] {
-        let origin = r.point.as_dvec3() + self.origin_offset * r.normal.as_dvec3();
-        let mut visible = [0.0f64; 3];
-        let mut total = [0.0f64; 3];
-        for s in samples {
-            let w = s.weight.map(f64::from);
-            for c in 0..3 {
-                total[c] += w[c];
-            }
-            if self.triangles.is_empty() || !self.blocked(origin, s.position.as_dvec3()) {
-                for c in 0..3 {
-                    visible[c] += w[c];
-                }
-            }
-        }
-        std::array::from_fn(|c| {
-            if total[c] > 0.0 {
-                (visible[c] / total[c]) as f32
-            } else {
-                0.0
-            }
-        })
     }
 }
 
@@ -428,22 +757,37 @@ pub fn raycast_visibility(
     // Only sphere lights depend on the receiver (the facing disk); sample the others once.
     let shared = match light.shape {
         LightShape::Sphere { .. } => None,
-        _ => Some(light_samples(light, light.center, settings)),
+        _ => Some((
+            light_samples(light, light.center, settings),
+            sampling::bounding_quad(light, light.center),
+        )),
     };
-    let pixel = |r: &Option<Receiver>| -> [f32; 3] {
-        match r {
-            None => [1.0; 3],
-            Some(r) => match &shared {
-                Some(samples) => caster.visibility_of_samples(r, samples),
-                None => caster.visibility(light, r, settings),
-            },
+    let pixel = |scratch: &mut Scratch, r: &Option<Receiver>| -> [f32; 3] {
+        match (r, &shared) {
+            (None, _) => [1.0; 3],
+            (Some(r), Some((samples, quad))) => {
+                caster.visibility_of_samples(r, samples, quad.as_ref(), scratch)
+            }
+            (Some(r), None) => {
+                let samples = light_samples(light, r.point, settings);
+                let quad = sampling::bounding_quad(light, r.point);
+                caster.visibility_of_samples(r, &samples, quad.as_ref(), scratch)
+            }
         }
     };
     match light.shape {
-        LightShape::TexturedRect { .. } => {
-            Visibility::Rgb(receivers.par_iter().map(pixel).collect())
-        }
-        _ => Visibility::Gray(receivers.par_iter().map(|r| pixel(r)[0]).collect()),
+        LightShape::TexturedRect { .. } => Visibility::Rgb(
+            receivers
+                .par_iter()
+                .map_init(Scratch::default, pixel)
+                .collect(),
+        ),
+        _ => Visibility::Gray(
+            receivers
+                .par_iter()
+                .map_init(Scratch::default, |s, r| pixel(s, r)[0])
+                .collect(),
+        ),
     }
 }
 
@@ -734,6 +1078,184 @@ mod tests {
         }
     }
 
+    /// Receivers on the floor and on the ball's surface (normals outward), a few per row.
+    fn floor_and_ball_receivers(center: Vec3, radius: f32) -> Vec<Receiver> {
+        let mut out = Vec::new();
+        for i in 0..24 * 24 {
+            let (x, z) = ((i % 24) as f32 / 6.0 - 2.0, (i / 24) as f32 / 6.0 - 2.0);
+            out.push(Receiver {
+                point: Vec3::new(x, 0.0, z),
+                normal: Vec3::Y,
+            });
+        }
+        for i in 0..64 {
+            let (a, b) = (i as f32 * 0.7, (i as f32 * 0.37).sin());
+            let n = Vec3::new(
+                a.cos() * (1.0 - b * b).sqrt(),
+                b,
+                a.sin() * (1.0 - b * b).sqrt(),
+            );
+            out.push(Receiver {
+                point: center + n * radius,
+                normal: n,
+            });
+        }
+        out
+    }
+
+    #[test]
+    fn binned_tracing_gives_the_bits_of_tracing_every_ray() {
+        let center = Vec3::new(0.2, 1.5, -0.1);
+        let meshes = vec![
+            floor(),
+            sphere("ball", center, 0.6, 8, 12),
+            cube("post", Vec3::new(-1.2, 0.0, 0.4), Vec3::new(-0.9, 2.2, 0.7)),
+        ];
+        let texture = RgbTexture {
+            width: 3,
+            height: 2,
+            texels: vec![
+                [1.0, 0.5, 0.0],
+                [0.0, 1.0, 0.2],
+                [0.3, 0.3, 0.3],
+                [0.0, 0.0, 1.0],
+                [1.0, 1.0, 1.0],
+                [0.5, 0.0, 0.5],
+            ],
+            source: "test".into(),
+        };
+        let lights = [
+            rect_light(),
+            // A skewed, tilted rectangle: u and v are not orthogonal.
+            Light {
+                center: Vec3::new(0.5, 3.5, 0.2),
+                shape: LightShape::Rect {
+                    u: Vec3::new(1.0, 0.2, 0.0),
+                    v: Vec3::new(0.6, 0.1, 0.9),
+                },
+            },
+            Light {
+                center: Vec3::new(-0.3, 3.8, 0.1),
+                shape: LightShape::TexturedRect {
+                    u: Vec3::X * 0.8,
+                    v: Vec3::Z * 1.3,
+                    texture,
+                },
+            },
+            Light {
+                center: Vec3::new(0.3, 4.0, -0.2),
+                shape: LightShape::Disk {
+                    radius: 1.2,
+                    normal: Vec3::new(0.1, -1.0, 0.2),
+                },
+            },
+            Light {
+                center: Vec3::new(0.0, 4.0, 0.0),
+                shape: LightShape::Sphere { radius: 0.9 },
+            },
+        ];
+        let mut receivers = floor_and_ball_receivers(center, 0.6);
+        // On the post's faces: a vertical wall, lit from above at a grazing angle.
+        for i in 0..40 {
+            let (y, z) = (0.05 + i as f32 * 0.05, 0.42 + (i % 7) as f32 * 0.04);
+            receivers.push(Receiver {
+                point: Vec3::new(-0.9, y, z),
+                normal: Vec3::X,
+            });
+            receivers.push(Receiver {
+                point: Vec3::new(-1.2, y, z),
+                normal: -Vec3::X,
+            });
+        }
+        let settings = RaycastSettings {
+            samples: 256,
+            seed: 11,
+        };
+        let mut empty_total = 0;
+        for light in lights {
+            let s = scene(light, meshes.clone());
+            let caster = ShadowRayCaster::new(&s);
+            let (mut partial, mut empty, mut binned) = (0, 0, 0);
+            for r in &receivers {
+                let samples = light_samples(&s.light, r.point, &settings);
+                let quad = sampling::bounding_quad(&s.light, r.point).unwrap();
+                let o = r.point.as_dvec3() + caster.origin_offset * r.normal.as_dvec3();
+                let mut fast = Scratch {
+                    lit: vec![true; samples.len()],
+                    ..Default::default()
+                };
+                if !caster.trace_binned(o, &samples, Some(&quad), &mut fast) {
+                    continue;
+                }
+                binned += 1;
+                empty += usize::from(fast.candidates.is_empty());
+                let mut full = Scratch {
+                    lit: vec![true; samples.len()],
+                    ..Default::default()
+                };
+                caster.trace_each(o, &samples, &mut full);
+                assert_eq!(fast.lit, full.lit, "{:?} at {:?}", s.light.shape, r.point);
+                let lit = full.lit.iter().filter(|&&l| l).count();
+                partial += usize::from(lit > 0 && lit < samples.len());
+                assert_eq!(
+                    caster.visibility(&s.light, r, &settings),
+                    caster.visibility_of_samples(r, &samples, None, &mut Scratch::default())
+                );
+            }
+            assert!(
+                binned > receivers.len() * 9 / 10,
+                "{binned} of {}",
+                receivers.len()
+            );
+            assert!(partial > 20, "the scene should have penumbrae ({partial})");
+            empty_total += empty;
+        }
+        assert!(empty_total > 0, "some shafts should hold no box");
+    }
+
+    #[test]
+    fn bvh_traversal_agrees_with_testing_every_triangle() {
+        let center = Vec3::new(0.2, 1.5, -0.1);
+        let s = scene(
+            rect_light(),
+            vec![floor(), sphere("ball", center, 0.6, 8, 12)],
+        );
+        let caster = ShadowRayCaster::new(&s);
+        let mut stack = vec![0u32; caster.depth + 2];
+        let mut blocked = 0;
+        for (i, r) in floor_and_ball_receivers(center, 0.6).iter().enumerate() {
+            let o = r.point.as_dvec3() + caster.origin_offset * r.normal.as_dvec3();
+            for j in 0..16 {
+                let (a, b) = (jitter_pair(i, j), jitter_pair(j, i));
+                let target = DVec3::new(2.0 * a - 1.0, 4.0, 2.0 * b - 1.0);
+                let d = target - o;
+                let brute = caster.triangles.iter().any(|t| t.blocks(o, d));
+                assert_eq!(caster.blocked(o, target, &mut stack), brute);
+                blocked += usize::from(brute);
+            }
+        }
+        assert!(blocked > 100, "{blocked}");
+        // Axis-parallel rays along a flat (axis-aligned) face and through shared edges.
+        for x in [-0.5, 0.0, 0.25] {
+            let o = DVec3::new(x, -0.5, 0.0);
+            for target in [
+                DVec3::new(x, 0.5, 0.0),
+                DVec3::new(x, 0.5, 0.3),
+                DVec3::new(5.0, 0.5, 5.0),
+            ] {
+                let d = target - o;
+                let brute = caster.triangles.iter().any(|t| t.blocks(o, d));
+                assert!(brute, "{o} → {target} crosses the floor top");
+                assert!(caster.blocked(o, target, &mut stack));
+            }
+        }
+    }
+
+    /// A deterministic value in [0,1) for the pair (i, j).
+    fn jitter_pair(i: usize, j: usize) -> f64 {
+        ((i * 7919 + j * 104729) % 1000) as f64 / 1000.0
+    }
+
     #[test]
     fn settings_validation() {
         assert!(RaycastSettings::default().validate().is_ok());
@@ -790,6 +1312,17 @@ mod tests {
                 })
             })
             .collect();
+        let cpu = || -> f64 {
+            // utime + stime of the process, in clock ticks (100 Hz) — fields 14 and 15.
+            let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+            let rest = stat.rsplit(')').next().unwrap_or("");
+            let f: Vec<f64> = rest
+                .split_whitespace()
+                .map(|x| x.parse().unwrap_or(0.0))
+                .collect();
+            (f.get(11).unwrap_or(&0.0) + f.get(12).unwrap_or(&0.0)) / 100.0
+        };
+        let cpu0 = cpu();
         let t = std::time::Instant::now();
         let caster = ShadowRayCaster::new(&s);
         let build = t.elapsed();
@@ -797,10 +1330,11 @@ mod tests {
         let total = t.elapsed();
         let mean: f64 = (0..v.len()).map(|i| f64::from(v.gray(i))).sum::<f64>() / v.len() as f64;
         println!(
-            "{} triangles, BVH build {:?}, 256×256×1024 rays in {:?} on {} threads, mean visibility {mean:.4}",
+            "{} triangles, BVH build {:?}, 256×256×1024 rays in {:?} wall, {:.2} s CPU, on {} threads, mean visibility {mean:.4}",
             caster.triangle_count(),
             build,
             total,
+            cpu() - cpu0,
             rayon::current_num_threads()
         );
     }
