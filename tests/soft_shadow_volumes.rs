@@ -14,6 +14,7 @@
 
 use glam::{DVec2, DVec3, Vec3};
 use penumbra::frame::{Frame, GpuSettings};
+use penumbra::geometry::ssv_wedge::SsvWedge;
 use penumbra::gpu::counters::Counters;
 use penumbra::gpu::vbuffer::{VBuffer8Tile, VBufferFormat, VBufferTile};
 use penumbra::light::coverage::{
@@ -352,4 +353,24 @@ fn textured_light_video_reuses_the_cache() {
     };
     // Coloured shadows: the red half of the light and the blue half cast different shadows.
     assert!(v.iter().any(|c| (c[0] - c[2]).abs() > 0.1));
+}
+
+proptest! {
+    /// The wedge encloses the penumbra volume of its edge (Paper III §3.1): wherever the
+    /// edge's coverage is not zero, the receiver is inside the wedge.
+    #[test]
+    fn wedge_contains_every_point_with_coverage(
+        p in (-3.0..3.0f64, -3.0..3.0f64, 0.2..4.0f64),
+        e0 in (-2.0..2.0f64, -2.0..2.0f64, 0.1..3.0f64),
+        e1 in (-2.0..2.0f64, -2.0..2.0f64, 0.1..3.0f64),
+    ) {
+        let l = unit_light();
+        let pw = point_above(&l, p.0, p.1, p.2);
+        let a = point_above(&l, e0.0, e0.1, e0.2);
+        let b = point_above(&l, e1.0, e1.1, e1.2);
+        let c = edge_coverage_exact(&l, pw, a, b);
+        if let Some(w) = SsvWedge::new(&l, a, b) {
+            prop_assert!(c.abs() < 1e-9 || w.contains(pw), "coverage {c} outside the wedge");
+        }
+    }
 }
