@@ -1,7 +1,7 @@
 //! The one error type user input can produce. Every variant names the file (or built-in
 //! scene), the object and the problem; the CLI prints it on one line and exits with code 2.
 
-use std::fmt;
+use std::fmt::{self, Write};
 
 /// A problem with user input: a scene file, an OBJ, an option, a command-line argument.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -39,12 +39,44 @@ impl InputError {
 }
 
 impl fmt::Display for InputError {
+    /// `file: object: message` (or `file: message`) on one line: control characters in any
+    /// part (a newline in a quoted path, say) are written escaped, e.g. `\n`.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match &self.object {
-            Some(o) => write!(f, "{}: {}: {}", self.file, o, self.message),
-            None => write!(f, "{}: {}", self.file, self.message),
+        write_one_line(f, &self.file)?;
+        if let Some(o) = &self.object {
+            f.write_str(": ")?;
+            write_one_line(f, o)?;
         }
+        f.write_str(": ")?;
+        write_one_line(f, &self.message)
     }
 }
 
+/// Writes `s` with every control character escaped (`\n`, `\r`, `\t`, `\u{..}`).
+fn write_one_line(f: &mut fmt::Formatter<'_>, s: &str) -> fmt::Result {
+    for c in s.chars() {
+        if c.is_control() {
+            write!(f, "{}", c.escape_default())?;
+        } else {
+            f.write_char(c)?;
+        }
+    }
+    Ok(())
+}
+
 impl std::error::Error for InputError {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn display_is_one_line() {
+        let e = InputError::at("a\nb.toml", "light.texture", "cannot open x\r\ny.png");
+        assert_eq!(
+            e.to_string(),
+            "a\\nb.toml: light.texture: cannot open x\\r\\ny.png"
+        );
+        assert_eq!(InputError::new("f", "m").to_string(), "f: m");
+    }
+}

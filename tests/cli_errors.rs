@@ -1,0 +1,351 @@
+//! The command line on bad input (README "Command line", DESIGN.md "Bad input"): every bad
+//! scene file and bad argument gets exactly one line on stderr naming the file and the
+//! problem, exit status 2, and no output at all — the `--out` directory is not created, and an
+//! existing one is left untouched. Plus the good path: one small render writes every
+//! documented file and a `stats.json` with the documented keys, and `penumbra list` prints
+//! the built-in scenes and the methods one per line.
+//!
+//! Runs the built binary (`CARGO_BIN_EXE_penumbra`) at 32×32 with `hard-sv`, so each case
+//! takes milliseconds.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// The crate root (the binary runs there, so relative scene paths match the README).
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A fresh, not yet existing output directory under `CARGO_TARGET_TMPDIR`, unique per call.
+fn fresh_out(tag: &str) -> PathBuf {
+    static N: AtomicUsize = AtomicUsize::new(0);
+    let n = N.fetch_add(1, Ordering::Relaxed);
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("cli_errors-{tag}-{}-{n}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+/// Runs `penumbra ARGS` in the crate root.
+fn penumbra(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_penumbra"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("cannot run the penumbra binary")
+}
+
+/// `penumbra render ARGS --out DIR` with `DIR` fresh; returns the output and `DIR`.
+fn render(tag: &str, args: &[&str]) -> (Output, PathBuf) {
+    let out = fresh_out(tag);
+    let mut all = vec!["render"];
+    all.extend_from_slice(args);
+    all.extend_from_slice(&["--out", out.to_str().expect("UTF-8 temp path")]);
+    (penumbra(&all), out)
+}
+
+/// Asserts the run failed as bad input must: status 2, one line on stderr that names `file`
+/// and contains at least one of `keywords`, nothing on stdout, and no `out` directory.
+fn assert_bad_input(what: &str, (output, out): &(Output, PathBuf), file: &str, keywords: &[&str]) {
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert_eq!(
+        output.status.code(),
+        Some(2),
+        "{what}: exit status {:?}, stderr {stderr:?}",
+        output.status
+    );
+    let lines: Vec<&str> = stderr.lines().collect();
+    assert_eq!(lines.len(), 1, "{what}: stderr is not one line: {stderr:?}");
+    assert!(
+        lines[0].contains(file),
+        "{what}: stderr does not name {file:?}: {stderr:?}"
+    );
+    assert!(
+        keywords.iter().any(|k| lines[0].contains(k)),
+        "{what}: stderr names none of {keywords:?}: {stderr:?}"
+    );
+    assert!(!stderr.contains("panicked"), "{what}: panic: {stderr:?}");
+    assert!(stdout.is_empty(), "{what}: printed on stdout: {stdout:?}");
+    assert!(
+        !out.exists(),
+        "{what}: wrote partial output into {}",
+        out.display()
+    );
+}
+
+/// Arguments of the small render every bad-file case uses.
+const SMALL: &[&str] = &["--width", "32", "--height", "32", "--methods", "hard-sv"];
+
+/// One case per file in `scenes/bad/`: which problem its error line must mention. A new bad
+/// file without an entry here fails [`every_bad_scene_file_is_rejected`].
+const BAD_FILES: &[(&str, &[&str])] = &[
+    ("malformed.toml", &["line"]),
+    (
+        "missing-obj.toml",
+        &["missing", "not found", "No such file", "cannot read"],
+    ),
+    ("open-mesh.toml", &["open"]),
+    ("nan-vertex.toml", &["NaN", "nan", "finite"]),
+    ("nan-light.toml", &["NaN", "nan", "finite"]),
+    ("zero-light.toml", &["zero"]),
+    ("unknown-method.toml", &["unknown method"]),
+];
+
+#[test]
+fn every_bad_scene_file_is_rejected() {
+    let mut files: Vec<String> = std::fs::read_dir(root().join("scenes/bad"))
+        .expect("scenes/bad")
+        .map(|e| e.expect("dir entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml" || e == "json"))
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    files.sort();
+    let mut known: Vec<String> = BAD_FILES.iter().map(|(f, _)| f.to_string()).collect();
+    known.sort();
+    assert_eq!(files, known, "scenes/bad/ and BAD_FILES disagree");
+
+    for (name, keywords) in BAD_FILES {
+        let path = format!("scenes/bad/{name}");
+        // unknown-method.toml's problem is its own method list, which `--methods` would
+        // replace (an override is not an error), so that file runs with its own list.
+        let args: Vec<&str> = if *name == "unknown-method.toml" {
+            vec![path.as_str(), "--width", "32", "--height", "32"]
+        } else {
+            [&[path.as_str()], SMALL].concat()
+        };
+        assert_bad_input(name, &render(name, &args), name, keywords);
+    }
+}
+
+#[test]
+fn bad_input_leaves_an_existing_out_dir_untouched() {
+    let out = fresh_out("existing");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("keep.txt"), "mine").unwrap();
+    let o = out.to_str().unwrap();
+    let output = penumbra(&[
+        "render",
+        "scenes/bad/open-mesh.toml",
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--methods",
+        "hard-sv",
+        "--out",
+        o,
+    ]);
+    assert_eq!(output.status.code(), Some(2));
+    let entries: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(entries, ["keep.txt"]);
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+#[test]
+fn unknown_scene_name_or_path() {
+    assert_bad_input(
+        "unknown built-in",
+        &render("nosuch", &[&["no-such-scene"], SMALL].concat()),
+        "no-such-scene",
+        &["not a built-in", "not found", "No such file"],
+    );
+    assert_bad_input(
+        "missing file",
+        &render("nofile", &[&["scenes/no-such-file.toml"], SMALL].concat()),
+        "scenes/no-such-file.toml",
+        &["not a built-in", "not found", "No such file"],
+    );
+    assert_bad_input(
+        "not a scene file",
+        &render("readme", &[&["README.md"], SMALL].concat()),
+        "README.md",
+        &["extension"],
+    );
+}
+
+#[test]
+fn bad_options_and_methods() {
+    let scene = "single-quad";
+    let small = ["--width", "32", "--height", "32"];
+    let cases: &[(&str, &[&str], &[&str])] = &[
+        (
+            "unknown option",
+            &["--methods", "nsample", "--opt", "nsample.bogus=1"],
+            &["nsample.bogus", "unknown option"],
+        ),
+        (
+            "not a perfect square",
+            &["--methods", "nsample", "--opt", "nsample.n=1000"],
+            &["perfect square"],
+        ),
+        (
+            "tile size",
+            &["--methods", "hard-sv", "--opt", "gpu.tile_size=3"],
+            &["tile_size"],
+        ),
+        (
+            "unknown method",
+            &["--methods", "nosuch"],
+            &["unknown method"],
+        ),
+        (
+            "unknown option table",
+            &["--methods", "hard-sv", "--opt", "bogus.x=1"],
+            &["unknown method"],
+        ),
+        (
+            "option without a value",
+            &["--methods", "hard-sv", "--opt", "hard-sv"],
+            &["METHOD.KEY=VALUE"],
+        ),
+        (
+            "hard-sv option",
+            &["--methods", "hard-sv", "--opt", "hard-sv.bogus=1"],
+            &["unknown option"],
+        ),
+    ];
+    for (what, args, keywords) in cases {
+        let all: Vec<&str> = [&[scene][..], &small, args].concat();
+        // A bad --opt names the option; everything else names the scene.
+        let file = if what.starts_with("option without") {
+            "--opt"
+        } else {
+            scene
+        };
+        assert_bad_input(what, &render(what, &all), file, keywords);
+    }
+    for size in ["0", "100000"] {
+        assert_bad_input(
+            "image size",
+            &render(
+                "size",
+                &[
+                    scene,
+                    "--width",
+                    size,
+                    "--height",
+                    "32",
+                    "--methods",
+                    "hard-sv",
+                ],
+            ),
+            scene,
+            &["width"],
+        );
+    }
+}
+
+/// A path with a line break in it (found by the `scene_json` fuzzer) still gives one line:
+/// the break is printed escaped.
+#[test]
+fn newline_in_a_quoted_path_stays_on_one_line() {
+    let dir = fresh_out("newline-scene");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("newline.toml");
+    std::fs::write(
+        &scene,
+        "[camera]\neye = [0, 2, 5]\ntarget = [0, 0, 0]\nup = [0, 1, 0]\nvfov_deg = 45\n\
+         [light]\ntype = \"point\"\ncenter = [0, 4, 0]\n\
+         [[meshes]]\nobj = \"models/no\\nsuch.obj\"\n",
+    )
+    .unwrap();
+    let run = render("newline", &[&[scene.to_str().unwrap()], SMALL].concat());
+    assert_bad_input("newline in path", &run, "newline.toml", &["no\\nsuch.obj"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Argument syntax errors are clap's (usage text on several lines), but they still exit with
+/// status 2 and write nothing.
+#[test]
+fn argument_syntax_errors_exit_2_without_output() {
+    for args in [
+        &["single-quad", "--width", "abc"][..],
+        &["single-quad", "--no-such-flag"],
+    ] {
+        let (output, out) = render("syntax", args);
+        assert_eq!(output.status.code(), Some(2), "{args:?}");
+        assert!(!out.exists(), "{args:?}: wrote {}", out.display());
+    }
+}
+
+#[test]
+fn small_render_writes_every_documented_output() {
+    let (output, out) = render(
+        "ok",
+        &[
+            "single-quad",
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--methods",
+            "hard-sv",
+        ],
+    );
+    assert_eq!(
+        output.status.code(),
+        Some(0),
+        "stderr: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let dir = out.join("hard-sv");
+    for f in [
+        "image.png",
+        "visibility.png",
+        "visibility.exr",
+        "visibility.pfm",
+        "stats.json",
+        "stencil.png",
+    ] {
+        let len = std::fs::metadata(dir.join(f))
+            .unwrap_or_else(|e| panic!("{f}: {e}"))
+            .len();
+        assert!(len > 0, "{f} is empty");
+    }
+    let stats: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("stats.json")).unwrap()).unwrap();
+    for key in [
+        "method",
+        "width",
+        "height",
+        "wall_seconds",
+        "plan",
+        "passes",
+    ] {
+        assert!(
+            stats.get(key).is_some(),
+            "stats.json lacks {key:?}: {stats}"
+        );
+    }
+    assert_eq!(stats["method"], "hard-sv");
+    assert_eq!(stats["width"], 32);
+    assert_eq!(stats["height"], 32);
+    let passes = stats["passes"].as_array().expect("passes is an array");
+    assert!(!passes.is_empty());
+    for p in passes {
+        for key in ["name", "wall_seconds", "counters"] {
+            assert!(p.get(key).is_some(), "pass lacks {key:?}: {p}");
+        }
+        assert!(p["counters"].is_object(), "{p}");
+    }
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+#[test]
+fn list_prints_scenes_and_methods_one_per_line() {
+    let output = penumbra(&["list"]);
+    assert_eq!(output.status.code(), Some(0));
+    let stdout = String::from_utf8(output.stdout).unwrap();
+    let lines: Vec<&str> = stdout.lines().collect();
+    for name in penumbra::scene::builtin::names() {
+        assert!(lines.contains(name), "list lacks scene {name}: {stdout}");
+    }
+    for m in penumbra::methods::ALL {
+        assert!(lines.contains(m), "list lacks method {m}: {stdout}");
+    }
+}
