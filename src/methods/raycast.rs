@@ -380,8 +380,10 @@ struct Scratch {
 /// (clamped, monotone in `x`).
 #[inline]
 fn cell_of(x: f64, g: usize) -> usize {
-    let c = ((x + 1.0) * 0.5 * g as f64).floor();
-    if c >= 0.0 {
+    // `as usize` truncates (= floor for the non-negative values that reach it), saturates
+    // and maps NaN to 0, all without a libm call.
+    let c = (x + 1.0) * 0.5 * g as f64;
+    if c > 0.0 {
         (c as usize).min(g - 1)
     } else {
         0
