@@ -12,6 +12,9 @@
 //!
 //! - [`coverage_texture`]: the 4D coverage texture of Paper III §3.3 (grey and RGB for textured
 //!   lights), computed once per light shape and cached.
+//!
+//! - [`lookup_tables`]: the lookup tables of Paper IV's optimized shaders (atan2 cube map, area
+//!   tables, split table) at the paper's sizes and bit depths (§4.2.1, §4.2.2, §4.3, §6).
 
 pub mod coverage;
 pub mod coverage_texture;
