@@ -31,6 +31,10 @@
 //! sector area for the sphere, and exact clipping ([`coverage::edge_coverage_exact`]) for the
 //! rectangle.
 //!
+//! Options: `coverage = tables|exact`, `filter = bilinear|nearest` (area table), `split =
+//! stencil|plane`, `wedge = tight|bounding-sphere`, `overlap = off|loops`, `light_split = 1…4`,
+//! `reserved_bits = 1…7` (default 5), `mode = auto|zpass|zfail`.
+//!
 //! Improvements (§5): `overlap = "loops"` renders every silhouette loop
 //! ([`crate::geometry::loops::silhouette_loops`]) into its own V-buffer and combines the loops'
 //! coverages `c = max(c_A, c_B) + ½·min(c_A, c_B)` (eq. 1), folded over the loops in order;
@@ -112,6 +116,8 @@ pub struct Settings {
     pub format: SplitFormat,
     /// Use z-fail (with caps) for pass 1.
     pub zfail: bool,
+    /// Tighter wedges for rectangular lights (§4.1); `false`: wedges of the bounding sphere.
+    pub tight_wedges: bool,
 }
 
 /// A light (or a piece of one) as the shaders see it.
@@ -153,20 +159,26 @@ impl LightModel {
         }
     }
 
-    /// The corners the wedge encloses (tight_wedge: the rectangle's four corners, the sphere's
-    /// bounding cube).
-    pub fn corners(&self) -> Vec<DVec3> {
+    /// The corners the wedge encloses (tight_wedge): with `tight`, the rectangle's four corners
+    /// (§4.1); otherwise — and always for a sphere — the corners of the cube around the light's
+    /// bounding sphere (the looser wedge of a spherical bound, Paper III §3.1 / Paper IV §4.1
+    /// "our previously presented method created wedges from bounding spheres").
+    pub fn corners(&self, tight: bool) -> Vec<DVec3> {
+        let cube = |center: DVec3, radius: f64| -> Vec<DVec3> {
+            (0..8)
+                .map(|i| {
+                    let s = |b: usize| if i & b == 0 { -1.0 } else { 1.0 };
+                    center + DVec3::new(s(1), s(2), s(4)) * radius
+                })
+                .collect()
+        };
         match self {
-            LightModel::Rect(r) => [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+            LightModel::Rect(r) if tight => [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
                 .iter()
                 .map(|(s, t)| r.center + r.u * *s + r.v * *t)
                 .collect(),
-            LightModel::Sphere { center, radius } => (0..8)
-                .map(|i| {
-                    let s = |b: usize| if i & b == 0 { -1.0 } else { 1.0 };
-                    *center + DVec3::new(s(1), s(2), s(4)) * *radius
-                })
-                .collect(),
+            LightModel::Rect(r) => cube(r.center, (r.u + r.v).length().max((r.u - r.v).length())),
+            LightModel::Sphere { center, radius } => cube(*center, *radius),
         }
     }
 
@@ -323,6 +335,7 @@ pub fn read_settings(r: &mut OptionReader, frame: &Frame) -> Result<Settings, In
         _ => HalfSplit::Stencil,
     };
     let overlap = r.choice("overlap", &["off", "loops"], "off")? == "loops";
+    let tight_wedges = r.choice("wedge", &["tight", "bounding-sphere"], "tight")? == "tight";
     let light_split = r.uint("light_split", 1, 1..=4)? as u32;
     let reserved = r.uint("reserved_bits", 5, 1..=7)? as u32;
     let format = SplitFormat::new(reserved).map_err(|e| {
@@ -369,6 +382,7 @@ pub fn read_settings(r: &mut OptionReader, frame: &Frame) -> Result<Settings, In
         light_split,
         format,
         zfail,
+        tight_wedges,
     })
 }
 
@@ -456,7 +470,7 @@ fn render_group(
     let (lo, hi) = frame.scene.bounds();
     let margin = (hi - lo).length() as f64 * 0.01 + 1e-3;
     let (lo, hi) = (lo.as_dvec3() - margin, hi.as_dvec3() + margin);
-    let corners = light.corners();
+    let corners = light.corners(s.tight_wedges);
     let c = light.center();
 
     // Wedge halves in edge order (inner, then outer).
