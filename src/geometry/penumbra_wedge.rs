@@ -168,22 +168,22 @@ impl Wedge {
         self.planes.iter().all(|pl| pl.eval(p) <= 0.0)
     }
 
-    /// The plane through which the ray `origin + t·dir` leaves the wedge: among the planes the
-    /// ray moves outward through (`n·dir > 0`), the one it reaches first (Paper I §6: "the exit
-    /// point is found by computing the intersection of the ray with all back facing planes,
-    /// and picking the closest").
-    pub fn exit_plane(&self, origin: DVec3, dir: DVec3) -> Option<FaceKind> {
-        let mut best: Option<(f64, FaceKind)> = None;
+    /// The plane through which the ray `origin + t·dir` leaves the wedge, and the ray
+    /// parameter there: among the planes the ray moves outward through (`n·dir > 0`), the one it
+    /// reaches first (Paper I §6: "the exit point is found by computing the intersection of the
+    /// ray with all back facing planes, and picking the closest").
+    pub fn exit(&self, origin: DVec3, dir: DVec3) -> Option<(FaceKind, f64)> {
+        let mut best: Option<(FaceKind, f64)> = None;
         for (pl, kind) in self.planes.iter().zip(FACE_ORDER) {
             let den = pl.n.dot(dir);
             if den > 0.0 {
                 let t = -pl.eval(origin) / den;
-                if best.is_none_or(|(bt, _)| t < bt) {
-                    best = Some((t, kind));
+                if best.is_none_or(|(_, bt)| t < bt) {
+                    best = Some((kind, t));
                 }
             }
         }
-        best.map(|(_, k)| k)
+        best
     }
 }
 

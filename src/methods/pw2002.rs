@@ -8,12 +8,10 @@
 //! scene depth (Paper I §4 line 2, "visible fragment") does:
 //! * `p = point(x, y, z)`: the pixel center un-projected at the stored depth
 //!   ([`crate::gpu::transform::Projection::unproject`], f64);
-//! * entry value `v_f`: 255 when the triangle lies in the front plane, 0 otherwise (back plane:
-//!   s = 0; side planes: §5, the entry and exit values on a shared side plane cancel between
-//!   neighbours, so both are taken as 0; bottom: s = 0);
-//! * `p_i`: p if it is inside the wedge, else the exit point, found as the nearest plane the
-//!   eye ray leaves through (Paper I §6); value `v_i = li_amount(s(p))` inside, 255 if the exit
-//!   is the front plane, 0 otherwise;
+//! * entry value `v_f = li_amount(s(p_f))` at the entry point p_f, the eye ray's intersection
+//!   with the rasterized triangle's plane;
+//! * `p_i`: p if it is inside the wedge, else the exit point p_b, found as the nearest plane the
+//!   eye ray leaves through (Paper I §6); `v_i = li_amount(s(p_i))`;
 //! * `addToLIBuffer(v_i − v_f)` (skipped when 0, so no write happens).
 //!
 //! Choice: Paper I writes `round(255·(s_i − s_f))`; we add `li_amount(s_i) − li_amount(s_f)`
@@ -22,7 +20,9 @@
 //! no point; their p is never inside a wedge. Visibility = clamp(LI, 0, 255)/255.
 //!
 //! Options (`[options.pw2002]`, shared with `pw-restructured` by [`read_wedge_settings`]):
-//! `li = 16|12|8` (bits), `overflow = wrap|saturate`, `falloff = linear|smoothstep`
+//! `side_planes = compute|cancel` ([`SidePlanes`]: the §4 pseudocode, default, or the §5
+//! shortcut — 255 on front planes, 0 on back and side planes), `li = 16|12|8` (bits),
+//! `overflow = wrap|saturate`, `falloff = linear|smoothstep`
 //! (s' = 3s² − 2s³, §4.2), `corner_wedges = on|off` (Fig. 7), `parallel_rule = on|off` (§8).
 //! The eye is assumed to be outside every shadow (Paper I §8); `pw-restructured` handles the
 //! other case.
@@ -44,6 +44,19 @@ use crate::plan::{BufferPlan, MethodPlan};
 use crate::scene::LightShape;
 use std::time::Instant;
 
+/// How `pw2002` values the points where an eye ray enters or leaves a wedge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum SidePlanes {
+    /// Paper I §4 pseudocode: s is computed at the entry point p_f and at the exit point p_b.
+    /// Where a neighbour's wedge does not continue across a shared side plane (degenerate
+    /// wedges, Fig. 6), the ray keeps the intensity of the point where it left.
+    Compute,
+    /// Paper I §5 optimization (and what Paper II §3 builds on): 255 on the front plane, 0 on
+    /// the back plane, 0 on side planes because neighbours cancel. This is what
+    /// `pw-restructured` computes, so the two agree bit for bit in this mode.
+    Cancel,
+}
+
 /// Settings shared by both penumbra-wedge methods.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct WedgeSettings {
@@ -53,6 +66,8 @@ pub struct WedgeSettings {
     pub overflow: LiOverflow,
     /// Smoothstep falloff s' = 3s² − 2s³.
     pub smooth: bool,
+    /// Values at entry and exit points (pw2002 only; Paper I §4 vs §5).
+    pub side_planes: SidePlanes,
     /// Number of lights n (LI amounts scaled by 255/n, Paper I §7). Scenes hold one light.
     pub lights: u32,
     /// Wedge construction options.
@@ -76,6 +91,10 @@ pub fn read_wedge_settings(
     let smooth = r.choice("falloff", &["linear", "smoothstep"], "linear")? == "smoothstep";
     let corner = r.choice("corner_wedges", &["on", "off"], "on")? == "on";
     let parallel = r.choice("parallel_rule", &["on", "off"], "on")? == "on";
+    let side_planes = match r.choice("side_planes", &["compute", "cancel"], "compute")? {
+        "cancel" => SidePlanes::Cancel,
+        _ => SidePlanes::Compute,
+    };
     let scene = frame.scene;
     let radius = match scene.light.shape {
         LightShape::Sphere { radius } => radius as f64,
@@ -91,6 +110,7 @@ pub fn read_wedge_settings(
         li,
         overflow,
         smooth,
+        side_planes,
         lights: 1,
         wedge: WedgeOptions {
             center: scene.light.center.as_dvec3(),
@@ -172,7 +192,23 @@ pub fn render_li(
                 return;
             };
             let w = &set.wedges[wi as usize];
-            let v_f = if kind == FaceKind::Front { full } else { 0 };
+            let dir = frame.proj.unproject(f.x, f.y, 0.5) - eye;
+            // The value at a wedge boundary point: §5 (`cancel`) uses 255 on the front plane and 0
+            // elsewhere; the §4 pseudocode (`compute`) evaluates s at the point itself.
+            let boundary = |k: FaceKind, t: f64| match s.side_planes {
+                SidePlanes::Cancel => {
+                    if k == FaceKind::Front {
+                        full
+                    } else {
+                        0
+                    }
+                }
+                SidePlanes::Compute => {
+                    li_amount(light_intensity(w, eye + dir * t, s.smooth), s.lights)
+                }
+            };
+            let entry = w.plane(kind);
+            let v_f = boundary(kind, -entry.eval(eye) / entry.n.dot(dir));
             let stored = depth.values[f.local];
             let p = frame
                 .proj
@@ -180,12 +216,7 @@ pub fn render_li(
             let v_i = if stored != far && w.contains(p) {
                 li_amount(light_intensity(w, p, s.smooth), s.lights)
             } else {
-                let dir = frame.proj.unproject(f.x, f.y, 0.5) - eye;
-                if w.exit_plane(eye, dir) == Some(FaceKind::Front) {
-                    full
-                } else {
-                    0
-                }
+                w.exit(eye, dir).map_or(0, |(k, t)| boundary(k, t))
             };
             let delta = v_i - v_f;
             if delta != 0 {

@@ -32,7 +32,8 @@
 //! * z-pass or z-fail: `mode = auto` picks z-fail when [`crate::plan::eye_in_shadow`] finds the
 //!   near plane in the shadow of a point of the light.
 //!
-//! Options: those of `pw2002` plus `passes = single|three`, `culling = zmin-zmax|zmax|off`,
+//! Options: those of `pw2002` (its `side_planes` has no effect here: the restructured
+//! algorithm never visits side planes, it is the `cancel` form by construction) plus `passes = single|three`, `culling = zmin-zmax|zmax|off`,
 //! `mode = auto|zpass|zfail`.
 
 use super::options::OptionReader;
@@ -51,6 +52,7 @@ use crate::gpu::raster::{bin, draw, Fragment};
 use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::stencil::{StencilFace, StencilOp, StencilState};
 use crate::plan::{eye_in_shadow, representative_light_points, BufferPlan, MethodPlan};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 /// Counting direction.
@@ -147,9 +149,18 @@ struct Ctx<'a> {
     screen: Vec<ScreenWedge>,
     tris: Vec<WedgeTriangle>,
     s: RestructuredSettings,
+    /// (tile, triangle) pairs whose tile zmin/zmax were tested (0 with culling off).
+    tile_tests: AtomicU64,
 }
 
 impl Ctx<'_> {
+    /// Count one tile zmin/zmax test (an integer sum: independent of thread scheduling).
+    fn count_tile_test(&self) {
+        if self.s.culling != Culling::Off {
+            self.tile_tests.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+
     /// Umbra sign of a front-plane or cap fragment (per §3/§5): the LI amount it adds when its
     /// depth condition holds.
     fn umbra_value(&self, front_facing: bool) -> i32 {
@@ -276,6 +287,7 @@ fn li_pass(
         |t, _, tri, c| {
             let roles = ctx.roles(tri);
             let (u, p) = culls(t, tri);
+            ctx.count_tile_test();
             c.tiles_culled_hiz += (umbra && roles.umbra && u) as u64;
             c.tiles_culled_hiz += (penumbra && roles.penumbra && p) as u64;
             u && p
@@ -323,12 +335,13 @@ fn raster_triangles(
     (rt, c)
 }
 
-/// Render the LI buffer of `pw-restructured` (tile-major); returns it with per-pass stats.
+/// Render the LI buffer of `pw-restructured` (tile-major); returns it with per-pass stats and
+/// the number of (tile, triangle) pairs whose tile zmin/zmax were read for a culling test.
 pub fn render_li(
     frame: &Frame,
     set: &WedgeSet,
     s: &RestructuredSettings,
-) -> (Vec<LiTile>, Vec<PassStats>) {
+) -> (Vec<LiTile>, Vec<PassStats>, u64) {
     let mut tris = Vec::new();
     if s.test == WedgeTest::ZFail {
         tris.extend(cap_triangles(set, &frame.proj));
@@ -344,6 +357,7 @@ pub fn render_li(
             .collect(),
         tris,
         s: *s,
+        tile_tests: AtomicU64::new(0),
     };
     let tiling = &frame.tiling;
     let mut tiles = alloc_tiles(tiling, |_, len| RTile {
@@ -401,7 +415,8 @@ pub fn render_li(
             });
         }
     }
-    (tiles.into_iter().map(|t| t.li).collect(), stats)
+    let tile_tests = ctx.tile_tests.load(Ordering::Relaxed);
+    (tiles.into_iter().map(|t| t.li).collect(), stats, tile_tests)
 }
 
 /// One stencil pass of the three-pass umbra: DECR for front-facing, INCR for back-facing
@@ -427,6 +442,7 @@ fn stencil_pass(ctx: &Ctx, stencil: &mut [StencilTile], rt: &[RasterTriangle]) -
         &bins,
         |t, _, tri, c| {
             let culled = ctx.umbra_culled(t, tri);
+            ctx.count_tile_test();
             c.tiles_culled_hiz += culled as u64;
             culled
         },
@@ -445,7 +461,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let start = Instant::now();
     let (s, mode) = read_settings(frame)?;
     let set = frame_wedges(frame, &s.wedge)?;
-    let (tiles, passes) = render_li(frame, &set, &s);
+    let (tiles, passes, _) = render_li(frame, &set, &s);
     let li = li_row_major(frame, &tiles);
     let mut names = vec![frame.pass.name.clone()];
     names.extend(passes.iter().map(|p| p.name.clone()));
