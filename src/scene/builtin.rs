@@ -12,9 +12,9 @@
 //! | `eye-in-shadow` | a 4×3 slab above the camera + a floating box in the lit region | rect ½-extents 0.4 | 36 |
 //! | `overlap-stress` | 300 stacked 1.2×1.2 two-sided quads, spacing 0.002 | point | 1212 |
 //! | `cube-of-spheres-sphere` | as `cube-of-spheres` | sphere r 0.5 at the same center | 4548 |
-//! | `pw-columns` | Paper II Fig. 9 analogue: 2×4 columns (16 segments, r 0.15, h 1.6) | sphere r 0.3 | 780 |
-//! | `pw-fractal` | Paper II Fig. 10 analogue: closed 24×24 midpoint-displacement landscape | sphere r 0.4 | 1250 |
-//! | `pw-2002` | Paper II Fig. 11 analogue: "2002" in seven-segment boxes at y = 0.9 | sphere r 0.25 | 216 |
+//! | `pw-columns` | Paper II Fig. 9 analogue: 2×4 columns (16 segments, r 0.15, h 1.6) | sphere r 0.3 | 524 |
+//! | `pw-fractal` | Paper II Fig. 10 analogue: closed 24×24 midpoint-displacement landscape | sphere r 0.4 | 1440 |
+//! | `pw-2002` | Paper II Fig. 11 analogue: "2002" in seven-segment boxes at y = 0.9 | sphere r 0.25 | 276 |
 
 use super::procedural::{box_mesh, cylinder, two_sided_quad, uv_sphere};
 use super::{Camera, Light, LightShape, Mesh, RawOptions, Scene};
@@ -467,6 +467,10 @@ mod tests {
         assert_eq!(count("cylinder"), 12 + 96);
         assert_eq!(count("eye-in-shadow"), 36);
         assert_eq!(count("overlap-stress"), 12 + 300 * 4);
+        assert_eq!(count("cube-of-spheres-sphere"), 12 + 27 * 168);
+        assert_eq!(count("pw-columns"), 12 + 8 * 64);
+        assert_eq!(count("pw-fractal"), 24 * 24 * 2 + 96 * 3);
+        assert_eq!(count("pw-2002"), 12 + 22 * 12);
     }
 
     /// The light's extent (a bounding sphere of its shape) clears every mesh's bounding box.
