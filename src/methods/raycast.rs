@@ -24,6 +24,17 @@
 //! `t ∈ (ε, 1 − ε)` of the segment `o + t·(s − o)`, `ε = `[`SEGMENT_EPSILON`] (the far end
 //! keeps a light that lies on a surface from being blocked by that surface).
 //!
+//! # Self-occlusion
+//!
+//! A light sample at or below the receiver's tangent plane (`n·(s − p) ≤ 0`) is blocked by the
+//! receiver's own surface: the meshes are closed, so the solid lies locally below that plane.
+//! Without this rule the normal offset would lift a receiver on a facet facing away from (part
+//! of) the light out of its own object's shadow — near terminators of faceted spheres, rays
+//! from the offset origin graze past the object and report light that the surface point cannot
+//! see, while every shadow-volume method (the receiver is inside its own object's volume)
+//! correctly reports shadow. Measured on `cube-of-spheres` with a point light at 256²: 147 of
+//! the 159 pixels where `raycast` and `hard-sv` disagreed were such receivers.
+//!
 //! Each ray–triangle test is Möller–Trumbore in f64 on the f32 vertices, edges and vertices
 //! inclusive (a ray through a shared edge of a closed mesh cannot leak), no back-face culling.
 //! It is a pure function of the ray and the triangle, and a ray is blocked if *any* triangle
@@ -507,6 +518,14 @@ impl ShadowRayCaster {
         scratch.lit.resize(samples.len(), true);
         if !self.nodes.is_empty() && !self.trace_binned(origin, samples, quad, scratch) {
             self.trace_each(origin, samples, scratch);
+        }
+        // The receiver's own surface hides every sample at or below its tangent plane (module
+        // doc, "Self-occlusion").
+        let (p, n) = (r.point.as_dvec3(), r.normal.as_dvec3());
+        for (s, lit) in samples.iter().zip(scratch.lit.iter_mut()) {
+            if n.dot(s.position.as_dvec3() - p) <= 0.0 {
+                *lit = false;
+            }
         }
         let mut visible = [0.0f64; 3];
         let mut total = [0.0f64; 3];
