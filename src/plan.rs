@@ -112,6 +112,26 @@ pub struct BufferPlan {
     pub bytes_per_sample: u32,
 }
 
+impl BufferPlan {
+    /// The frame's scene depth buffer, in the format the frame uses.
+    pub fn depth(gpu: &crate::frame::GpuSettings) -> Self {
+        Self {
+            name: "depth".into(),
+            format: format!("{:?}", gpu.depth),
+            bytes_per_sample: gpu.depth.bytes() as u32,
+        }
+    }
+
+    /// An 8-bit stencil buffer.
+    pub fn stencil8() -> Self {
+        Self {
+            name: "stencil".into(),
+            format: "S8".into(),
+            bytes_per_sample: 1,
+        }
+    }
+}
+
 /// What one method will do for this frame.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct MethodPlan {

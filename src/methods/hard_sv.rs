@@ -209,18 +209,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let plan = MethodPlan {
         method: "hard-sv".into(),
         passes: vec![frame.pass.name.clone(), name.into()],
-        buffers: vec![
-            BufferPlan {
-                name: "depth".into(),
-                format: format!("{:?}", frame.gpu.depth),
-                bytes_per_sample: frame.gpu.depth.bytes() as u32,
-            },
-            BufferPlan {
-                name: "stencil".into(),
-                format: "S8".into(),
-                bytes_per_sample: 1,
-            },
-        ],
+        buffers: vec![BufferPlan::depth(&frame.gpu), BufferPlan::stencil8()],
         settings: serde_json::json!({ "mode": mode, "resolved": settings, "gpu": frame.gpu }),
     };
     let passes = vec![frame.pass.clone(), pass];

@@ -121,16 +121,8 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             format!("{pass_name} ×{}", samples.len()),
         ],
         buffers: vec![
-            BufferPlan {
-                name: "depth".into(),
-                format: format!("{:?}", frame.gpu.depth),
-                bytes_per_sample: frame.gpu.depth.bytes() as u32,
-            },
-            BufferPlan {
-                name: "stencil".into(),
-                format: "S8".into(),
-                bytes_per_sample: 1,
-            },
+            BufferPlan::depth(&frame.gpu),
+            BufferPlan::stencil8(),
             BufferPlan {
                 name: "accumulator".into(),
                 format: "f64x3".into(),

@@ -766,16 +766,8 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         method: "ssv-optimized".into(),
         passes: vec![frame.pass.name.clone(), "soft-shadow-volumes".into()],
         buffers: vec![
-            BufferPlan {
-                name: "depth".into(),
-                format: format!("{:?}", frame.gpu.depth),
-                bytes_per_sample: frame.gpu.depth.bytes() as u32,
-            },
-            BufferPlan {
-                name: "stencil".into(),
-                format: "S8".into(),
-                bytes_per_sample: 1,
-            },
+            BufferPlan::depth(&frame.gpu),
+            BufferPlan::stencil8(),
             BufferPlan {
                 name: "v-buffer".into(),
                 format: format!(
