@@ -162,6 +162,27 @@ impl Wedge {
         &self.planes[FACE_ORDER.iter().position(|k| *k == kind).unwrap_or(0)]
     }
 
+    /// The front plane's part of the outer soft shadow volume, `(b, a, P_a, P_b)` as two
+    /// triangles, wound outward like a shadow-volume quad. Consecutive quads share their far
+    /// lines, so with the top and bottom caps they close the volume even where the wedge itself
+    /// is degenerate (Fig. 6) and the quad self-intersects.
+    pub fn umbra_front_quad(&self) -> [[DVec3; 3]; 2] {
+        let [pa, pb] = self.far_front;
+        [[self.b, self.a, pa], [self.b, pa, pb]]
+    }
+
+    /// Whether the wedge's front face is exactly [`Wedge::umbra_front_quad`] (same vertices):
+    /// false for degenerate wedges whose side planes cross (Fig. 6).
+    pub fn front_face_is_quad(&self) -> bool {
+        let mut quad = vec![self.a, self.b, self.far_front[0], self.far_front[1]];
+        quad.dedup();
+        self.faces.iter().any(|(k, poly)| {
+            *k == FaceKind::Front
+                && poly.len() == quad.len()
+                && quad.iter().all(|q| poly.contains(q))
+        })
+    }
+
     /// Whether `p` lies inside (or on) all five planes.
     #[inline]
     pub fn contains(&self, p: DVec3) -> bool {

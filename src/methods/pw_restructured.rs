@@ -16,6 +16,12 @@
 //!   of (z-fail) the rasterized face by the depth test — implied in exact arithmetic, and it
 //!   makes the umbra and penumbra contributions agree on the discrete depth buffer, so that
 //!   with the eye outside all shadows this method and `pw2002` add the same integers.
+//! * **Degenerate wedges** (Paper I Fig. 6: side planes crossing): the wedge's front face is
+//!   then smaller than the quad `(b, a, P_a, P_b)` between its far front lines, which would
+//!   leave a hole in the umbra surface (dark streaks to infinity). Choice: such a wedge's front
+//!   face carries only penumbra and its umbra is drawn with that quad
+//!   ([`Wedge::umbra_front_quad`](crate::geometry::penumbra_wedge::Wedge::umbra_front_quad)),
+//!   submitted after all wedges.
 //! * **Three-pass** (§6.1): the front planes go to an 8-bit stencil cleared to 128 (the offset
 //!   trick for an unsigned, saturating stencil): front-facing fragments DECR, then back-facing
 //!   ones INCR (on depth pass for z-pass, depth fail for z-fail); a full-screen pass adds
@@ -149,6 +155,10 @@ struct Ctx<'a> {
     screen: Vec<ScreenWedge>,
     tris: Vec<WedgeTriangle>,
     s: RestructuredSettings,
+    /// Per wedge: whether its front face is the outer-volume quad (not degenerate).
+    front_is_quad: Vec<bool>,
+    /// Index of the first umbra-only quad of a degenerate wedge in `tris`.
+    umbra_quads_from: usize,
     /// (tile, triangle) pairs whose tile zmin/zmax were tested (0 with culling off).
     tile_tests: AtomicU64,
 }
@@ -172,13 +182,20 @@ impl Ctx<'_> {
     }
 
     fn roles(&self, tri: &RasterTriangle) -> Roles {
+        if tri.prim as usize >= self.umbra_quads_from {
+            return Roles {
+                umbra: true,
+                penumbra: false,
+            };
+        }
         let wt = &self.tris[tri.prim as usize];
+        let degenerate = wt.wedge.is_some_and(|w| !self.front_is_quad[w as usize]);
         let penumbra_facing = match self.s.test {
             WedgeTest::ZPass => tri.front_facing,
             WedgeTest::ZFail => !tri.front_facing,
         };
         Roles {
-            umbra: wt.kind.is_none_or(|k| k == FaceKind::Front),
+            umbra: wt.kind.is_none_or(|k| k == FaceKind::Front && !degenerate),
             penumbra: wt.wedge.is_some() && penumbra_facing,
         }
     }
@@ -347,7 +364,22 @@ pub fn render_li(
         tris.extend(cap_triangles(set, &frame.proj));
     }
     tris.extend(wedge_triangles(set, &frame.proj));
+    // Degenerate wedges (Fig. 6): their front face only carries penumbra; the umbra uses the
+    // outer-volume quad, submitted after all wedges, so the umbra surface stays closed.
+    let front_is_quad: Vec<bool> = set.wedges.iter().map(|w| w.front_face_is_quad()).collect();
+    let umbra_quads_from = tris.len();
+    for (wi, w) in set.wedges.iter().enumerate() {
+        if !front_is_quad[wi] {
+            tris.extend(w.umbra_front_quad().map(|t| WedgeTriangle {
+                clip: t.map(|p| frame.proj.clip_point(p.as_vec3())),
+                wedge: Some(wi as u32),
+                kind: Some(FaceKind::Front),
+            }));
+        }
+    }
     let ctx = Ctx {
+        front_is_quad,
+        umbra_quads_from,
         frame,
         set,
         screen: set
