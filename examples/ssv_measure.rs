@@ -3,26 +3,58 @@
 //! 585 MB, depth and V-buffer/stencil accesses only).
 //!
 //! `cargo run --release --example ssv_measure [SIZE] [SCENE…]` (default 256,
-//! `cube-of-spheres single-quad`). Times are informational (wall clock, all threads); counters
+//! `cube-of-spheres single-quad`); `cargo run --release --example ssv_measure textures` times
+//! the coverage-texture precomputation instead (grey n = 8…64, RGB n = 32). Times are informational (wall clock, all threads); counters
 //! are deterministic. The scene depth pass is excluded from every method's bytes.
 
 use penumbra::frame::{Frame, GpuSettings};
 use penumbra::gpu::counters::Counters;
 use penumbra::gpu::vbuffer::VBufferFormat;
-use penumbra::light::coverage_texture::CoverageFilter;
+use penumbra::light::coverage_texture::{CoverageFilter, CoverageTexture, CoverageTextureKey};
 use penumbra::methods::hard_sv::ShadowTest;
 use penumbra::methods::ssv::{render, CoverageMode, SsvSettings};
 use penumbra::methods::{self};
 use penumbra::metrics::compare;
-use penumbra::scene::{builtin, OptionValue};
+use penumbra::scene::{builtin, OptionValue, RgbTexture};
 use std::time::Instant;
 
 fn mb(bytes: u64) -> f64 {
     bytes as f64 / 1e6
 }
 
+/// Time the coverage-texture precomputation (Paper III §3.3: "less than 3 minutes" for n = 32
+/// on a Pentium 4 1.7 GHz, naive implementation).
+fn time_textures() {
+    for n in [8, 16, 32, 64] {
+        let t = Instant::now();
+        let tex = CoverageTexture::compute(&CoverageTextureKey::uniform(n));
+        println!(
+            "grey n = {n}: {} bytes in {:.2} s",
+            tex.bytes(),
+            t.elapsed().as_secs_f64()
+        );
+    }
+    let light = RgbTexture {
+        width: 2,
+        height: 1,
+        texels: vec![[1.0, 0.3, 0.0], [0.0, 0.3, 1.0]],
+        source: "two colours".into(),
+    };
+    let t = Instant::now();
+    let tex = CoverageTexture::compute(&CoverageTextureKey::textured(32, &light));
+    println!(
+        "RGB n = 32: {} bytes in {:.2} s",
+        tex.bytes(),
+        t.elapsed().as_secs_f64()
+    );
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.first().map(String::as_str) == Some("textures") {
+        time_textures();
+        return;
+    }
     let size: u32 = args.first().and_then(|a| a.parse().ok()).unwrap_or(256);
     let scenes: Vec<String> = if args.len() > 1 {
         args[1..].to_vec()

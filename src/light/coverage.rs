@@ -192,7 +192,14 @@ pub fn segment_coverage(a: DVec2, b: DVec2) -> f64 {
 /// The region whose area [`segment_coverage`] measures, as a convex polygon in light
 /// coordinates: the quad `a, b, b∞, a∞` clipped to the light square `[−1, 1]²` (Paper III
 /// §3.3; textured lights weight it by the light texture).
+///
+/// When the line through `a` and `b` passes exactly through the center the quad degenerates
+/// (the receiver lies in the plane of the hard shadow quad) and the region is empty, as
+/// [`edge_coverage_exact`] is 0 there.
 pub fn segment_region(a: DVec2, b: DVec2) -> Vec<DVec2> {
+    if a.perp_dot(b) == 0.0 {
+        return Vec::new();
+    }
     let quad = [a.extend(1.0), b.extend(1.0), b.extend(0.0), a.extend(0.0)];
     clip_to_light(&quad)
 }
