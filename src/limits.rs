@@ -19,3 +19,7 @@ pub const MAX_IMAGE_SIZE: u32 = 16384;
 pub const GUARD_BAND: f64 = 4.0;
 /// Largest D24 value, 2^24 − 1.
 pub const D24_MAX: u32 = (1 << 24) - 1;
+/// Largest |window coordinate| in pixels a vertex may have after clipping: 2^20. The guard
+/// band keeps real vertices below (GUARD_BAND + 1)/2 · MAX_IMAGE_SIZE ≈ 41,000 px; with
+/// 8 sub-pixel bits, coordinates stay below 2^28 and edge-function products below 2^58.
+pub const WINDOW_LIMIT: f32 = 1_048_576.0;

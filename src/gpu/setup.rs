@@ -17,7 +17,7 @@ use super::clip::{clip_triangle, fully_inside};
 use super::counters::Counters;
 use super::fixed::Fixed8;
 use super::transform::{viewport, ClipVertex};
-use crate::limits::FIXED_ONE;
+use crate::limits::{FIXED_ONE, WINDOW_LIMIT};
 
 /// Which facing to discard before rasterization.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -117,12 +117,20 @@ pub fn setup_triangle(
     }
 }
 
-/// Snapped image-space position (fixed point) and window depth of a clipped vertex.
-fn window_vertex(v: ClipVertex, width: u32, height: u32) -> (i64, i64, f32) {
+/// Snapped image-space position (fixed point) and window depth of a clipped vertex, or `None`
+/// when the window position is not finite or lies beyond [`WINDOW_LIMIT`] pixels — possible
+/// only for degenerate clip input (w within rounding error of 0 after clipping), never for a
+/// vertex inside the guard band. Such triangles are dropped, which keeps every edge-function
+/// product inside i64.
+fn window_vertex(v: ClipVertex, width: u32, height: u32) -> Option<(i64, i64, f32)> {
     let [xw, yw, zw] = viewport(v, width, height);
+    let inside = |c: f32| c.is_finite() && c.abs() <= WINDOW_LIMIT;
+    if !(inside(xw) && inside(yw) && zw.is_finite()) {
+        return None;
+    }
     let x = Fixed8::snap(xw);
     let y = Fixed8::snap(yw).flip_y(height);
-    (x.0, y.0, zw)
+    Some((x.0, y.0, zw))
 }
 
 fn setup_clipped(
@@ -133,7 +141,10 @@ fn setup_clipped(
     height: u32,
     out: &mut Vec<RasterTriangle>,
 ) {
-    let mut v = tri.map(|c| window_vertex(c, width, height));
+    let [Some(a), Some(b), Some(c)] = tri.map(|c| window_vertex(c, width, height)) else {
+        return;
+    };
+    let mut v = [a, b, c];
     // Image-space signed area ×2 (y down). Counter-clockwise in GL (y up) = negative here.
     let area = (v[1].0 - v[0].0) * (v[2].1 - v[0].1) - (v[1].1 - v[0].1) * (v[2].0 - v[0].0);
     if area == 0 {
@@ -286,5 +297,19 @@ mod tests {
         // and `top` (image above): belongs to the triangle for which it is a bottom edge: `top`.
         assert!(covered(&out[2], 0, 3));
         assert!(!covered(&out[0], 0, 3));
+    }
+
+    #[test]
+    fn degenerate_tiny_w_after_clipping_is_dropped_not_overflowed() {
+        // Found by the `raster` fuzz target: w ≈ 1e-39 leaves x/w ≈ 1e23 after clipping.
+        let mut out = Vec::new();
+        let mut c = Counters::default();
+        let tri = [
+            ClipVertex([0.0, 0.0, -2.0, 0.0]),
+            ClipVertex([1.0000075, 0.0, 0.5, 2.204052e-39]),
+            ClipVertex([-2.0, 5.831554e-39, 5.7856363e-39, 2.2779508e-41]),
+        ];
+        setup_triangle(&tri, 0, CullMode::None, 32, 32, &mut out, &mut c);
+        assert!(out.iter().all(|t| t.bbox[2] < 32 && t.bbox[3] < 32));
     }
 }
