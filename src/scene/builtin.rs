@@ -271,7 +271,8 @@ fn pw_columns() -> Scene {
 const FRACTAL_N: usize = 24;
 
 /// Paper II Fig. 10 analogue ("fractal scene"): a closed heightfield landscape made by
-/// midpoint displacement (deterministic LCG, roughness 0.55) that shadows itself.
+/// midpoint displacement (deterministic LCG, roughness 0.55) on a central massif, lit from
+/// low on one side so that it shadows itself.
 fn pw_fractal() -> Scene {
     let n = 32; // power-of-two grid for midpoint displacement, sampled down to FRACTAL_N
     let mut h = vec![vec![0.0f64; n + 1]; n + 1];
@@ -283,7 +284,7 @@ fn pw_fractal() -> Scene {
         ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
     };
     let mut step = n;
-    let mut amp = 0.9;
+    let mut amp = 1.3;
     while step > 1 {
         let half = step / 2;
         for y in (0..n).step_by(step) {
@@ -314,14 +315,19 @@ fn pw_fractal() -> Scene {
     let heights: Vec<Vec<f64>> = (0..=m)
         .map(|j| {
             (0..=m)
-                .map(|i| 0.3 + h[j * n / m][i * n / m].max(-0.25))
+                .map(|i| {
+                    // A central massif so that peaks shadow the valleys around them.
+                    let (u, v) = (i as f64 / m as f64 - 0.5, j as f64 / m as f64 - 0.5);
+                    let massif = 0.9 * (-(u * u + v * v) / 0.05).exp();
+                    0.3 + h[j * n / m][i * n / m].max(-0.25) + massif
+                })
                 .collect()
         })
         .collect();
     scene(
         camera([0.0, 3.0, 4.6], [0.0, 0.2, 0.0], 50.0),
         Light {
-            center: Vec3::new(-2.0, 3.5, -1.5),
+            center: Vec3::new(-3.2, 2.4, -2.2),
             shape: LightShape::Sphere { radius: 0.4 },
         },
         vec![heightfield("landscape", &heights, 4.0, -0.1)],
