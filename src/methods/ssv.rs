@@ -446,17 +446,9 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             counters: r.pass2,
         },
     ];
-    let mut buffers = vec![BufferPlan {
-        name: "depth".into(),
-        format: format!("{:?}", frame.gpu.depth),
-        bytes_per_sample: frame.gpu.depth.bytes() as u32,
-    }];
+    let mut buffers = vec![BufferPlan::depth(&frame.gpu)];
     if settings.vbuffer == VBufferFormat::Split8 {
-        buffers.push(BufferPlan {
-            name: "stencil".into(),
-            format: "S8".into(),
-            bytes_per_sample: 1,
-        });
+        buffers.push(BufferPlan::stencil8());
     }
     buffers.push(BufferPlan {
         name: "vbuffer".into(),
