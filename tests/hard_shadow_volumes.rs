@@ -108,7 +108,9 @@ fn eye_in_shadow_needs_zfail() {
         Submission::TwoSided,
     );
     let (bad_f, bad_p) = (mismatches(&zf, &truth), mismatches(&zp, &truth));
-    eprintln!("eye-in-shadow: {receivers} receivers, z-fail wrong at {bad_f}, z-pass wrong at {bad_p}");
+    eprintln!(
+        "eye-in-shadow: {receivers} receivers, z-fail wrong at {bad_f}, z-pass wrong at {bad_p}"
+    );
     // z-fail may differ from the exact segment test only where a pixel sample lies within
     // rasterization precision of a shadow boundary: < 1% of the receivers.
     assert!(
@@ -146,7 +148,10 @@ fn more_than_255_volumes_wrap_and_saturate_differ() {
         .filter(|&i| prims[i] != BACKGROUND && sat[i] == 255)
         .collect();
     assert!(!floor_full.is_empty());
-    eprintln!("overlap-stress: {} pixels saturated at 255", floor_full.len());
+    eprintln!(
+        "overlap-stress: {} pixels saturated at 255",
+        floor_full.len()
+    );
     let n44 = floor_full.iter().filter(|&&i| wrap[i] == 44).count();
     assert!(
         n44 * 2 > floor_full.len(),

@@ -46,7 +46,10 @@ pub fn supports(method: &str, shape: &LightShape) -> bool {
         // Paper IV §4.2: the rectangular and the spherical shader.
         "ssv-optimized" => matches!(shape, LightShape::Rect { .. } | LightShape::Sphere { .. }),
         // Paper III §3.2.2, §3.3: rectangular and textured rectangular lights.
-        "ssv" => matches!(shape, LightShape::Rect { .. } | LightShape::TexturedRect { .. }),
+        "ssv" => matches!(
+            shape,
+            LightShape::Rect { .. } | LightShape::TexturedRect { .. }
+        ),
         _ => false,
     }
 }
