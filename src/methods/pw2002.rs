@@ -19,9 +19,9 @@
 //! `pw-restructured` add literally the same integers. Background pixels (stored depth 1.0) have
 //! no point; their p is never inside a wedge. Visibility = clamp(LI, 0, 255)/255.
 //!
-//! Options (`[options.pw2002]`, shared with `pw-restructured` by [`read_wedge_settings`]):
-//! `side_planes = compute|cancel` ([`SidePlanes`]: the §4 pseudocode, default, or the §5
-//! shortcut — 255 on front planes, 0 on back and side planes), `li = 16|12|8` (bits),
+//! Options (`[options.pw2002]`): `side_planes = compute|cancel` ([`SidePlanes`]: the §4
+//! pseudocode, default, or the §5 shortcut — 255 on front planes, 0 on back and side planes;
+//! pw2002 only), and, shared with `pw-restructured` by [`read_wedge_settings`], `li = 16|12|8` (bits),
 //! `overflow = wrap|saturate`, `falloff = linear|smoothstep`
 //! (s' = 3s² − 2s³, §4.2), `corner_wedges = on|off` (Fig. 7), `parallel_rule = on|off` (§8).
 //! The eye is assumed to be outside every shadow (Paper I §8); `pw-restructured` handles the
@@ -91,10 +91,6 @@ pub fn read_wedge_settings(
     let smooth = r.choice("falloff", &["linear", "smoothstep"], "linear")? == "smoothstep";
     let corner = r.choice("corner_wedges", &["on", "off"], "on")? == "on";
     let parallel = r.choice("parallel_rule", &["on", "off"], "on")? == "on";
-    let side_planes = match r.choice("side_planes", &["compute", "cancel"], "compute")? {
-        "cancel" => SidePlanes::Cancel,
-        _ => SidePlanes::Compute,
-    };
     let scene = frame.scene;
     let radius = match scene.light.shape {
         LightShape::Sphere { radius } => radius as f64,
@@ -110,7 +106,7 @@ pub fn read_wedge_settings(
         li,
         overflow,
         smooth,
-        side_planes,
+        side_planes: SidePlanes::Compute,
         lights: 1,
         wedge: WedgeOptions {
             center: scene.light.center.as_dvec3(),
@@ -231,7 +227,11 @@ pub fn render_li(
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let start = Instant::now();
     let mut r = OptionReader::new(frame.scene, "pw2002");
-    let s = read_wedge_settings(&mut r, frame)?;
+    let mut s = read_wedge_settings(&mut r, frame)?;
+    s.side_planes = match r.choice("side_planes", &["compute", "cancel"], "compute")? {
+        "cancel" => SidePlanes::Cancel,
+        _ => SidePlanes::Compute,
+    };
     r.finish()?;
     let pass_start = Instant::now();
     let set = frame_wedges(frame, &s)?;

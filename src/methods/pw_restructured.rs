@@ -38,7 +38,7 @@
 //! * z-pass or z-fail: `mode = auto` picks z-fail when [`crate::plan::eye_in_shadow`] finds the
 //!   near plane in the shadow of a point of the light.
 //!
-//! Options: those of `pw2002` (its `side_planes` has no effect here: the restructured
+//! Options: those of `pw2002` except `side_planes` (an error here: the restructured
 //! algorithm never visits side planes, it is the `cancel` form by construction) plus `passes = single|three`, `culling = zmin-zmax|zmax|off`,
 //! `mode = auto|zpass|zfail`.
 
