@@ -21,6 +21,7 @@ use penumbra::scene::file::{parse_scene_str, Format};
 use penumbra::scene::obj::parse_obj;
 use penumbra::scene::Camera;
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 /// Image edge (pixels) every raster check uses: 32×32, as the fuzz brief fixes.
 pub const SIZE: u32 = 32;
@@ -305,4 +306,13 @@ fn draw_checked(setup: &[RasterTriangle], tile: u32) {
     );
     let seen: u64 = tiles.iter().flatten().map(|&n| n as u64).sum();
     assert_eq!(counters.fragments_rasterized, seen);
+}
+
+/// The fuzz targets' scene directory, made once per process under the system temp directory.
+pub fn fuzz_scene_dir() -> &'static PathBuf {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let root = std::env::temp_dir().join(format!("penumbra-fuzz-{}", std::process::id()));
+        populate_scene_dir(&root).expect("cannot create the fuzz scene directory")
+    })
 }

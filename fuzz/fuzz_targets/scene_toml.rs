@@ -9,18 +9,7 @@ mod common;
 
 use libfuzzer_sys::fuzz_target;
 use penumbra::scene::file::Format;
-use std::path::PathBuf;
-use std::sync::OnceLock;
-
-/// The scene directory, made once per process under the system temp directory.
-fn base_dir() -> &'static PathBuf {
-    static DIR: OnceLock<PathBuf> = OnceLock::new();
-    DIR.get_or_init(|| {
-        let root = std::env::temp_dir().join(format!("penumbra-fuzz-{}", std::process::id()));
-        common::populate_scene_dir(&root).expect("cannot create the fuzz scene directory")
-    })
-}
 
 fuzz_target!(|data: &[u8]| {
-    common::scene(data, Format::Toml, base_dir());
+    common::scene(data, Format::Toml, common::fuzz_scene_dir());
 });

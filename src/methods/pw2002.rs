@@ -246,18 +246,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let plan = MethodPlan {
         method: "pw2002".into(),
         passes: vec![frame.pass.name.clone(), "wedges".into()],
-        buffers: vec![
-            BufferPlan {
-                name: "depth".into(),
-                format: format!("{:?}", frame.gpu.depth),
-                bytes_per_sample: frame.gpu.depth.bytes() as u32,
-            },
-            BufferPlan {
-                name: "li".into(),
-                format: format!("{:?}", s.li),
-                bytes_per_sample: s.li.bytes() as u32,
-            },
-        ],
+        buffers: vec![BufferPlan::depth(&frame.gpu), li_buffer_plan(s.li)],
         settings: serde_json::json!({
             "settings": s,
             "wedges": set.wedges.len(),
@@ -277,4 +266,13 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             vec![frame.pass.clone(), pass],
         ),
     })
+}
+
+/// The plan entry of the LI buffer in format `li`.
+pub fn li_buffer_plan(li: LiFormat) -> BufferPlan {
+    BufferPlan {
+        name: "li".into(),
+        format: format!("{li:?}"),
+        bytes_per_sample: li.bytes() as u32,
+    }
 }

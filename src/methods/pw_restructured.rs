@@ -44,7 +44,9 @@
 
 use super::options::OptionReader;
 use super::output::{MethodOutput, PassStats};
-use super::pw2002::{frame_wedges, li_row_major, read_wedge_settings, resolve, WedgeSettings};
+use super::pw2002::{
+    frame_wedges, li_buffer_plan, li_row_major, read_wedge_settings, resolve, WedgeSettings,
+};
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame};
 use crate::geometry::penumbra_wedge::{
@@ -497,18 +499,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let li = li_row_major(frame, &tiles);
     let mut names = vec![frame.pass.name.clone()];
     names.extend(passes.iter().map(|p| p.name.clone()));
-    let mut buffers = vec![
-        BufferPlan {
-            name: "depth".into(),
-            format: format!("{:?}", frame.gpu.depth),
-            bytes_per_sample: frame.gpu.depth.bytes() as u32,
-        },
-        BufferPlan {
-            name: "li".into(),
-            format: format!("{:?}", s.wedge.li),
-            bytes_per_sample: s.wedge.li.bytes() as u32,
-        },
-    ];
+    let mut buffers = vec![BufferPlan::depth(&frame.gpu), li_buffer_plan(s.wedge.li)];
     if s.passes == Passes::Three {
         buffers.push(BufferPlan {
             name: "stencil".into(),
