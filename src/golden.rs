@@ -365,13 +365,13 @@ fn same_bits(a: &Visibility, b: &Visibility, i: usize) -> bool {
     }
 }
 
-fn compare_visibility(
-    expected_bytes: &[u8],
-    actual: &Visibility,
+/// The decoded golden, or the mismatch saying it does not decode or has another size.
+fn decoded<T>(
+    golden: Result<(u32, u32, T), String>,
     width: u32,
     height: u32,
-) -> Result<(), Mismatch> {
-    let (ew, eh, expected) = read_pfm(expected_bytes).map_err(|e| Mismatch {
+) -> Result<T, Mismatch> {
+    let (ew, eh, values) = golden.map_err(|e| Mismatch {
         summary: format!("the golden does not decode: {e}"),
         panels: None,
     })?;
@@ -381,6 +381,16 @@ fn compare_visibility(
             panels: None,
         });
     }
+    Ok(values)
+}
+
+fn compare_visibility(
+    expected_bytes: &[u8],
+    actual: &Visibility,
+    width: u32,
+    height: u32,
+) -> Result<(), Mismatch> {
+    let expected = decoded(read_pfm(expected_bytes), width, height)?;
     let w = width as usize;
     let n = w * height as usize;
     let differing: Vec<usize> = (0..n)
@@ -419,16 +429,7 @@ fn compare_raw(
     width: u32,
     height: u32,
 ) -> Result<(), Mismatch> {
-    let (ew, eh, expected) = decode_gray8_png(expected_bytes).map_err(|e| Mismatch {
-        summary: format!("the golden does not decode: {e}"),
-        panels: None,
-    })?;
-    if (ew, eh) != (width, height) {
-        return Err(Mismatch {
-            summary: format!("size differs: expected {ew}x{eh}, actual {width}x{height}"),
-            panels: None,
-        });
-    }
+    let expected = decoded(decode_gray8_png(expected_bytes), width, height)?;
     let w = width as usize;
     let differing = expected.iter().zip(actual).filter(|(a, b)| a != b).count();
     let Some(first) = expected.iter().zip(actual).position(|(a, b)| a != b) else {
