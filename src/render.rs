@@ -81,6 +81,10 @@ pub fn render_scene(scene: &Scene) -> Result<Vec<MethodRun>, InputError> {
     let selected = methods::selected(scene)?;
     let gpu = gpu_settings(scene)?;
     let frame = Frame::render(scene, gpu)?;
+    // Every option table is checked before anything runs, also for methods not rendered now.
+    for method in scene.options.keys().filter(|k| k.as_str() != "gpu") {
+        methods::check_options(method, &frame)?;
+    }
     let mut order: Vec<&String> = selected
         .iter()
         .filter(|m| m.as_str() == methods::REFERENCE)

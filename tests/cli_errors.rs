@@ -184,6 +184,16 @@ fn bad_options_and_methods() {
             &["perfect square"],
         ),
         (
+            "option of a method not rendered",
+            &["--methods", "hard-sv", "--opt", "nsample.n=1000"],
+            &["perfect square"],
+        ),
+        (
+            "unknown key of a method not rendered",
+            &["--methods", "hard-sv", "--opt", "ssv.bogus=1"],
+            &["ssv.bogus", "unknown option"],
+        ),
+        (
             "tile size",
             &["--methods", "hard-sv", "--opt", "gpu.tile_size=3"],
             &["tile_size"],

@@ -174,13 +174,19 @@ pub fn stencil_row_major(frame: &Frame, tiles: &[StencilTile]) -> Vec<u8> {
     frame.tiling.to_row_major(&flat)
 }
 
+/// Read and check `[options.hard-sv]` (settings and the `mode` as written).
+pub fn options(frame: &Frame) -> Result<(StencilShadowSettings, &'static str), InputError> {
+    let mut r = OptionReader::new(frame.scene, "hard-sv");
+    let parsed = read_settings(&mut r, frame, &[frame.scene.light.center])?;
+    r.finish()?;
+    Ok(parsed)
+}
+
 /// Run `hard-sv` on a rendered frame.
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let start = Instant::now();
-    let mut r = OptionReader::new(frame.scene, "hard-sv");
     let center = frame.scene.light.center;
-    let (settings, mode) = read_settings(&mut r, frame, &[center])?;
-    r.finish()?;
+    let (settings, mode) = options(frame)?;
     let pass_start = Instant::now();
     let (tiles, counters) = stencil_shadow(frame, center, &settings);
     let name = match settings.test {

@@ -151,16 +151,7 @@ pub fn method_stats(
 fn run_raycast(frame: &Frame) -> Result<MethodOutput, InputError> {
     let start = Instant::now();
     let scene = frame.scene;
-    let mut r = options::OptionReader::new(scene, "raycast");
-    let settings = raycast::RaycastSettings {
-        samples: r.uint("samples", raycast::DEFAULT_SAMPLES as u64, 1..=65536)? as u32,
-        seed: r.uint("seed", 0, 0..=u64::MAX >> 1)?,
-    };
-    settings
-        .validate()
-        .map_err(|e| InputError::at(&scene.source, "options.raycast.samples", e))?;
-    let receiver = r.choice("receiver", &["depth-buffer", "primary-ray"], "depth-buffer")?;
-    r.finish()?;
+    let (settings, receiver) = raycast_options(scene)?;
     let pass_start = Instant::now();
     let receivers: Vec<Option<raycast::Receiver>> = frame
         .receivers(receiver == "primary-ray")
@@ -191,4 +182,42 @@ fn run_raycast(frame: &Frame) -> Result<MethodOutput, InputError> {
         raw_images: vec![],
         stats: method_stats("raycast", frame, start, &plan, passes),
     })
+}
+
+/// Read and check `[options.raycast]`: the settings and the receiver choice.
+fn raycast_options(scene: &Scene) -> Result<(raycast::RaycastSettings, &'static str), InputError> {
+    let mut r = options::OptionReader::new(scene, "raycast");
+    let settings = raycast::RaycastSettings {
+        samples: r.uint("samples", raycast::DEFAULT_SAMPLES as u64, 1..=65536)? as u32,
+        seed: r.uint("seed", 0, 0..=u64::MAX >> 1)?,
+    };
+    settings
+        .validate()
+        .map_err(|e| InputError::at(&scene.source, "options.raycast.samples", e))?;
+    let receiver = r.choice("receiver", &["depth-buffer", "primary-ray"], "depth-buffer")?;
+    r.finish()?;
+    Ok((settings, receiver))
+}
+
+/// Parse and check `method`'s options without running it, so that a bad option is reported
+/// even for a method this run does not render. Methods that do not support the scene's light
+/// shape are not checked (their options cannot be interpreted for this light).
+pub fn check_options(method: &str, frame: &Frame) -> Result<(), InputError> {
+    if !supports(method, &frame.scene.light.shape) {
+        return Ok(());
+    }
+    match method {
+        "hard-sv" => hard_sv::options(frame).map(drop),
+        "nsample" => nsample::options(frame).map(drop),
+        "raycast" => raycast_options(frame.scene).map(drop),
+        "pw2002" => pw2002::options(frame).map(drop),
+        "pw-restructured" => pw_restructured::read_settings(frame).map(drop),
+        "ssv" => ssv::read_settings(frame).map(drop),
+        "ssv-optimized" => ssv_optimized::options(frame).map(drop),
+        _ => Err(InputError::at(
+            &frame.scene.source,
+            "methods",
+            format!("unknown method {method:?}"),
+        )),
+    }
 }

@@ -13,13 +13,13 @@
 //! for `hard-sv`; `mode = auto` chooses z-fail when the near plane is in the shadow of the
 //! light center or of the shape's extreme points ([`crate::plan::representative_light_points`]).
 
-use super::hard_sv::{read_settings, stencil_shadow, ShadowTest};
+use super::hard_sv::{read_settings, stencil_shadow, ShadowTest, StencilShadowSettings};
 use super::options::OptionReader;
 use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
 use crate::frame::{Frame, BACKGROUND};
 use crate::gpu::counters::Counters;
-use crate::light::sampling::{stratified, Pattern};
+use crate::light::sampling::{stratified, LightSample, Pattern};
 use crate::plan::{representative_light_points, BufferPlan, MethodPlan};
 use crate::scene::LightShape;
 use glam::Vec3;
@@ -42,9 +42,11 @@ pub fn sphere_disk_target(frame: &Frame) -> Vec3 {
     (lo + hi) * 0.5
 }
 
-/// Run `nsample` on a rendered frame.
-pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
-    let start = Instant::now();
+/// Read and check `[options.nsample]`: the light samples, the stencil settings and the
+/// `mode` as written.
+pub fn options(
+    frame: &Frame,
+) -> Result<(Vec<LightSample>, StencilShadowSettings, &'static str), InputError> {
     let scene = frame.scene;
     let mut r = OptionReader::new(scene, "nsample");
     let n = r.uint("n", DEFAULT_SAMPLES, 1..=4096)?;
@@ -57,6 +59,14 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         sphere_disk_target(frame),
     )
     .map_err(|e| InputError::at(&scene.source, "options.nsample.n", e))?;
+    Ok((samples, settings, mode))
+}
+
+/// Run `nsample` on a rendered frame.
+pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
+    let start = Instant::now();
+    let scene = frame.scene;
+    let (samples, settings, mode) = options(frame)?;
     let colored = matches!(scene.light.shape, LightShape::TexturedRect { .. });
 
     let tiling = &frame.tiling;

@@ -223,9 +223,8 @@ pub fn render_li(
     (li, counters)
 }
 
-/// Run `pw2002` on a rendered frame.
-pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
-    let start = Instant::now();
+/// Read and check `[options.pw2002]`.
+pub fn options(frame: &Frame) -> Result<WedgeSettings, InputError> {
     let mut r = OptionReader::new(frame.scene, "pw2002");
     let mut s = read_wedge_settings(&mut r, frame)?;
     s.side_planes = match r.choice("side_planes", &["compute", "cancel"], "compute")? {
@@ -233,6 +232,13 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         _ => SidePlanes::Compute,
     };
     r.finish()?;
+    Ok(s)
+}
+
+/// Run `pw2002` on a rendered frame.
+pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
+    let start = Instant::now();
+    let s = options(frame)?;
     let pass_start = Instant::now();
     let set = frame_wedges(frame, &s)?;
     let (tiles, counters) = render_li(frame, &set, &s);

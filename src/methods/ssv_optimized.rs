@@ -721,12 +721,18 @@ pub fn overlap_combine(a: f32, b: f32) -> f32 {
     a.max(b) + 0.5 * a.min(b)
 }
 
-/// Run `ssv-optimized` on a rendered frame.
-pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
-    let start = Instant::now();
+/// Read and check `[options.ssv-optimized]`.
+pub fn options(frame: &Frame) -> Result<Settings, InputError> {
     let mut r = OptionReader::new(frame.scene, "ssv-optimized");
     let s = read_settings(&mut r, frame)?;
     r.finish()?;
+    Ok(s)
+}
+
+/// Run `ssv-optimized` on a rendered frame.
+pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
+    let start = Instant::now();
+    let s = options(frame)?;
     let model = LightModel::from_shape(frame.scene.light.center, &frame.scene.light.shape)
         .expect("read_settings checked the shape");
     let pieces = model
