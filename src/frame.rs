@@ -19,6 +19,7 @@ use crate::methods::output::PassStats;
 use crate::scene::Scene;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
+use std::sync::OnceLock;
 use std::time::Instant;
 
 /// The pixel at which no geometry was drawn.
@@ -79,6 +80,10 @@ pub struct Frame<'s> {
     pub prim_owner: Vec<(u32, u32)>,
     /// Stats of the scene pass.
     pub pass: PassStats,
+    /// Row-major visible primitive ids, computed on first use ([`Frame::prim_ids`]).
+    prim_rows: OnceLock<Vec<u32>>,
+    /// Row-major depth-buffer receivers, computed on first use ([`Frame::receivers`]).
+    depth_receivers: OnceLock<Vec<Option<Receiver>>>,
 }
 
 impl<'s> Frame<'s> {
@@ -155,6 +160,8 @@ impl<'s> Frame<'s> {
             tiles,
             prim_owner,
             pass,
+            prim_rows: OnceLock::new(),
+            depth_receivers: OnceLock::new(),
         })
     }
 
@@ -163,14 +170,16 @@ impl<'s> Frame<'s> {
         (self.scene.width * self.scene.height) as usize
     }
 
-    /// Visible primitive per pixel, row-major.
-    pub fn prim_ids(&self) -> Vec<u32> {
-        let flat: Vec<u32> = self
-            .tiles
-            .iter()
-            .flat_map(|t| t.prim.iter().copied())
-            .collect();
-        self.tiling.to_row_major(&flat)
+    /// Visible primitive per pixel, row-major (computed once per frame).
+    pub fn prim_ids(&self) -> &[u32] {
+        self.prim_rows.get_or_init(|| {
+            let flat: Vec<u32> = self
+                .tiles
+                .iter()
+                .flat_map(|t| t.prim.iter().copied())
+                .collect();
+            self.tiling.to_row_major(&flat)
+        })
     }
 
     /// Stored depth per pixel, row-major.
@@ -192,14 +201,30 @@ impl<'s> Frame<'s> {
         (b - a).cross(c - a).normalize_or_zero().as_vec3()
     }
 
-    /// The receiver of every pixel, row-major; `None` for background. By default
-    /// (`primary_ray = false`) the point is the depth-buffer point: the pixel center
-    /// un-projected at its stored depth — the point the rasterized methods see. With
-    /// `primary_ray = true` it is the exact intersection of the ray through the pixel center
-    /// with the plane of the visible triangle, in f64.
-    pub fn receivers(&self, primary_ray: bool) -> Vec<Option<Receiver>> {
+    /// The receiver of every pixel, row-major; `None` for background: the depth-buffer point,
+    /// i.e. the pixel center un-projected at its stored depth — the point the rasterized
+    /// methods see (computed once per frame).
+    pub fn receivers(&self) -> &[Option<Receiver>] {
+        self.depth_receivers.get_or_init(|| {
+            let depth = self.depth_values();
+            self.receivers_with(|i, x, y, _| {
+                self.proj
+                    .unproject(x, y, self.gpu.depth.to_window(depth[i]))
+            })
+        })
+    }
+
+    /// Like [`Frame::receivers`], but each point is the exact intersection of the ray through
+    /// the pixel center with the plane of the visible triangle, in f64.
+    pub fn primary_ray_receivers(&self) -> Vec<Option<Receiver>> {
+        self.receivers_with(|_, x, y, prim| self.primary_hit(x, y, prim))
+    }
+
+    fn receivers_with(
+        &self,
+        point: impl Fn(usize, u32, u32, u32) -> DVec3 + Sync,
+    ) -> Vec<Option<Receiver>> {
         let prims = self.prim_ids();
-        let depth = self.depth_values();
         let w = self.scene.width;
         (0..prims.len())
             .into_par_iter()
@@ -209,16 +234,9 @@ impl<'s> Frame<'s> {
                     return None;
                 }
                 let (x, y) = (i as u32 % w, i as u32 / w);
-                let normal = self.normal_of(prim);
-                let point = if primary_ray {
-                    self.primary_hit(x, y, prim)
-                } else {
-                    self.proj
-                        .unproject(x, y, self.gpu.depth.to_window(depth[i]))
-                };
                 Some(Receiver {
-                    point: point.as_vec3(),
-                    normal,
+                    point: point(i, x, y, prim).as_vec3(),
+                    normal: self.normal_of(prim),
                 })
             })
             .collect()

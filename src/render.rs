@@ -52,13 +52,13 @@ pub fn gpu_settings(scene: &Scene) -> Result<GpuSettings, InputError> {
 /// The shaded image (DESIGN.md "Methods"): `albedo · (ambient + visibility · max(0, n·l))` with
 /// l toward the light center (a point light there), per RGB channel of the visibility.
 pub fn shade(frame: &Frame, vis: &Visibility) -> Vec<[f32; 3]> {
-    let receivers = frame.receivers(false);
+    let receivers = frame.receivers();
     let prims = frame.prim_ids();
     let ambient = frame.scene.ambient;
     let light = frame.scene.light.center;
     receivers
         .iter()
-        .zip(&prims)
+        .zip(prims)
         .enumerate()
         .map(|(i, (r, prim))| match r {
             Some(r) if *prim != BACKGROUND => {

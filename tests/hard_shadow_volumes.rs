@@ -41,7 +41,7 @@ fn in_hard_shadow(frame: &Frame) -> Vec<Option<bool>> {
     let eps = (hi - lo).length() * 1e-4;
     let light = frame.scene.light.center;
     frame
-        .receivers(false)
+        .receivers()
         .iter()
         .map(|r| {
             r.map(|r| {

@@ -150,7 +150,7 @@ fn stacked_li(k: usize, li: LiFormat, overflow: LiOverflow) -> i32 {
     let mut scene = with_sphere(small("overlap-stress", 24), 0.02);
     scene.meshes.truncate(1 + k);
     let frame = Frame::render(&scene, GpuSettings::default()).unwrap();
-    let recv = frame.receivers(false);
+    let recv = frame.receivers();
     let px = recv
         .iter()
         .position(|r| {

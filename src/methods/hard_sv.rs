@@ -203,7 +203,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let prims = frame.prim_ids();
     let vis: Vec<f32> = stencil
         .iter()
-        .zip(&prims)
+        .zip(prims)
         .map(|(s, p)| {
             if *p == BACKGROUND || *s == 0 {
                 1.0

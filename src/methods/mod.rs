@@ -153,17 +153,14 @@ fn run_raycast(frame: &Frame) -> Result<MethodOutput, InputError> {
     let scene = frame.scene;
     let (settings, receiver) = raycast_options(scene)?;
     let pass_start = Instant::now();
-    let receivers: Vec<Option<raycast::Receiver>> = frame
-        .receivers(receiver == "primary-ray")
-        .into_iter()
-        .map(|o| {
-            o.map(|x| raycast::Receiver {
-                point: x.point,
-                normal: x.normal,
-            })
-        })
-        .collect();
-    let visibility = raycast::raycast_visibility(scene, &receivers, &settings);
+    let primary;
+    let receivers = if receiver == "primary-ray" {
+        primary = frame.primary_ray_receivers();
+        &primary[..]
+    } else {
+        frame.receivers()
+    };
+    let visibility = raycast::raycast_visibility(scene, receivers, &settings);
     let pass = PassStats {
         name: "raycast".into(),
         wall_seconds: pass_start.elapsed().as_secs_f64(),

@@ -106,7 +106,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let visibility = if colored {
         Visibility::Rgb(
             rows.iter()
-                .zip(&prims)
+                .zip(prims)
                 .map(|(p, id)| {
                     if *id == BACKGROUND {
                         [1.0; 3]
@@ -119,7 +119,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     } else {
         Visibility::Gray(
             rows.iter()
-                .zip(&prims)
+                .zip(prims)
                 .map(|(p, id)| if *id == BACKGROUND { 1.0 } else { to_f32(p)[0] })
                 .collect(),
         )

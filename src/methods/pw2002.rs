@@ -138,7 +138,7 @@ pub fn resolve(frame: &Frame, li: &[i32]) -> Visibility {
     let prims = frame.prim_ids();
     Visibility::Gray(
         li.iter()
-            .zip(&prims)
+            .zip(prims)
             .map(|(v, p)| {
                 if *p == BACKGROUND {
                     1.0

@@ -110,16 +110,7 @@ pub const BOX_PADDING: f64 = 1e-5;
 /// Paper III §5.1).
 pub const DEFAULT_SAMPLES: u32 = 1024;
 
-/// A receiver point seen at one pixel: the point whose light visibility is wanted, and its
-/// surface normal (unit, facing the camera side). By default the rasterized methods' own
-/// depth-buffer point (issue 2, `raycast`), so a method's error is the method's alone.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Receiver {
-    /// The receiver point in world space.
-    pub point: Vec3,
-    /// Unit surface normal on the camera side; the shadow-ray origin is offset along it.
-    pub normal: Vec3,
-}
+pub use crate::frame::Receiver;
 
 /// Options of the `raycast` method (issue 2, `raycast`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -277,7 +277,7 @@ fn render_with<V: VBufferTile>(frame: &Frame, settings: &SsvSettings) -> SsvRend
             owner.push(k as u32);
         }
     }
-    let receivers = frame.receivers(false);
+    let receivers = frame.receivers();
     let texture = match settings.coverage {
         CoverageMode::Exact => None,
         CoverageMode::Texture { n, .. } => Some(coverage_texture(&match &scene.light.shape {
@@ -289,7 +289,7 @@ fn render_with<V: VBufferTile>(frame: &Frame, settings: &SsvSettings) -> SsvRend
         light,
         mode: settings.coverage,
         texture,
-        receivers: &receivers,
+        receivers,
         width: scene.width,
     };
     let bins = bin(tiling, &tris);

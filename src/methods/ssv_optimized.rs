@@ -753,7 +753,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let prims = frame.prim_ids();
     let vis: Vec<f32> = sum
         .iter()
-        .zip(&prims)
+        .zip(prims)
         .map(|(v, p)| {
             if *p == BACKGROUND {
                 1.0
