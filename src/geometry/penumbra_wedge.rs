@@ -642,13 +642,12 @@ pub fn screen_wedge(w: &Wedge, proj: &Projection) -> ScreenWedge {
     let mut behind = false;
     for (_, poly) in &w.faces {
         for p in poly {
-            let h = proj.view_proj * p.extend(1.0);
-            if h.w <= 0.0 {
-                behind = true;
-            } else {
-                let z = (h.z / h.w) * 0.5 + 0.5;
-                lo = lo.min(z);
-                hi = hi.max(z);
+            match proj.window_depth(*p) {
+                None => behind = true,
+                Some(z) => {
+                    lo = lo.min(z);
+                    hi = hi.max(z);
+                }
             }
         }
     }

@@ -91,6 +91,14 @@ impl Projection {
         round_clip(self.view_proj * d.extend(0.0))
     }
 
+    /// Window depth `(z/w)·0.5 + 0.5` of world point `p` in f64 (unclamped), or `None` when `p`
+    /// is not in front of the eye (w ≤ 0). For conservative depth bounds (hierarchical-Z
+    /// culling); rasterized depth comes from [`viewport`] in f32.
+    pub fn window_depth(&self, p: DVec3) -> Option<f64> {
+        let h = self.view_proj * p.extend(1.0);
+        (h.w > 0.0).then(|| (h.z / h.w) * 0.5 + 0.5)
+    }
+
     /// The world point seen at the center of pixel (`x`, `y`) (row 0 at the top) at window depth
     /// `z_w` in [0,1]: the inverse of the viewport and projection, in f64.
     pub fn unproject(&self, x: u32, y: u32, z_w: f64) -> DVec3 {
