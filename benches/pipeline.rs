@@ -67,7 +67,7 @@ fn pipeline(c: &mut Criterion) {
     });
 
     let frame = Frame::render(&scene, GpuSettings::default()).expect("scene pass");
-    let center = scene.light.center;
+    let center = scene.light().center;
     for (name, test) in [
         ("hard-sv/zpass", ShadowTest::ZPass),
         ("hard-sv/zfail", ShadowTest::ZFail),

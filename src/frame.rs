@@ -165,6 +165,30 @@ impl<'s> Frame<'s> {
         })
     }
 
+    /// This frame for `scene`, a scene that differs from this frame's only in its lights
+    /// ([`Scene::with_only_light`]): the scene pass does not depend on the lights, so its
+    /// buffers are re-used instead of rendered again.
+    pub fn lit_by<'a>(&self, scene: &'a Scene) -> Frame<'a> {
+        debug_assert!(
+            scene.meshes == self.scene.meshes
+                && scene.camera == self.scene.camera
+                && (scene.width, scene.height) == (self.scene.width, self.scene.height),
+            "Frame::lit_by needs the same meshes, camera and size"
+        );
+        Frame {
+            scene,
+            proj: self.proj.clone(),
+            gpu: self.gpu,
+            tiling: self.tiling,
+            adjacency: self.adjacency.clone(),
+            tiles: self.tiles.clone(),
+            prim_owner: self.prim_owner.clone(),
+            pass: self.pass.clone(),
+            prim_rows: self.prim_rows.clone(),
+            depth_receivers: self.depth_receivers.clone(),
+        }
+    }
+
     /// Number of pixels.
     pub fn pixel_count(&self) -> usize {
         (self.scene.width * self.scene.height) as usize

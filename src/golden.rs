@@ -666,14 +666,16 @@ pub struct GoldenCase {
 /// Golden image size (DESIGN.md "Goldens are rendered small").
 pub const GOLDEN_SIZE: u32 = 64;
 
-/// Every golden case: each built-in scene of the foundation with every method that exists
-/// (those that do not support a scene's light shape are skipped by [`render_case`]).
+/// Every golden case: each built-in scene of the foundation and the two-light scene, with
+/// every method that exists (those that do not support a scene's lights are skipped by
+/// [`render_case`]).
 pub fn cases() -> Vec<GoldenCase> {
     [
         "cube-of-spheres",
         "single-quad",
         "cylinder",
         "eye-in-shadow",
+        "two-lights",
     ]
     .into_iter()
     .map(|scene| GoldenCase {
@@ -694,7 +696,7 @@ pub fn render_case(case: &GoldenCase) -> Result<Vec<crate::render::MethodRun>, S
     let methods = case
         .methods
         .iter()
-        .filter(|m| crate::methods::supports(m, &scene.light.shape))
+        .filter(|m| crate::methods::supports_scene(m, &scene))
         .map(|m| m.to_string())
         .collect();
     scene.methods = Some(methods);

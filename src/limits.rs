@@ -23,3 +23,6 @@ pub const D24_MAX: u32 = (1 << 24) - 1;
 /// band keeps real vertices below (GUARD_BAND + 1)/2 · MAX_IMAGE_SIZE ≈ 41,000 px; with
 /// 8 sub-pixel bits, coordinates stay below 2^28 and edge-function products below 2^58.
 pub const WINDOW_LIMIT: f32 = 1_048_576.0;
+/// Largest number of lights in a scene: Paper I §7 scales light intensities by 255/n, so
+/// with more than 255 lights a fully visible light would add less than one LI unit.
+pub const MAX_LIGHTS: usize = 255;

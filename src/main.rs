@@ -143,7 +143,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
             let twin = builtin::load("cube-of-spheres-sphere").ok_or("missing built-in twin")?;
             let methods = penumbra::methods::ALL
                 .iter()
-                .filter(|m| **m != "nsample" && penumbra::methods::supports(m, &twin.light.shape))
+                .filter(|m| **m != "nsample" && penumbra::methods::supports_scene(m, &twin))
                 .map(|m| m.to_string())
                 .collect();
             render(&RenderArgs {

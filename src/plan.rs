@@ -8,31 +8,35 @@ use glam::{DVec3, Vec3};
 /// Grid of near-plane points tested for shadow (per side).
 const NEAR_GRID: u32 = 9;
 
-/// The light points whose hard shadow volumes a method renders, for the z-fail decision:
-/// the center, plus the extreme points of the shape (rectangle corners; four rim points of a
-/// disk or of a sphere's silhouette disk in every axis plane). The union of their shadows
-/// bounds the shadow of any point of the light only approximately; a user can force z-fail.
+/// The light points whose hard shadow volumes a method renders, for the z-fail decision: for
+/// every light, its center plus the extreme points of its shape (rectangle corners; four rim
+/// points of a disk or of a sphere's silhouette disk in every axis plane). The union of their
+/// shadows bounds the shadow of any point of the lights only approximately; a user can force
+/// z-fail.
 pub fn representative_light_points(scene: &Scene) -> Vec<Vec3> {
-    let c = scene.light.center;
-    let mut pts = vec![c];
-    match &scene.light.shape {
-        LightShape::Point => {}
-        LightShape::Rect { u, v } | LightShape::TexturedRect { u, v, .. } => {
-            for (su, sv) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                pts.push(c + *u * su + *v * sv);
+    let mut pts = Vec::new();
+    for light in &scene.lights {
+        let c = light.center;
+        pts.push(c);
+        match &light.shape {
+            LightShape::Point => {}
+            LightShape::Rect { u, v } | LightShape::TexturedRect { u, v, .. } => {
+                for (su, sv) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                    pts.push(c + *u * su + *v * sv);
+                }
             }
-        }
-        LightShape::Disk { radius, normal } => {
-            let n = normal.normalize();
-            let a = n.any_orthonormal_vector();
-            let b = n.cross(a);
-            for d in [a, -a, b, -b] {
-                pts.push(c + d * *radius);
+            LightShape::Disk { radius, normal } => {
+                let n = normal.normalize();
+                let a = n.any_orthonormal_vector();
+                let b = n.cross(a);
+                for d in [a, -a, b, -b] {
+                    pts.push(c + d * *radius);
+                }
             }
-        }
-        LightShape::Sphere { radius } => {
-            for d in [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z] {
-                pts.push(c + d * *radius);
+            LightShape::Sphere { radius } => {
+                for d in [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z] {
+                    pts.push(c + d * *radius);
+                }
             }
         }
     }

@@ -50,12 +50,16 @@ pub fn gpu_settings(scene: &Scene) -> Result<GpuSettings, InputError> {
 }
 
 /// The shaded image (DESIGN.md "Methods"): `albedo · (ambient + visibility · max(0, n·l))` with
-/// l toward the light center (a point light there), per RGB channel of the visibility.
+/// l toward the light center (a point light there), per RGB channel of the visibility. With
+/// several lights the diffuse term is the mean of `max(0, n·l_k)` over the lights: a method's
+/// visibility is already the mean over the lights (Paper I §7), so per-light terms cannot be
+/// weighted separately.
 pub fn shade(frame: &Frame, vis: &Visibility) -> Vec<[f32; 3]> {
     let receivers = frame.receivers();
     let prims = frame.prim_ids();
     let ambient = frame.scene.ambient;
-    let light = frame.scene.light.center;
+    let lights = &frame.scene.lights;
+    let n = lights.len() as f32;
     receivers
         .iter()
         .zip(prims)
@@ -64,8 +68,15 @@ pub fn shade(frame: &Frame, vis: &Visibility) -> Vec<[f32; 3]> {
             Some(r) if *prim != BACKGROUND => {
                 let (mi, _) = frame.prim_owner[*prim as usize];
                 let albedo = frame.scene.meshes[mi as usize].color;
-                let l = (light - r.point).normalize_or_zero();
-                let diffuse = r.normal.dot(l).max(0.0);
+                let diffuse = lights
+                    .iter()
+                    .map(|l| {
+                        r.normal
+                            .dot((l.center - r.point).normalize_or_zero())
+                            .max(0.0)
+                    })
+                    .sum::<f32>()
+                    / n;
                 let v = vis.rgb(i);
                 std::array::from_fn(|c| (albedo[c] * (ambient + v[c] * diffuse)).clamp(0.0, 1.0))
             }
@@ -126,12 +137,14 @@ pub fn write_runs(dir: &Path, scene: &Scene, runs: &[MethodRun]) -> std::io::Res
 
 /// The table the default run prints: time and error vs the reference per method.
 pub fn table(scene: &Scene, runs: &[MethodRun]) -> String {
+    let shapes: Vec<&str> = scene.lights.iter().map(|l| l.shape.type_name()).collect();
     let mut s = format!(
-        "scene {} ({}×{}, {} light, reference: {})\n",
+        "scene {} ({}×{}, {} light{}, reference: {})\n",
         scene.source,
         scene.width,
         scene.height,
-        scene.light.shape.type_name(),
+        shapes.join(" + "),
+        if shapes.len() > 1 { "s" } else { "" },
         methods::REFERENCE
     );
     s += &format!(

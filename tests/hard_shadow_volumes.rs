@@ -29,7 +29,7 @@ fn stencil(
         overflow,
         submission,
     };
-    let (tiles, _) = stencil_shadow(frame, frame.scene.light.center, &settings);
+    let (tiles, _) = stencil_shadow(frame, frame.scene.light().center, &settings);
     stencil_row_major(frame, &tiles)
 }
 
@@ -39,7 +39,7 @@ fn stencil(
 fn in_hard_shadow(frame: &Frame) -> Vec<Option<bool>> {
     let (lo, hi) = frame.scene.bounds();
     let eps = (hi - lo).length() * 1e-4;
-    let light = frame.scene.light.center;
+    let light = frame.scene.light().center;
     frame
         .receivers()
         .iter()
@@ -69,7 +69,7 @@ fn zpass_equals_zfail_bit_for_bit_when_the_eye_is_lit() {
         let s = scene(name, 96);
         let frame = Frame::render(&s, GpuSettings::default()).unwrap();
         assert!(
-            !eye_in_shadow(&s, frame.proj.near, &[s.light.center]),
+            !eye_in_shadow(&s, frame.proj.near, &[s.light().center]),
             "{name}: eye should be lit"
         );
         for sub in [Submission::TwoSided, Submission::TwoPass] {
@@ -90,7 +90,7 @@ fn eye_in_shadow_needs_zfail() {
     let s = scene("eye-in-shadow", 96);
     let frame = Frame::render(&s, GpuSettings::default()).unwrap();
     assert!(
-        eye_in_shadow(&s, frame.proj.near, &[s.light.center]),
+        eye_in_shadow(&s, frame.proj.near, &[s.light().center]),
         "the plan must detect the eye in shadow"
     );
     let truth = in_hard_shadow(&frame);

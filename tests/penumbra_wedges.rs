@@ -115,7 +115,7 @@ fn mean_abs(a: &[f32], b: &[f32]) -> f64 {
 }
 
 fn with_sphere(mut s: Scene, r: f32) -> Scene {
-    s.light.shape = LightShape::Sphere { radius: r };
+    s.lights[0].shape = LightShape::Sphere { radius: r };
     s
 }
 
@@ -200,7 +200,7 @@ fn hard_cases() -> Vec<Scene> {
     // Edges nearly parallel to the light: the cylinder's vertical edges under a light almost
     // straight above its rim.
     let mut s = small("cylinder", 32);
-    s.light.center = glam::Vec3::new(0.35, 3.2, 0.0);
+    s.lights[0].center = glam::Vec3::new(0.35, 3.2, 0.0);
     v.push(s);
     // Far from the origin (depth precision).
     let mut s = small("cylinder", 32);
@@ -210,7 +210,7 @@ fn hard_cases() -> Vec<Scene> {
             *p += off;
         }
     }
-    s.light.center += off;
+    s.lights[0].center += off;
     s.camera.eye += off.as_dvec3();
     s.camera.target += off.as_dvec3();
     v.push(s);
@@ -267,8 +267,8 @@ fn near_parallel_rule_removes_edges_and_without_it_wedges_degenerate() {
         glam::Vec3::new(0.5, 0.8, 2.5),
         [0.5; 3],
     ));
-    scene.light.center = glam::Vec3::new(-0.01, 4.0, 2.01);
-    scene.light.shape = LightShape::Sphere { radius: 0.2 };
+    scene.lights[0].center = glam::Vec3::new(-0.01, 4.0, 2.01);
+    scene.lights[0].shape = LightShape::Sphere { radius: 0.2 };
     let frame = Frame::render(&scene, GpuSettings::default()).unwrap();
     let mut w = wedge_settings(&frame);
     let with_rule = pw2002::frame_wedges(&frame, &w).unwrap();

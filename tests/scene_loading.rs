@@ -55,7 +55,7 @@ fn every_scene_file_loads() {
 fn shipped_scenes_cover_light_types() {
     let mut kinds: Vec<&str> = scene_files(&scenes_dir())
         .iter()
-        .map(|p| load_scene_file(p).unwrap().light.shape.type_name())
+        .map(|p| load_scene_file(p).unwrap().light().shape.type_name())
         .collect();
     kinds.sort();
     kinds.dedup();
@@ -161,7 +161,7 @@ fn zero_light() {
 fn unknown_method_loads_and_is_left_to_the_registry() {
     let scene = load_scene_file(&scenes_dir().join("bad/unknown-method.toml")).unwrap();
     assert_eq!(scene.methods, Some(vec!["no-such-method".to_string()]));
-    assert!(matches!(scene.light.shape, LightShape::Rect { .. }));
+    assert!(matches!(scene.light().shape, LightShape::Rect { .. }));
 }
 
 #[test]

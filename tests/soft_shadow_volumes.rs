@@ -325,10 +325,10 @@ fn textured_light_video_reuses_the_cache() {
     let mut textures = Vec::new();
     for f in [0usize, 1, 0] {
         let mut s = small("single-quad");
-        let LightShape::Rect { u, v } = s.light.shape.clone() else {
+        let LightShape::Rect { u, v } = s.light().shape.clone() else {
             unreachable!()
         };
-        s.light.shape = LightShape::TexturedRect {
+        s.lights[0].shape = LightShape::TexturedRect {
             u,
             v,
             texture: frames[f].clone(),

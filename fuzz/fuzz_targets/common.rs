@@ -109,7 +109,7 @@ pub fn scene(data: &[u8], format: Format, base_dir: &Path) {
     match parse_scene_str(text, format, source, base_dir) {
         Ok(scene) => {
             assert!(scene.width >= 1 && scene.height >= 1);
-            assert!(scene.light.center.is_finite());
+            assert!(scene.lights.iter().all(|l| l.center.is_finite()));
         }
         Err(e) => {
             let msg = e.to_string();

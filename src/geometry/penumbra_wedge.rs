@@ -238,10 +238,21 @@ pub struct WedgeSet {
     pub extra_wedges: usize,
 }
 
-/// A distance beyond every point of the scene and the eye as seen from the light center (4×
-/// the largest such distance), used to place the far ends of wedges.
-pub fn far_distance(scene: &Scene) -> f64 {
-    let c = scene.light.center.as_dvec3();
+impl WedgeSet {
+    /// Append `other`'s wedges and caps after this set's (several lights, Paper I §7: the
+    /// wedges of every light are submitted in light order).
+    pub fn append(&mut self, other: WedgeSet) {
+        self.wedges.extend(other.wedges);
+        self.top_caps.extend(other.top_caps);
+        self.bottom_caps.extend(other.bottom_caps);
+        self.removed_parallel += other.removed_parallel;
+        self.extra_wedges += other.extra_wedges;
+    }
+}
+
+/// A distance beyond every point of the scene and the eye as seen from the light center `c`
+/// (4× the largest such distance), used to place the far ends of wedges.
+pub fn far_distance(scene: &Scene, c: DVec3) -> f64 {
     let (lo, hi) = scene.bounds();
     let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
     let mut r = (scene.camera.eye - c).length();

@@ -177,7 +177,7 @@ pub fn stencil_row_major(frame: &Frame, tiles: &[StencilTile]) -> Vec<u8> {
 /// Read and check `[options.hard-sv]` (settings and the `mode` as written).
 pub fn options(frame: &Frame) -> Result<(StencilShadowSettings, &'static str), InputError> {
     let mut r = OptionReader::new(frame.scene, "hard-sv");
-    let parsed = read_settings(&mut r, frame, &[frame.scene.light.center])?;
+    let parsed = read_settings(&mut r, frame, &[frame.scene.light().center])?;
     r.finish()?;
     Ok(parsed)
 }
@@ -185,7 +185,7 @@ pub fn options(frame: &Frame) -> Result<(StencilShadowSettings, &'static str), I
 /// Run `hard-sv` on a rendered frame.
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let start = Instant::now();
-    let center = frame.scene.light.center;
+    let center = frame.scene.light().center;
     let (settings, mode) = options(frame)?;
     let pass_start = Instant::now();
     let (tiles, counters) = stencil_shadow(frame, center, &settings);

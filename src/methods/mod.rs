@@ -1,7 +1,10 @@
 //! One module per soft-shadow method; each cites its paper section. This module is the
-//! registry: method names, which light shapes each supports, and dispatch.
+//! registry: method names, which light shapes each supports, and dispatch — including scenes
+//! with several lights: the penumbra-wedge methods render them in one LI buffer (Paper I §7),
+//! every other method once per light ([`light_average`]).
 
 pub mod hard_sv;
+pub mod light_average;
 pub mod nsample;
 pub mod options;
 pub mod output;
@@ -33,6 +36,30 @@ pub const ALL: &[&str] = &[
 /// The reference every other method's error is measured against.
 pub const REFERENCE: &str = "raycast";
 
+/// Methods that render every light of a scene in one pass structure: Paper I §7 scales the
+/// LI amounts by 255/n into one LI buffer (also used by Paper II's restructured algorithm).
+/// Every other method runs once per light ([`light_average`]).
+pub const RENDERS_SEVERAL_LIGHTS: &[&str] = &["pw2002", "pw-restructured"];
+
+/// Whether `method` can render every light of `scene`.
+pub fn supports_scene(method: &str, scene: &Scene) -> bool {
+    scene.lights.iter().all(|l| supports(method, &l.shape))
+}
+
+/// The first light of `scene` that `method` cannot render, as a message.
+fn unsupported_light(method: &str, scene: &Scene) -> Option<String> {
+    scene
+        .lights
+        .iter()
+        .find(|l| !supports(method, &l.shape))
+        .map(|l| {
+            format!(
+                "method {method} does not support {} lights",
+                l.shape.type_name()
+            )
+        })
+}
+
 /// Whether `method` can render a light of this shape.
 pub fn supports(method: &str, shape: &LightShape) -> bool {
     match method {
@@ -60,7 +87,7 @@ pub fn selected(scene: &Scene) -> Result<Vec<String>, InputError> {
     match &scene.methods {
         None => Ok(ALL
             .iter()
-            .filter(|m| supports(m, &scene.light.shape))
+            .filter(|m| supports_scene(m, scene))
             .map(|m| m.to_string())
             .collect()),
         Some(list) => {
@@ -72,15 +99,8 @@ pub fn selected(scene: &Scene) -> Result<Vec<String>, InputError> {
                         format!("unknown method {m:?}; known: {}", ALL.join(", ")),
                     ));
                 }
-                if !supports(m, &scene.light.shape) {
-                    return Err(InputError::at(
-                        &scene.source,
-                        "methods",
-                        format!(
-                            "method {m} does not support {} lights",
-                            scene.light.shape.type_name()
-                        ),
-                    ));
+                if let Some(why) = unsupported_light(m, scene) {
+                    return Err(InputError::at(&scene.source, "methods", why));
                 }
             }
             Ok(list.clone())
@@ -102,8 +122,18 @@ pub fn check_option_tables(scene: &Scene) -> Result<(), InputError> {
     Ok(())
 }
 
-/// Run one method on a rendered frame.
+/// Run one method on a rendered frame: directly for a single light or a method in
+/// [`RENDERS_SEVERAL_LIGHTS`], else once per light, averaged ([`light_average`]).
 pub fn run(method: &str, frame: &Frame) -> Result<MethodOutput, InputError> {
+    if frame.scene.is_multi_light() && !RENDERS_SEVERAL_LIGHTS.contains(&method) {
+        return light_average::run(method, frame, run_one_light);
+    }
+    run_one_light(method, frame)
+}
+
+/// Run one method on a frame whose scene has one light (or on any frame for a method in
+/// [`RENDERS_SEVERAL_LIGHTS`]).
+fn run_one_light(method: &str, frame: &Frame) -> Result<MethodOutput, InputError> {
     match method {
         "hard-sv" => hard_sv::run(frame),
         "nsample" => nsample::run(frame),
@@ -198,11 +228,24 @@ fn raycast_options(scene: &Scene) -> Result<(raycast::RaycastSettings, &'static 
 
 /// Parse and check `method`'s options without running it, so that a bad option is reported
 /// even for a method this run does not render. Methods that do not support the scene's light
-/// shape are not checked (their options cannot be interpreted for this light).
+/// shapes are not checked (their options cannot be interpreted for these lights); a method
+/// that runs once per light is checked for each light.
 pub fn check_options(method: &str, frame: &Frame) -> Result<(), InputError> {
-    if !supports(method, &frame.scene.light.shape) {
+    if !supports_scene(method, frame.scene) {
         return Ok(());
     }
+    if frame.scene.is_multi_light() && !RENDERS_SEVERAL_LIGHTS.contains(&method) {
+        for k in 0..frame.scene.lights.len() {
+            let scene = frame.scene.with_only_light(k);
+            check_options_one_light(method, &frame.lit_by(&scene))?;
+        }
+        return Ok(());
+    }
+    check_options_one_light(method, frame)
+}
+
+/// [`check_options`] for a frame with one light (or a method in [`RENDERS_SEVERAL_LIGHTS`]).
+fn check_options_one_light(method: &str, frame: &Frame) -> Result<(), InputError> {
     match method {
         "hard-sv" => hard_sv::options(frame).map(drop),
         "nsample" => nsample::options(frame).map(drop),

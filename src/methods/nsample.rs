@@ -53,7 +53,7 @@ pub fn options(
     let (settings, mode) = read_settings(&mut r, frame, &representative_light_points(scene))?;
     r.finish()?;
     let samples = stratified(
-        &scene.light,
+        scene.light(),
         n as u32,
         Pattern::Centered,
         sphere_disk_target(frame),
@@ -67,7 +67,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let start = Instant::now();
     let scene = frame.scene;
     let (samples, settings, mode) = options(frame)?;
-    let colored = matches!(scene.light.shape, LightShape::TexturedRect { .. });
+    let colored = matches!(scene.light().shape, LightShape::TexturedRect { .. });
 
     let tiling = &frame.tiling;
     let mut acc: Vec<Vec<[f64; 3]>> = (0..tiling.tile_count())

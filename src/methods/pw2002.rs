@@ -23,7 +23,9 @@
 //! pseudocode, default, or the §5 shortcut — 255 on front planes, 0 on back and side planes;
 //! pw2002 only), and, shared with `pw-restructured` by [`read_wedge_settings`], `li = 16|12|8` (bits),
 //! `overflow = wrap|saturate`, `falloff = linear|smoothstep`
-//! (s' = 3s² − 2s³, §4.2), `corner_wedges = on|off` (Fig. 7), `parallel_rule = on|off` (§8).
+//! (s' = 3s² − 2s³, §4.2), `corner_wedges = on|off` (Fig. 7), `parallel_rule = on|off` (§8),
+//! `lights = shared|separate` ([`MultiLight`]: several lights in one LI buffer with amounts
+//! scaled by 255/n, Paper I §7, default; or one LI buffer per light, averaged).
 //! The eye is assumed to be outside every shadow (Paper I §8); `pw-restructured` handles the
 //! other case.
 
@@ -41,7 +43,7 @@ use crate::gpu::li_buffer::{li_visibility, LiFormat, LiOverflow, LiTile};
 use crate::gpu::raster::{bin, draw, no_tile_culling};
 use crate::gpu::setup::CullMode;
 use crate::plan::{BufferPlan, MethodPlan};
-use crate::scene::LightShape;
+use crate::scene::{LightShape, Scene};
 use std::time::Instant;
 
 /// How `pw2002` values the points where an eye ray enters or leaves a wedge.
@@ -57,6 +59,18 @@ pub enum SidePlanes {
     Cancel,
 }
 
+/// How the penumbra-wedge methods render a scene with several lights.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum MultiLight {
+    /// Paper I §7: every light's wedges add amounts scaled by 255/n into one LI buffer,
+    /// clamped once at the end. Where shadows of one light overlap (two occluders of the same
+    /// light), that light's umbra is subtracted twice and eats into the other lights' share.
+    SharedLi,
+    /// One LI buffer per light, each clamped to [0,255], visibilities averaged
+    /// ([`super::light_average`]): n times the LI memory and passes, no cross-light error.
+    PerLight,
+}
+
 /// Settings shared by both penumbra-wedge methods.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct WedgeSettings {
@@ -68,9 +82,12 @@ pub struct WedgeSettings {
     pub smooth: bool,
     /// Values at entry and exit points (pw2002 only; Paper I §4 vs §5).
     pub side_planes: SidePlanes,
-    /// Number of lights n (LI amounts scaled by 255/n, Paper I §7). Scenes hold one light.
+    /// Number of lights n (LI amounts scaled by 255/n, Paper I §7).
     pub lights: u32,
-    /// Wedge construction options.
+    /// Several lights in one LI buffer or one per light.
+    pub multi_light: MultiLight,
+    /// Wedge construction options of the first light; [`frame_wedges`] builds every light's
+    /// wedges with these flags and that light's center, radius and far distance.
     pub wedge: WedgeOptions,
 }
 
@@ -91,37 +108,72 @@ pub fn read_wedge_settings(
     let smooth = r.choice("falloff", &["linear", "smoothstep"], "linear")? == "smoothstep";
     let corner = r.choice("corner_wedges", &["on", "off"], "on")? == "on";
     let parallel = r.choice("parallel_rule", &["on", "off"], "on")? == "on";
-    let scene = frame.scene;
-    let radius = match scene.light.shape {
-        LightShape::Sphere { radius } => radius as f64,
-        _ => {
-            return Err(InputError::at(
-                &scene.source,
-                "light",
-                "penumbra wedges need a sphere light",
-            ))
-        }
+    let multi_light = match r.choice("lights", &["shared", "separate"], "shared")? {
+        "separate" => MultiLight::PerLight,
+        _ => MultiLight::SharedLi,
     };
+    let scene = frame.scene;
+    let lights = sphere_lights(scene)?;
     Ok(WedgeSettings {
         li,
         overflow,
         smooth,
         side_planes: SidePlanes::Compute,
-        lights: 1,
+        lights: lights.len() as u32,
+        multi_light,
         wedge: WedgeOptions {
-            center: scene.light.center.as_dvec3(),
-            radius,
-            far: far_distance(scene),
             extra_corner_wedges: corner,
             parallel_rule: parallel,
+            ..lights[0]
         },
     })
 }
 
-/// The wedges of every mesh of the frame's scene.
+/// Center, radius and far distance of every light of `scene` (all must be spheres), as wedge
+/// options with the default construction flags.
+fn sphere_lights(scene: &Scene) -> Result<Vec<WedgeOptions>, InputError> {
+    scene
+        .lights
+        .iter()
+        .enumerate()
+        .map(|(k, l)| match l.shape {
+            LightShape::Sphere { radius } => Ok(WedgeOptions {
+                center: l.center.as_dvec3(),
+                radius: radius as f64,
+                far: far_distance(scene, l.center.as_dvec3()),
+                extra_corner_wedges: true,
+                parallel_rule: true,
+            }),
+            _ => Err(InputError::at(
+                &scene.source,
+                if scene.is_multi_light() {
+                    format!("lights[{k}]")
+                } else {
+                    "light".to_string()
+                },
+                "penumbra wedges need a sphere light",
+            )),
+        })
+        .collect()
+}
+
+/// The wedges of every mesh of the frame's scene, light by light (Paper I §7: all lights'
+/// wedges go into one LI buffer, in light order, each with amounts scaled by 255/n).
 pub fn frame_wedges(frame: &Frame, s: &WedgeSettings) -> Result<WedgeSet, InputError> {
-    let meshes: Vec<_> = frame.scene.meshes.iter().zip(&frame.adjacency).collect();
-    build_wedges(&meshes, &s.wedge).map_err(|e| InputError::at(&frame.scene.source, "meshes", e))
+    let scene = frame.scene;
+    let meshes: Vec<_> = scene.meshes.iter().zip(&frame.adjacency).collect();
+    let mut all = WedgeSet::default();
+    for light in sphere_lights(scene)? {
+        let opts = WedgeOptions {
+            extra_corner_wedges: s.wedge.extra_corner_wedges,
+            parallel_rule: s.wedge.parallel_rule,
+            ..light
+        };
+        let set =
+            build_wedges(&meshes, &opts).map_err(|e| InputError::at(&scene.source, "meshes", e))?;
+        all.append(set);
+    }
+    Ok(all)
 }
 
 /// Row-major LI values of a tiled LI buffer.
@@ -239,6 +291,9 @@ pub fn options(frame: &Frame) -> Result<WedgeSettings, InputError> {
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let start = Instant::now();
     let s = options(frame)?;
+    if s.multi_light == MultiLight::PerLight && frame.scene.is_multi_light() {
+        return super::light_average::run("pw2002", frame, |_, f| run(f));
+    }
     let pass_start = Instant::now();
     let set = frame_wedges(frame, &s)?;
     let (tiles, counters) = render_li(frame, &set, &s);

@@ -45,7 +45,8 @@
 use super::options::OptionReader;
 use super::output::{MethodOutput, PassStats};
 use super::pw2002::{
-    frame_wedges, li_buffer_plan, li_row_major, read_wedge_settings, resolve, WedgeSettings,
+    frame_wedges, li_buffer_plan, li_row_major, read_wedge_settings, resolve, MultiLight,
+    WedgeSettings,
 };
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame};
@@ -494,6 +495,9 @@ fn stencil_pass(ctx: &Ctx, stencil: &mut [StencilTile], rt: &[RasterTriangle]) -
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let start = Instant::now();
     let (s, mode) = read_settings(frame)?;
+    if s.wedge.multi_light == MultiLight::PerLight && frame.scene.is_multi_light() {
+        return super::light_average::run("pw-restructured", frame, |_, f| run(f));
+    }
     let set = frame_wedges(frame, &s.wedge)?;
     let (tiles, passes, _) = render_li(frame, &set, &s);
     let li = li_row_major(frame, &tiles);

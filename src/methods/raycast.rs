@@ -420,7 +420,7 @@ impl ShadowRayCaster {
         };
         // Padding and margins use the bounds of meshes and the whole light.
         let (mut lo, mut hi) = (bounds_lo.as_dvec3(), bounds_hi.as_dvec3());
-        for q in sampling::bounding_quad(&scene.light, scene.light.center)
+        for q in sampling::bounding_quad(scene.light(), scene.light().center)
             .into_iter()
             .flatten()
         {
@@ -765,7 +765,7 @@ pub fn raycast_visibility(
     settings: &RaycastSettings,
 ) -> Visibility {
     let caster = ShadowRayCaster::new(scene);
-    let light = &scene.light;
+    let light = scene.light();
     // Only sphere lights depend on the receiver (the facing disk); sample the others once.
     let shared = match light.shape {
         LightShape::Sphere { .. } => None,
@@ -894,7 +894,7 @@ mod tests {
                 vfov_deg: 45.0,
                 near: None,
             },
-            light,
+            lights: vec![light],
             meshes,
             methods: None,
             options: Default::default(),
@@ -934,7 +934,7 @@ mod tests {
         );
         let caster = ShadowRayCaster::new(&s);
         assert_eq!(caster.triangle_count(), 24);
-        let v = caster.visibility(&s.light, &ON_FLOOR, &RaycastSettings::default());
+        let v = caster.visibility(s.light(), &ON_FLOOR, &RaycastSettings::default());
         assert_eq!(v, [1.0; 3]);
     }
 
@@ -948,7 +948,7 @@ mod tests {
             ],
         );
         let v =
-            ShadowRayCaster::new(&s).visibility(&s.light, &ON_FLOOR, &RaycastSettings::default());
+            ShadowRayCaster::new(&s).visibility(s.light(), &ON_FLOOR, &RaycastSettings::default());
         assert_eq!(v, [0.0; 3]);
         // Same for a disk, a sphere and a point light.
         for shape in [
@@ -965,11 +965,11 @@ mod tests {
             };
             let s = scene(light, s.meshes.clone());
             let v = ShadowRayCaster::new(&s).visibility(
-                &s.light,
+                s.light(),
                 &ON_FLOOR,
                 &RaycastSettings::default(),
             );
-            assert_eq!(v, [0.0; 3], "{:?}", s.light.shape);
+            assert_eq!(v, [0.0; 3], "{:?}", s.light().shape);
         }
     }
 
@@ -988,7 +988,7 @@ mod tests {
         let caster = ShadowRayCaster::new(&s);
         for (samples, seed) in [(1024, 0), (1024, 77), (256, 3)] {
             let settings = RaycastSettings { samples, seed };
-            let v = caster.visibility(&s.light, &ON_FLOOR, &settings);
+            let v = caster.visibility(s.light(), &ON_FLOOR, &settings);
             let k = f64::from(samples).sqrt();
             assert!(
                 (f64::from(v[0]) - 0.65).abs() <= 1.0 / k + 2e-4,
@@ -1004,7 +1004,7 @@ mod tests {
         );
         let s = scene(rect_light(), vec![floor(), half]);
         let v =
-            ShadowRayCaster::new(&s).visibility(&s.light, &ON_FLOOR, &RaycastSettings::default());
+            ShadowRayCaster::new(&s).visibility(s.light(), &ON_FLOOR, &RaycastSettings::default());
         assert_eq!(v, [0.5; 3]);
     }
 
@@ -1032,7 +1032,7 @@ mod tests {
         );
         let s = scene(light, vec![floor(), half]);
         let v =
-            ShadowRayCaster::new(&s).visibility(&s.light, &ON_FLOOR, &RaycastSettings::default());
+            ShadowRayCaster::new(&s).visibility(s.light(), &ON_FLOOR, &RaycastSettings::default());
         // Red is hidden, blue fully visible, green emits nothing (reported as 0).
         assert_eq!(v, [0.0, 0.0, 1.0]);
         let out = raycast_visibility(&s, &[Some(ON_FLOOR), None], &RaycastSettings::default());
@@ -1189,8 +1189,8 @@ mod tests {
             let caster = ShadowRayCaster::new(&s);
             let (mut partial, mut empty, mut binned) = (0, 0, 0);
             for r in &receivers {
-                let samples = light_samples(&s.light, r.point, &settings);
-                let quad = sampling::bounding_quad(&s.light, r.point).unwrap();
+                let samples = light_samples(s.light(), r.point, &settings);
+                let quad = sampling::bounding_quad(s.light(), r.point).unwrap();
                 let o = r.point.as_dvec3() + caster.origin_offset * r.normal.as_dvec3();
                 let mut fast = Scratch {
                     lit: vec![true; samples.len()],
@@ -1206,11 +1206,11 @@ mod tests {
                     ..Default::default()
                 };
                 caster.trace_each(o, &samples, &mut full);
-                assert_eq!(fast.lit, full.lit, "{:?} at {:?}", s.light.shape, r.point);
+                assert_eq!(fast.lit, full.lit, "{:?} at {:?}", s.light().shape, r.point);
                 let lit = full.lit.iter().filter(|&&l| l).count();
                 partial += usize::from(lit > 0 && lit < samples.len());
                 assert_eq!(
-                    caster.visibility(&s.light, r, &settings),
+                    caster.visibility(s.light(), r, &settings),
                     caster.visibility_of_samples(r, &samples, None, &mut Scratch::default())
                 );
             }

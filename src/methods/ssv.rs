@@ -95,7 +95,7 @@ pub struct SsvSettings {
 /// Read the `ssv` options (module doc) for `frame`.
 pub fn read_settings(frame: &Frame) -> Result<(SsvSettings, &'static str), InputError> {
     let scene = frame.scene;
-    let textured = matches!(scene.light.shape, LightShape::TexturedRect { .. });
+    let textured = matches!(scene.light().shape, LightShape::TexturedRect { .. });
     let mut r = OptionReader::new(scene, "ssv");
     let mode = r.choice("mode", &["auto", "zpass", "zfail"], "auto")?;
     let coverage = r.choice(
@@ -134,7 +134,7 @@ pub fn read_settings(frame: &Frame) -> Result<(SsvSettings, &'static str), Input
             "textured lights need the RGB f32 V-buffer (vbuffer = \"f32\"); f16 and 8bit are grey",
         ));
     }
-    let center = scene.light.center;
+    let center = scene.light().center;
     let test = match mode {
         "zpass" => ShadowTest::ZPass,
         "zfail" => ShadowTest::ZFail,
@@ -216,8 +216,8 @@ pub fn render(frame: &Frame, settings: &SsvSettings) -> SsvRender {
 fn render_with<V: VBufferTile>(frame: &Frame, settings: &SsvSettings) -> SsvRender {
     let scene = frame.scene;
     let tiling = &frame.tiling;
-    let light = RectLight::from_light(&scene.light).expect("ssv supports rectangular lights");
-    let center = scene.light.center;
+    let light = RectLight::from_light(scene.light()).expect("ssv supports rectangular lights");
+    let center = scene.light().center;
     let mut vbuf: Vec<V> = (0..tiling.tile_count())
         .map(|_| V::cleared(tiling.tile_len()))
         .collect();
@@ -280,7 +280,7 @@ fn render_with<V: VBufferTile>(frame: &Frame, settings: &SsvSettings) -> SsvRend
     let receivers = frame.receivers();
     let texture = match settings.coverage {
         CoverageMode::Exact => None,
-        CoverageMode::Texture { n, .. } => Some(coverage_texture(&match &scene.light.shape {
+        CoverageMode::Texture { n, .. } => Some(coverage_texture(&match &scene.light().shape {
             LightShape::TexturedRect { texture, .. } => CoverageTextureKey::textured(n, texture),
             _ => CoverageTextureKey::uniform(n),
         })),
@@ -374,7 +374,7 @@ fn near_radius(frame: &Frame) -> f64 {
 /// volume, so `e0 = b`, `e1 = a` puts the umbra on the positive side of
 /// [`crate::light::coverage`]'s sign.
 fn edge_wedges(frame: &Frame, light: &RectLight) -> Vec<EdgeWedge> {
-    let center = frame.scene.light.center;
+    let center = frame.scene.light().center;
     let mut out = Vec::new();
     for (mesh, adj) in frame.scene.meshes.iter().zip(&frame.adjacency) {
         let facing = light_facing(mesh, center);
@@ -399,7 +399,7 @@ fn hard_quads_pass<V: VBufferTile>(frame: &Frame, test: ShadowTest, vbuf: &mut [
         ShadowTest::ZFail => Capping::Capped,
     };
     let meshes: Vec<_> = frame.scene.meshes.iter().zip(&frame.adjacency).collect();
-    let prims = shadow_volume_triangles(&meshes, frame.scene.light.center, &frame.proj, capping);
+    let prims = shadow_volume_triangles(&meshes, frame.scene.light().center, &frame.proj, capping);
     let (tris, mut counters) = setup_all(&prims, CullMode::None, &frame.tiling);
     let bins = bin(&frame.tiling, &tris);
     let depth = DepthState {

@@ -346,7 +346,7 @@ pub fn read_settings(r: &mut OptionReader, frame: &Frame) -> Result<Settings, In
         )
     })?;
     let mode = r.choice("mode", &["auto", "zpass", "zfail"], "auto")?;
-    let model = LightModel::from_shape(frame.scene.light.center, &frame.scene.light.shape)
+    let model = LightModel::from_shape(frame.scene.light().center, &frame.scene.light().shape)
         .ok_or_else(|| {
             InputError::at(
                 &frame.scene.source,
@@ -733,7 +733,7 @@ pub fn options(frame: &Frame) -> Result<Settings, InputError> {
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let start = Instant::now();
     let s = options(frame)?;
-    let model = LightModel::from_shape(frame.scene.light.center, &frame.scene.light.shape)
+    let model = LightModel::from_shape(frame.scene.light().center, &frame.scene.light().shape)
         .expect("read_settings checked the shape");
     let pieces = model
         .pieces(s.light_split)

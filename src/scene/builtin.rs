@@ -15,6 +15,7 @@
 //! | `pw-columns` | Paper II Fig. 9 analogue: 2×4 columns (16 segments, r 0.15, h 1.6) | sphere r 0.3 | 524 |
 //! | `pw-fractal` | Paper II Fig. 10 analogue: closed 24×24 midpoint-displacement landscape | sphere r 0.4 | 1440 |
 //! | `pw-2002` | Paper II Fig. 11 analogue: "2002" in seven-segment boxes at y = 0.9 | sphere r 0.25 | 276 |
+//! | `two-lights` | Paper I Fig. 16 analogue: the `cylinder` occluder and a box | two spheres r 0.3, 0.25 | 120 |
 
 use super::procedural::{box_mesh, cylinder, two_sided_quad, uv_sphere};
 use super::{Camera, Light, LightShape, Mesh, RawOptions, Scene};
@@ -34,6 +35,7 @@ const NAMES: &[&str] = &[
     "pw-columns",
     "pw-fractal",
     "pw-2002",
+    "two-lights",
 ];
 
 /// Names of all built-in scenes.
@@ -53,6 +55,7 @@ pub fn load(name: &str) -> Option<Scene> {
         "pw-columns" => pw_columns(),
         "pw-fractal" => pw_fractal(),
         "pw-2002" => pw_2002(),
+        "two-lights" => two_lights(),
         _ => return None,
     };
     Some(Scene {
@@ -102,7 +105,7 @@ fn scene(camera: Camera, light: Light, meshes: Vec<Mesh>) -> Scene {
         width: 256,
         height: 256,
         camera,
-        light,
+        lights: vec![light],
         meshes,
         methods: None,
         options: RawOptions::new(),
@@ -242,7 +245,32 @@ fn overlap_stress() -> Scene {
 /// twin that the penumbra-wedge methods (sphere lights only) render in the default run.
 fn cube_of_spheres_sphere() -> Scene {
     let mut s = cube_of_spheres();
-    s.light.shape = LightShape::Sphere { radius: 0.5 };
+    s.lights[0].shape = LightShape::Sphere { radius: 0.5 };
+    s
+}
+
+/// Paper I §7, Fig. 16 analogue: two sphere lights, one on each side, so that the floor shows
+/// two overlapping soft shadows of a floating cylinder and of a box (visibility = the mean
+/// over the lights).
+fn two_lights() -> Scene {
+    let mut s = cylinder_scene();
+    s.camera = camera([0.0, 2.8, 4.2], [0.0, 0.3, 0.4], 50.0);
+    s.meshes.push(box_mesh(
+        "box",
+        Vec3::new(-1.3, 0.3, 0.3),
+        Vec3::new(-0.8, 0.8, 0.8),
+        OCCLUDER,
+    ));
+    s.lights = vec![
+        Light {
+            center: Vec3::new(-1.8, 2.6, -1.6),
+            shape: LightShape::Sphere { radius: 0.3 },
+        },
+        Light {
+            center: Vec3::new(2.0, 2.2, -1.2),
+            shape: LightShape::Sphere { radius: 0.25 },
+        },
+    ];
     s
 }
 
@@ -477,6 +505,8 @@ mod tests {
         assert_eq!(count("pw-columns"), 12 + 8 * 64);
         assert_eq!(count("pw-fractal"), 24 * 24 * 2 + 96 * 3);
         assert_eq!(count("pw-2002"), 12 + 22 * 12);
+        assert_eq!(count("two-lights"), 12 + 96 + 12);
+        assert_eq!(load("two-lights").unwrap().lights.len(), 2);
     }
 
     /// The light's extent (a bounding sphere of its shape) clears every mesh's bounding box.
@@ -484,22 +514,24 @@ mod tests {
     fn lights_clear_geometry() {
         for &name in names() {
             let s = load(name).unwrap();
-            let r = match &s.light.shape {
-                LightShape::Point => 0.0,
-                LightShape::Sphere { radius } | LightShape::Disk { radius, .. } => *radius,
-                LightShape::Rect { u, v } | LightShape::TexturedRect { u, v, .. } => {
-                    u.length() + v.length()
+            for light in &s.lights {
+                let r = match &light.shape {
+                    LightShape::Point => 0.0,
+                    LightShape::Sphere { radius } | LightShape::Disk { radius, .. } => *radius,
+                    LightShape::Rect { u, v } | LightShape::TexturedRect { u, v, .. } => {
+                        u.length() + v.length()
+                    }
+                };
+                for m in &s.meshes {
+                    let (lo, hi) = m
+                        .positions
+                        .iter()
+                        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| {
+                            (l.min(*p), h.max(*p))
+                        });
+                    let d = light.center.clamp(lo, hi).distance(light.center);
+                    assert!(d > r + 0.5, "{name}: light {r} within {d} of {}", m.name);
                 }
-            };
-            for m in &s.meshes {
-                let (lo, hi) = m
-                    .positions
-                    .iter()
-                    .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| {
-                        (l.min(*p), h.max(*p))
-                    });
-                let d = s.light.center.clamp(lo, hi).distance(s.light.center);
-                assert!(d > r + 0.5, "{name}: light {r} within {d} of {}", m.name);
             }
         }
     }
@@ -515,7 +547,7 @@ mod tests {
         let s = load("eye-in-shadow").unwrap();
         let eye = s.camera.eye.as_vec3();
         for y in [SLAB.0.y, SLAB.1.y] {
-            let c = cross_at(eye, s.light.center, y);
+            let c = cross_at(eye, s.light().center, y);
             let margin = (c.x - SLAB.0.x)
                 .min(SLAB.1.x - c.x)
                 .min(c.z - SLAB.0.z)
@@ -535,7 +567,7 @@ mod tests {
                 .iter()
                 .filter(|m| {
                     let y = m.positions[0].y;
-                    let c = cross_at(p, s.light.center, y);
+                    let c = cross_at(p, s.light().center, y);
                     c.x.abs() < 0.6 && c.z.abs() < 0.6
                 })
                 .count()

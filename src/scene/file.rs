@@ -22,6 +22,9 @@
 //! normal = [0, -1, 0]         # disk (used as written, not normalized)
 //! texture = "fire.png"        # textured_rect, relative to the scene file, sRGB → linear
 //!
+//! # Several lights (Paper I §7): instead of [light], one [[lights]] table per light,
+//! # each with the fields of [light]; errors name `lights[K].<field>`.
+//!
 //! [[meshes]]
 //! obj = "models/bunny.obj"    # relative to the scene file
 //! transform = [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]   # optional, column-major, affine
@@ -32,7 +35,9 @@
 //! ```
 //!
 //! Unknown keys anywhere are errors (`deny_unknown_fields`), as are light fields that do not
-//! belong to the chosen light type and missing ones that do (the error names `light.<field>`).
+//! belong to the chosen light type and missing ones that do (the error names `light.<field>`),
+//! and a scene with both `light` and `lights`, with neither, or with more than
+//! [`crate::limits::MAX_LIGHTS`] lights.
 //! Option values must be scalars (integer, float, bool, string). Every error is one line
 //! naming the file, and for syntax and schema errors the line and column.
 
@@ -40,6 +45,7 @@ use super::obj::{check_transform, load_obj};
 use super::validate::validate;
 use super::{builtin, Camera, Light, LightShape, Mesh, OptionValue, RawOptions, RgbTexture, Scene};
 use crate::error::InputError;
+use crate::limits::MAX_LIGHTS;
 use glam::{DVec3, Mat4, Vec3};
 use serde::de::{self, IgnoredAny, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer};
@@ -83,7 +89,8 @@ struct SceneDef {
     ambient: Option<f64>,
     methods: Option<Vec<String>>,
     camera: CameraDef,
-    light: LightDef,
+    light: Option<LightDef>,
+    lights: Option<Vec<LightDef>>,
     meshes: Vec<MeshDef>,
     #[serde(default)]
     options: BTreeMap<String, BTreeMap<String, RawValue>>,
@@ -279,7 +286,7 @@ fn build(def: SceneDef, source: &str, base_dir: &Path) -> Result<Scene, InputErr
         vfov_deg: def.camera.vfov_deg,
         near: def.camera.near,
     };
-    let light = build_light(def.light, source, base_dir)?;
+    let lights = build_lights(def.light, def.lights, source, base_dir)?;
 
     let mut meshes = Vec::with_capacity(def.meshes.len());
     for (i, m) in def.meshes.iter().enumerate() {
@@ -310,7 +317,7 @@ fn build(def: SceneDef, source: &str, base_dir: &Path) -> Result<Scene, InputErr
         width: def.width.unwrap_or(DEFAULT_SIZE),
         height: def.height.unwrap_or(DEFAULT_SIZE),
         camera,
-        light,
+        lights,
         meshes,
         methods: def.methods,
         options,
@@ -327,9 +334,50 @@ const LIGHT_FIELDS: [(&str, &[&str]); 5] = [
     ("textured_rect", &["u", "v", "texture"]),
 ];
 
-fn build_light(l: LightDef, source: &str, base_dir: &Path) -> Result<Light, InputError> {
+/// The scene's lights from `light` (one) or `lights` (one or more), exactly one of the two.
+fn build_lights(
+    light: Option<LightDef>,
+    lights: Option<Vec<LightDef>>,
+    source: &str,
+    base_dir: &Path,
+) -> Result<Vec<Light>, InputError> {
+    match (light, lights) {
+        (Some(l), None) => Ok(vec![build_light(l, "light", source, base_dir)?]),
+        (None, Some(list)) => {
+            if list.is_empty() || list.len() > MAX_LIGHTS {
+                return Err(InputError::at(
+                    source,
+                    "lights",
+                    format!("has {} lights, needs 1..={MAX_LIGHTS}", list.len()),
+                ));
+            }
+            list.into_iter()
+                .enumerate()
+                .map(|(k, l)| build_light(l, &format!("lights[{k}]"), source, base_dir))
+                .collect()
+        }
+        (Some(_), Some(_)) => Err(InputError::at(
+            source,
+            "lights",
+            "give either [light] or [[lights]], not both".to_string(),
+        )),
+        (None, None) => Err(InputError::at(
+            source,
+            "light",
+            "missing: a scene needs [light] (or [[lights]] for several lights)".to_string(),
+        )),
+    }
+}
+
+/// One light; `object` names it in errors (`light` or `lights[K]`).
+fn build_light(
+    l: LightDef,
+    object: &str,
+    source: &str,
+    base_dir: &Path,
+) -> Result<Light, InputError> {
     let at =
-        |field: &str, message: String| InputError::at(source, format!("light.{field}"), message);
+        |field: &str, message: String| InputError::at(source, format!("{object}.{field}"), message);
     let Some(&(kind, fields)) = LIGHT_FIELDS.iter().find(|(k, _)| *k == l.kind) else {
         let kinds: Vec<&str> = LIGHT_FIELDS.iter().map(|(k, _)| *k).collect();
         return Err(at(
@@ -534,7 +582,7 @@ f = 0.5
         assert_eq!(o["name"], OptionValue::Str("x".into()));
         assert_eq!(o["f"], OptionValue::Float(0.5));
         assert_eq!(
-            s.light.shape,
+            s.light().shape,
             LightShape::Rect {
                 u: Vec3::X * 0.5,
                 v: Vec3::Z * 0.5
@@ -608,6 +656,71 @@ f = 0.5
         assert!(e.starts_with("s.toml: light.texture: cannot open "), "{e}");
     }
 
+    /// `GOOD` with its `[light]` replaced by `[[lights]]` tables of the given bodies.
+    fn with_lights(bodies: &[&str]) -> String {
+        let tables: String = bodies
+            .iter()
+            .map(|b| format!("[[lights]]\n{b}\n"))
+            .collect();
+        GOOD.replace(
+            "[light]\ntype = \"rect\"\ncenter = [0, 4, 0]\nu = [0.5, 0, 0]\nv = [0, 0, 0.5]\n",
+            &tables,
+        )
+    }
+
+    #[test]
+    fn several_lights() {
+        let rect = "type = \"rect\"\ncenter = [0, 4, 0]\nu = [0.5, 0, 0]\nv = [0, 0, 0.5]";
+        let sphere = "type = \"sphere\"\ncenter = [1, 4, 0]\nradius = 0.25";
+        let s = toml(&with_lights(&[rect, sphere])).unwrap();
+        assert_eq!(s.lights.len(), 2);
+        assert!(s.is_multi_light());
+        assert_eq!(s.lights[1].shape, LightShape::Sphere { radius: 0.25 });
+        assert_eq!(s.lights[1].center, Vec3::new(1.0, 4.0, 0.0));
+        // One [[lights]] table is the same scene as [light].
+        let dir = fixture();
+        assert_eq!(
+            toml_in(&dir, &with_lights(&[rect])).unwrap(),
+            toml_in(&dir, GOOD).unwrap()
+        );
+        let only = s.with_only_light(1);
+        assert_eq!(only.lights, vec![s.lights[1].clone()]);
+        assert_eq!(only.meshes, s.meshes);
+
+        let e = err(&with_lights(&[
+            rect,
+            "type = \"sphere\"\ncenter = [1, 4, 0]",
+        ]));
+        assert_eq!(
+            e,
+            "s.toml: lights[1].radius: missing: a \"sphere\" light needs radius"
+        );
+        let e = err(&with_lights(&[
+            rect,
+            "type = \"sphere\"\ncenter = [1, 4, 0]\nradius = 0",
+        ]));
+        assert!(e.starts_with("s.toml: lights[1].radius: "), "{e}");
+        let e = err(&format!("{GOOD}\n[[lights]]\n{sphere}\n"));
+        assert_eq!(
+            e,
+            "s.toml: lights: give either [light] or [[lights]], not both"
+        );
+        let e = err(&with_lights(&[]));
+        assert_eq!(
+            e,
+            "s.toml: light: missing: a scene needs [light] (or [[lights]] for several lights)"
+        );
+        let json = r#"{"camera": {"eye": [0, 2, 5], "target": [0, 0, 0], "up": [0, 1, 0], "vfov_deg": 45},
+            "lights": [], "meshes": [{"obj": "floor.obj"}]}"#;
+        let e = parse_scene_str(json, Format::Json, "s.json", &fixture())
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "s.json: lights: has 0 lights, needs 1..=255");
+        let many: Vec<&str> = vec![sphere; MAX_LIGHTS + 1];
+        let e = err(&with_lights(&many));
+        assert_eq!(e, "s.toml: lights: has 256 lights, needs 1..=255");
+    }
+
     #[test]
     fn mesh_and_option_errors() {
         let e = err(&GOOD.replace("obj = \"tet.obj\"", "obj = \"nope.obj\""));
@@ -646,7 +759,7 @@ f = 0.5
             ),
         )
         .unwrap();
-        let LightShape::TexturedRect { texture, .. } = &s.light.shape else {
+        let LightShape::TexturedRect { texture, .. } = &s.light().shape else {
             panic!()
         };
         assert_eq!((texture.width, texture.height), (2, 1));

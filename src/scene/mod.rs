@@ -1,5 +1,11 @@
-//! Scenes: the validated, in-memory description of one frame — image size, camera, light,
+//! Scenes: the validated, in-memory description of one frame — image size, camera, lights,
 //! closed meshes in world space, the methods to run and their options.
+//!
+//! A scene holds one light or several (Paper I §7, Fig. 16: "multiply the light intensities
+//! by 255/n, where n is the number of lights"). Visibility with n lights is the mean of the
+//! per-light visibilities; the penumbra-wedge methods compute it in one LI buffer with
+//! amounts scaled by 255/n, every other method renders each light on its own
+//! ([`Scene::with_only_light`]) and averages ([`crate::methods::run`]).
 //!
 //! Files are TOML or JSON with one schema ([`file`]); built-in scenes are generated in code
 //! ([`builtin`]); OBJ meshes are loaded with `tobj` ([`obj`]). Everything that reaches a
@@ -141,8 +147,8 @@ pub struct Scene {
     pub height: u32,
     /// The camera.
     pub camera: Camera,
-    /// The single area light.
-    pub light: Light,
+    /// The lights, at least one and at most [`crate::limits::MAX_LIGHTS`].
+    pub lights: Vec<Light>,
     /// The shadow-casting and receiving meshes (every mesh does both).
     pub meshes: Vec<Mesh>,
     /// Methods to run; `None` = every method that supports the light shape.
@@ -154,10 +160,34 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// Axis-aligned bounds (min, max) of all mesh vertices and the light center.
+    /// The light of a single-light scene. Methods that render one light at a time only ever
+    /// see single-light scenes ([`Scene::with_only_light`]); for a multi-light scene this is
+    /// the first light.
+    pub fn light(&self) -> &Light {
+        &self.lights[0]
+    }
+
+    /// Whether the scene has more than one light.
+    pub fn is_multi_light(&self) -> bool {
+        self.lights.len() > 1
+    }
+
+    /// A copy of this scene lit by light `k` alone (same camera, meshes, methods, options).
+    pub fn with_only_light(&self, k: usize) -> Scene {
+        Scene {
+            lights: vec![self.lights[k].clone()],
+            ..self.clone()
+        }
+    }
+
+    /// Axis-aligned bounds (min, max) of all mesh vertices and every light center.
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        let mut lo = self.light.center;
-        let mut hi = self.light.center;
+        let mut lo = self.light().center;
+        let mut hi = lo;
+        for l in &self.lights {
+            lo = lo.min(l.center);
+            hi = hi.max(l.center);
+        }
         for m in &self.meshes {
             for p in &m.positions {
                 lo = lo.min(*p);

@@ -3,18 +3,18 @@
 //!
 //! Checked: image size in `1..=MAX_IMAGE_SIZE`; every number finite (camera, light, every
 //! vertex, colours); camera with `vfov_deg` in (0,180), `eye ≠ target`, `up` not parallel to
-//! the view direction, `near > 0` if given; a light of positive size (radius > 0; `u`, `v`
+//! the view direction, `near > 0` if given; 1 to [`MAX_LIGHTS`] lights, each of positive size (radius > 0; `u`, `v`
 //! non-zero and not parallel; disk normal non-zero; a non-empty texture of `width·height`
 //! texels in `[0,1]`); at least one mesh, each a closed, consistently wound two-manifold
 //! ([`crate::geometry::adjacency::build`], the message names the offending edge) that is not
-//! inside out (signed volume not negative; flat two-sided meshes have volume 0); the light
+//! inside out (signed volume not negative; flat two-sided meshes have volume 0); every light
 //! centre strictly outside every mesh (bounding box, then ray parity); `ambient` in `[0,1]`;
 //! a `methods` list, if given, not empty (the names are checked by the methods registry).
 
 use super::{Camera, Light, LightShape, Mesh, Scene};
 use crate::error::InputError;
 use crate::geometry::adjacency;
-use crate::limits::MAX_IMAGE_SIZE;
+use crate::limits::{MAX_IMAGE_SIZE, MAX_LIGHTS};
 use glam::{DVec3, Vec3};
 
 /// Checks every invariant a [`Scene`] promises (see the module docs); the first violation is
@@ -27,7 +27,15 @@ pub fn validate(scene: &Scene) -> Result<(), InputError> {
         }
     }
     validate_camera(&scene.camera).map_err(|(o, m)| err(o, m))?;
-    validate_light(&scene.light).map_err(|(o, m)| err(o, m))?;
+    if scene.lights.is_empty() || scene.lights.len() > MAX_LIGHTS {
+        return Err(err(
+            "lights",
+            format!("has {} lights, needs 1..={MAX_LIGHTS}", scene.lights.len()),
+        ));
+    }
+    for (k, light) in scene.lights.iter().enumerate() {
+        validate_light(light).map_err(|(o, m)| err(&light_object(scene, k, o), m))?;
+    }
     if !(scene.ambient.is_finite() && (0.0..=1.0).contains(&scene.ambient)) {
         return Err(err(
             "ambient",
@@ -49,19 +57,34 @@ pub fn validate(scene: &Scene) -> Result<(), InputError> {
         let object = format!("meshes[{i}] ({})", mesh.name);
         validate_mesh(mesh).map_err(|m| err(&object, m))?;
     }
-    for (i, mesh) in scene.meshes.iter().enumerate() {
-        if let Some(why) = light_touches(mesh, scene.light.center) {
-            return Err(err(
-                "light",
-                format!(
-                    "light intersects geometry: the light center {} is {why} meshes[{i}] ({})",
-                    fmt_f32v(scene.light.center),
-                    mesh.name
-                ),
-            ));
+    for (k, light) in scene.lights.iter().enumerate() {
+        for (i, mesh) in scene.meshes.iter().enumerate() {
+            if let Some(why) = light_touches(mesh, light.center) {
+                return Err(err(
+                    &light_object(scene, k, "light"),
+                    format!(
+                        "light intersects geometry: the light center {} is {why} meshes[{i}] ({})",
+                        fmt_f32v(light.center),
+                        mesh.name
+                    ),
+                ));
+            }
         }
     }
     Ok(())
+}
+
+/// The name of light `k`'s field `object` (written `light.FIELD`) in messages: unchanged for a
+/// single-light scene, `lights[K].FIELD` when the scene has several lights.
+fn light_object(scene: &Scene, k: usize, object: &str) -> String {
+    if scene.is_multi_light() {
+        format!(
+            "lights[{k}]{}",
+            object.strip_prefix("light").unwrap_or(object)
+        )
+    } else {
+        object.to_string()
+    }
 }
 
 /// Formats a vector as `(x, y, z)` with Rust's shortest round-trip digits.
@@ -418,13 +441,13 @@ mod tests {
                 vfov_deg: 45.0,
                 near: None,
             },
-            light: Light {
+            lights: vec![Light {
                 center: Vec3::new(0.0, 4.0, 0.0),
                 shape: LightShape::Rect {
                     u: Vec3::X * 0.5,
                     v: Vec3::Z * 0.5,
                 },
-            },
+            }],
             meshes: vec![
                 box_mesh(
                     "floor",
@@ -485,24 +508,24 @@ mod tests {
     #[test]
     fn light_errors() {
         let mut s = scene();
-        s.light.shape = LightShape::Sphere { radius: 0.0 };
+        s.lights[0].shape = LightShape::Sphere { radius: 0.0 };
         assert!(msg(&s).contains("light.radius: 0 must be a finite number > 0 (zero-size light)"));
-        s.light.shape = LightShape::Rect {
+        s.lights[0].shape = LightShape::Rect {
             u: Vec3::ZERO,
             v: Vec3::Z,
         };
         assert!(msg(&s).contains("light.u: is the zero vector"));
-        s.light.shape = LightShape::Rect {
+        s.lights[0].shape = LightShape::Rect {
             u: Vec3::X,
             v: Vec3::X * -2.0,
         };
         assert!(msg(&s).contains("light.v") && msg(&s).contains("parallel"));
-        s.light.shape = LightShape::Disk {
+        s.lights[0].shape = LightShape::Disk {
             radius: 1.0,
             normal: Vec3::ZERO,
         };
         assert!(msg(&s).contains("light.normal"));
-        s.light.shape = LightShape::TexturedRect {
+        s.lights[0].shape = LightShape::TexturedRect {
             u: Vec3::X,
             v: Vec3::Z,
             texture: RgbTexture {
@@ -513,8 +536,8 @@ mod tests {
             },
         };
         assert!(msg(&s).contains("light.texture: t.png is empty"));
-        s.light.shape = LightShape::Point;
-        s.light.center.y = f32::INFINITY;
+        s.lights[0].shape = LightShape::Point;
+        s.lights[0].center.y = f32::INFINITY;
         assert!(msg(&s).contains("light.center"));
     }
 
@@ -547,19 +570,46 @@ mod tests {
     }
 
     #[test]
+    fn several_lights_are_each_checked_and_named() {
+        let mut s = scene();
+        let second = Light {
+            center: Vec3::new(2.0, 4.0, 0.0),
+            shape: LightShape::Sphere { radius: 0.0 },
+        };
+        s.lights.push(second.clone());
+        assert!(
+            msg(&s).starts_with("test-scene: lights[1].radius: 0 must be a finite number > 0"),
+            "{}",
+            msg(&s)
+        );
+        s.lights[1].shape = LightShape::Sphere { radius: 0.2 };
+        validate(&s).unwrap();
+        s.lights[1].center = Vec3::new(0.1, 1.05, -0.02);
+        assert!(
+            msg(&s).starts_with("test-scene: lights[1]: light intersects geometry"),
+            "{}",
+            msg(&s)
+        );
+        s.lights = vec![second; MAX_LIGHTS + 1];
+        assert_eq!(msg(&s), "test-scene: lights: has 256 lights, needs 1..=255");
+        s.lights.clear();
+        assert_eq!(msg(&s), "test-scene: lights: has 0 lights, needs 1..=255");
+    }
+
+    #[test]
     fn light_inside_geometry() {
         let mut s = scene();
-        s.light.center = Vec3::new(0.1, 1.05, -0.02);
+        s.lights[0].center = Vec3::new(0.1, 1.05, -0.02);
         let m = msg(&s);
         assert!(
             m.contains("light intersects geometry") && m.contains("inside meshes[1] (ball)"),
             "{m}"
         );
         // Inside the bounding box of the sphere but outside the sphere itself: fine.
-        s.light.center = Vec3::new(0.45, 1.45, 0.45);
+        s.lights[0].center = Vec3::new(0.45, 1.45, 0.45);
         validate(&s).unwrap();
         // On the floor's top surface.
-        s.light.center = Vec3::new(1.0, 0.0, 1.0);
+        s.lights[0].center = Vec3::new(1.0, 0.0, 1.0);
         assert!(msg(&s).contains("on the surface of meshes[0] (floor)"));
         // Next to a two-sided quad, inside its (flat) bounding box only when on its plane.
         let q = [
@@ -569,9 +619,9 @@ mod tests {
             Vec3::new(-1.0, 2.0, -1.0),
         ];
         s.meshes[1] = two_sided_quad("quad", q, [0.5; 3]);
-        s.light.center = Vec3::new(0.3, 2.0, 0.2);
+        s.lights[0].center = Vec3::new(0.3, 2.0, 0.2);
         assert!(msg(&s).contains("on the surface of meshes[1] (quad)"));
-        s.light.center = Vec3::new(0.3, 3.0, 0.2);
+        s.lights[0].center = Vec3::new(0.3, 3.0, 0.2);
         validate(&s).unwrap();
     }
 

@@ -1,0 +1,132 @@
+//! Several lights for methods that render one light at a time: the method runs once per light
+//! on the same frame lit by that light alone ([`Scene::with_only_light`],
+//! [`Frame::lit_by`]), and the visibilities are averaged — the definition Paper I §7 gives
+//! for n lights ("multiply the light intensities by 255/n"), which the penumbra-wedge methods
+//! instead compute natively in one LI buffer.
+//!
+//! Arithmetic: per pixel and channel, the per-light values are summed in f32 in light order
+//! and the sum is divided by n once (fixed order: independent of threads). A gray and an RGB
+//! result average to RGB (gray replicated). Stats: the scene pass appears once; every pass of
+//! light k is named `light<k>/<pass>`; raw images are named `<name>-light<k>`; the plan lists
+//! the per-light plans.
+
+use super::output::{MethodOutput, RawImage8, Visibility};
+use crate::error::InputError;
+use crate::frame::Frame;
+use crate::gpu::counters::Counters;
+use crate::scene::Scene;
+use std::time::Instant;
+
+/// Run `method` (through `run_one`, the single-light dispatch) once per light of `frame`'s
+/// scene and average the visibilities.
+pub fn run(
+    method: &str,
+    frame: &Frame,
+    run_one: impl Fn(&str, &Frame) -> Result<MethodOutput, InputError>,
+) -> Result<MethodOutput, InputError> {
+    let start = Instant::now();
+    let lights = frame.scene.lights.len();
+    let mut outputs = Vec::with_capacity(lights);
+    for k in 0..lights {
+        let scene: Scene = frame.scene.with_only_light(k);
+        outputs.push(run_one(method, &frame.lit_by(&scene))?);
+    }
+    let visibility = average(outputs.iter().map(|o| &o.visibility));
+    let mut passes = vec![frame.pass.clone()];
+    let mut raw_images = Vec::new();
+    let mut plans = Vec::new();
+    for (k, out) in outputs.into_iter().enumerate() {
+        passes.extend(
+            out.stats
+                .passes
+                .into_iter()
+                .filter(|p| p.name != frame.pass.name)
+                .map(|mut p| {
+                    p.name = format!("light{k}/{}", p.name);
+                    p
+                }),
+        );
+        raw_images.extend(out.raw_images.into_iter().map(|r| RawImage8 {
+            name: format!("{}-light{k}", r.name),
+            values: r.values,
+        }));
+        plans.push(out.stats.plan);
+    }
+    let mut totals = Counters::default();
+    for p in &passes {
+        totals += p.counters;
+    }
+    Ok(MethodOutput {
+        visibility,
+        raw_images,
+        stats: super::output::MethodStats {
+            method: method.into(),
+            width: frame.scene.width,
+            height: frame.scene.height,
+            wall_seconds: start.elapsed().as_secs_f64(),
+            plan: serde_json::json!({
+                "method": method,
+                "lights": lights,
+                "combine": "mean of per-light visibilities (f32 sum in light order, / n)",
+                "per_light": plans,
+            }),
+            passes,
+            totals,
+        },
+    })
+}
+
+/// The mean of the visibilities, per pixel and channel: f32 sum in order, divided by n once.
+pub fn average<'a>(all: impl Iterator<Item = &'a Visibility> + Clone) -> Visibility {
+    let n = all.clone().count() as f32;
+    let rgb = all.clone().any(|v| matches!(v, Visibility::Rgb(_)));
+    let len = all.clone().next().map_or(0, Visibility::len);
+    if rgb {
+        Visibility::Rgb(
+            (0..len)
+                .map(|i| {
+                    let mut sum = [0.0f32; 3];
+                    for v in all.clone() {
+                        let c = v.rgb(i);
+                        for ch in 0..3 {
+                            sum[ch] += c[ch];
+                        }
+                    }
+                    sum.map(|s| s / n)
+                })
+                .collect(),
+        )
+    } else {
+        Visibility::Gray(
+            (0..len)
+                .map(|i| all.clone().map(|v| v.gray(i)).sum::<f32>() / n)
+                .collect(),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn average_is_the_ordered_mean() {
+        let a = Visibility::Gray(vec![0.0, 1.0, 0.25]);
+        let b = Visibility::Gray(vec![1.0, 1.0, 0.5]);
+        assert_eq!(
+            average([&a, &b].into_iter()),
+            Visibility::Gray(vec![0.5, 1.0, 0.375])
+        );
+        let c = Visibility::Rgb(vec![[1.0, 0.0, 0.5]; 3]);
+        assert_eq!(
+            average([&a, &c].into_iter()),
+            Visibility::Rgb(vec![
+                [0.5, 0.0, 0.25],
+                [1.0, 0.5, 0.75],
+                [0.625, 0.125, 0.375]
+            ])
+        );
+        // One light: unchanged.
+        assert_eq!(average([&a].into_iter()), a);
+    }
+}
