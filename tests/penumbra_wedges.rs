@@ -412,12 +412,27 @@ fn zfail_umbra_surface_is_closed_also_where_the_parallel_rule_moves_vertices() {
 /// every penumbra contribution, so the LI buffers are equal bit for bit.
 ///
 /// They are not equal everywhere on the lit-eye built-ins (64²: 1 pixel of `cylinder`, 1 of
-/// `pw-2002`, 3 of `pw-fractal`, 2 of `cube-of-spheres-sphere`; none of `pw-columns`): there
-/// the receiver point lies less than one D24 step behind the side face shared by two wedges
-/// (e.g. `cylinder` pixel (14, 33): ray parameter 318.0756 against the side plane at
-/// 318.0635). The entry face's fragment then quantizes to the stored depth and fails LESS, so
-/// z-pass (like `pw2002`) counts the penumbra of neither wedge, while z-fail counts the exit
-/// face of the wedge whose world-space inside test holds p (LI 0 against 194 there).
+/// `pw-2002`, 3 of `pw-fractal`, 2 of `cube-of-spheres-sphere`, none of `pw-columns`; 256²:
+/// `cylinder` 1, `pw-2002` 8, `pw-fractal` 83, `cube-of-spheres-sphere` 11, `pw-columns` 3).
+/// Two causes were found by tracing single pixels (not every pixel was traced):
+/// * **Depth ties.** The receiver point p lies within about one D24 step of a wedge face,
+///   where the depth test of the rasterized face (its interpolated f32 depth, quantized,
+///   against the stored depth) and the world-space inside test of the penumbra (at the
+///   un-projected stored depth, f64) disagree about which side of the face p is on; z-pass
+///   tests the faces in front of p and z-fail those behind it, so they resolve the tie from
+///   opposite sides. `cylinder` 64² pixel (14, 33): p at ray parameter 318.0756 lies in
+///   wedge 18 just past the side plane it shares with wedge 19 (318.0635); the entry face's
+///   fragment quantizes to the stored depth and fails LESS, so z-pass (like `pw2002`) adds
+///   the penumbra of neither wedge (LI 0, `raycast` 0.84) while z-fail adds wedge 18's
+///   (LI 194). `pw-fractal` 256² pixel (178, 112): p lies in wedge 357 0.0022 before it leaves
+///   through its front plane (372.3636 against 372.3658); z-pass adds the penumbra (+255,
+///   s = 1) and, because the front face's fragment passes LESS, also the umbra exit (+255),
+///   z-fail neither.
+/// * **Unbounded wedges.** 5 of the 629 wedges of `pw-fractal` have fewer than 3 faces: their
+///   five half-spaces are not bounded by the bottom plane (corner wedge 379 has a direction
+///   d with n·d < −0.04 for all five normals), so the faces do not enclose the points the
+///   inside test accepts. 64² pixel (54, 32): p lies in wedge 379, whose only face is on the
+///   side z-fail draws (LI 445 against 452).
 #[test]
 fn zpass_and_zfail_agree_where_the_parallel_rule_fires() {
     let scene = parallel_corner_box(64);
