@@ -2,9 +2,12 @@
 //! buffers, z-fail, overflow, construction invariants and hard cases.
 
 use penumbra::frame::{Frame, GpuSettings};
+use penumbra::gpu::transform::ClipVertex;
 use penumbra::methods::pw2002::{self, WedgeSettings};
 use penumbra::methods::pw_restructured::{self, Culling, Passes, RestructuredSettings, WedgeTest};
 use penumbra::scene::{builtin, Scene};
+use std::cmp::Ordering;
+use std::collections::BTreeMap;
 
 fn small(name: &str, size: u32) -> Scene {
     let mut s = builtin::load(name).expect("built-in scene");
@@ -46,14 +49,49 @@ fn restructured(
 
 /// Pixels where the LI buffers of `pw2002` (side planes cancelling, Paper I §5) and
 /// `pw-restructured` (z-pass) may differ: pixels whose eye ray grazes a line where two wedge
-/// faces meet. There `pw2002` finds the exit plane analytically in f64 while
+/// faces meet. There `pw2002` finds the exit plane analytically in f64 (Paper I §6) while
 /// `pw-restructured` sees whether the snapped, fixed-point triangle of the neighbouring face
 /// covers the pixel center; both are exact for their own representation but can disagree by
 /// one umbra step. Everywhere else the two add the same integers (same wedges, same
 /// `light_intensity`, same `li_amount`). The equality needs the same wedges in both: scenes
 /// with degenerate wedges (Fig. 6), whose umbra `pw-restructured` draws with the outer-volume
 /// quad instead, are excluded — `cube-of-spheres-sphere` has them (asserted below).
+///
+/// The one `pw-columns` pixel (64², pixel (4, 32): `pw2002` LI 0, `pw-restructured` 255,
+/// `raycast` 1.0): its eye ray runs through wedge 101 of the loop, crosses the side plane
+/// shared with wedge 100 at ray parameter 305.4964, and leaves wedge 100 through its front
+/// plane at 305.5179 (wedge 101's front plane is at 305.5550): in f64 it passes 0.0011 pixel
+/// from the projected front line the two wedges share (where both front planes and the side
+/// plane meet), less than the rasterizer's vertex snapping of 1/256 pixel. The snapped
+/// triangles put the pixel center on wedge 101's side of that line: `pw-restructured` counts
+/// wedge 101's back-facing front face (+255, leaving the umbra); `pw2002` adds nothing: wedge
+/// 100's entry face does not cover the pixel, and for wedge 101 its analytic f64 exit is the
+/// left side plane (value 0 with `cancel`), not the front plane. Making them agree would mean
+/// replacing the analytic exit search of Paper I §6 by the rasterizer's coverage test of the
+/// exit faces, so the pixel is allowed rather than forced.
 const GRAZING_PIXELS_ALLOWED: [(&str, usize); 2] = [("cylinder", 0), ("pw-columns", 1)];
+
+/// Where `pw-restructured` and `pw2002` (`cancel`) build their umbra differently — the
+/// outer-volume quad of degenerate wedges (Fig. 6) — their LI buffers differ, but only by
+/// whole umbra steps: the penumbra contributions stay identical (64² `cube-of-spheres-sphere`:
+/// 35 pixels differ, all by multiples of 255; see the light-spike note in `pw_restructured`).
+#[test]
+fn degenerate_wedges_change_only_whole_umbra_steps() {
+    let scene = small("cube-of-spheres-sphere", 64);
+    let frame = Frame::render(&scene, GpuSettings::default()).unwrap();
+    let mut w = wedge_settings(&frame);
+    w.side_planes = pw2002::SidePlanes::Cancel;
+    let a = li_pw2002(&frame, &w);
+    let b = li_restructured(
+        &frame,
+        &restructured(w, WedgeTest::ZPass, Passes::Single, Culling::ZminZmax),
+    );
+    let diff: Vec<usize> = (0..a.len()).filter(|&i| a[i] != b[i]).collect();
+    assert!(!diff.is_empty());
+    for i in diff {
+        assert_eq!((b[i] - a[i]) % 255, 0, "pixel {i}: {} vs {}", a[i], b[i]);
+    }
+}
 
 #[test]
 fn large_light_over_small_spheres_gives_degenerate_wedges() {
@@ -255,11 +293,10 @@ fn wedge_faces_are_closed_and_contain_their_edge() {
     }
 }
 
-#[test]
-fn near_parallel_rule_removes_edges_and_without_it_wedges_degenerate() {
-    use penumbra::geometry::penumbra_wedge::nearly_parallel;
-    // A box whose vertical edges point straight at the light: light directly above a corner.
-    let mut scene = small("eye-in-shadow", 32);
+/// A floor and a box whose vertical edges point almost straight at the light (light directly
+/// above a corner), so that the near-parallel rule (Paper I §8) fires; the eye is lit.
+fn parallel_corner_box(size: u32) -> Scene {
+    let mut scene = small("eye-in-shadow", size);
     scene.meshes.truncate(1);
     scene.meshes.push(penumbra::scene::procedural::box_mesh(
         "box",
@@ -269,6 +306,13 @@ fn near_parallel_rule_removes_edges_and_without_it_wedges_degenerate() {
     ));
     scene.lights[0].center = glam::Vec3::new(-0.01, 4.0, 2.01);
     scene.lights[0].shape = LightShape::Sphere { radius: 0.2 };
+    scene
+}
+
+#[test]
+fn near_parallel_rule_removes_edges_and_without_it_wedges_degenerate() {
+    use penumbra::geometry::penumbra_wedge::nearly_parallel;
+    let scene = parallel_corner_box(32);
     let frame = Frame::render(&scene, GpuSettings::default()).unwrap();
     let mut w = wedge_settings(&frame);
     let with_rule = pw2002::frame_wedges(&frame, &w).unwrap();
@@ -290,4 +334,115 @@ fn near_parallel_rule_removes_edges_and_without_it_wedges_degenerate() {
     let on = li_pw2002(&frame, &wedge_settings(&frame));
     let off = li_pw2002(&frame, &w);
     assert_ne!(on, off);
+}
+
+/// The umbra surface `pw-restructured` rasterizes in z-fail (Paper II §5: top caps, front
+/// planes — the outer-volume quad for degenerate wedges — and bottom caps) as clip-space
+/// triangles, exactly as submitted.
+fn zfail_umbra_surface(
+    frame: &Frame,
+    set: &penumbra::geometry::penumbra_wedge::WedgeSet,
+) -> Vec<[ClipVertex; 3]> {
+    use penumbra::geometry::penumbra_wedge::{cap_triangles, wedge_triangles, FaceKind};
+    let mut tris: Vec<[ClipVertex; 3]> = cap_triangles(set, &frame.proj)
+        .iter()
+        .map(|t| t.clip)
+        .collect();
+    for t in wedge_triangles(set, &frame.proj) {
+        let w = &set.wedges[t.wedge.unwrap() as usize];
+        if t.kind == Some(FaceKind::Front) && w.front_face_is_quad() {
+            tris.push(t.clip);
+        }
+    }
+    for w in set.wedges.iter().filter(|w| !w.front_face_is_quad()) {
+        tris.extend(
+            w.umbra_front_quad()
+                .map(|t| t.map(|p| frame.proj.clip_point(p.as_vec3()))),
+        );
+    }
+    tris
+}
+
+/// Directed edges of `tris` not cancelled by the same edge in the opposite direction (with
+/// bit-identical clip-space vertices): none for a closed, consistently oriented surface.
+fn open_edges(tris: &[[ClipVertex; 3]]) -> usize {
+    let key = |v: &ClipVertex| v.0.map(f32::to_bits);
+    let mut count: BTreeMap<([u32; 4], [u32; 4]), i32> = BTreeMap::new();
+    for t in tris {
+        for i in 0..3 {
+            let (u, v) = (key(&t[i]), key(&t[(i + 1) % 3]));
+            match u.cmp(&v) {
+                Ordering::Less => *count.entry((u, v)).or_default() += 1,
+                Ordering::Greater => *count.entry((v, u)).or_default() -= 1,
+                Ordering::Equal => {}
+            }
+        }
+    }
+    count.values().filter(|c| **c != 0).count()
+}
+
+/// Paper II §5: z-fail needs the umbra surface (top caps, front planes, bottom caps) closed.
+/// The near-parallel rule (Paper I §8) moves loop vertices to midpoints, off the top caps'
+/// boundary; without the patch triangles it adds to the top caps the surface has holes there
+/// (z-fail then differs from z-pass at 114 pixels of a 64² render of `parallel_corner_box`,
+/// LI off by up to 255, in streaks).
+#[test]
+fn zfail_umbra_surface_is_closed_also_where_the_parallel_rule_moves_vertices() {
+    let mut scenes: Vec<Scene> = ["cylinder", "pw-columns", "pw-2002", "pw-fractal"]
+        .iter()
+        .map(|n| small(n, 32))
+        .collect();
+    scenes.push(small("cube-of-spheres-sphere", 32));
+    scenes.push(parallel_corner_box(32));
+    for scene in scenes {
+        let frame = Frame::render(&scene, GpuSettings::default()).unwrap();
+        let set = pw2002::frame_wedges(&frame, &wedge_settings(&frame)).unwrap();
+        assert_eq!(
+            open_edges(&zfail_umbra_surface(&frame, &set)),
+            0,
+            "{}: {} edges removed by the parallel rule",
+            scene.source,
+            set.removed_parallel
+        );
+    }
+}
+
+/// With the eye lit and the umbra surface closed, z-pass and z-fail count the same umbra
+/// crossings; on `parallel_corner_box` (where the near-parallel rule fires) they also agree on
+/// every penumbra contribution, so the LI buffers are equal bit for bit.
+///
+/// They are not equal everywhere on the lit-eye built-ins (64²: 1 pixel of `cylinder`, 1 of
+/// `pw-2002`, 3 of `pw-fractal`, 2 of `cube-of-spheres-sphere`, none of `pw-columns`; 256²:
+/// `cylinder` 1, `pw-2002` 8, `pw-fractal` 83, `cube-of-spheres-sphere` 11, `pw-columns` 3).
+/// Two causes were found by tracing single pixels (not every pixel was traced):
+/// * **Depth ties.** The receiver point p lies within about one D24 step of a wedge face,
+///   where the depth test of the rasterized face (its interpolated f32 depth, quantized,
+///   against the stored depth) and the world-space inside test of the penumbra (at the
+///   un-projected stored depth, f64) disagree about which side of the face p is on; z-pass
+///   tests the faces in front of p and z-fail those behind it, so they resolve the tie from
+///   opposite sides. `cylinder` 64² pixel (14, 33): p at ray parameter 318.0756 lies in
+///   wedge 18 just past the side plane it shares with wedge 19 (318.0635); the entry face's
+///   fragment quantizes to the stored depth and fails LESS, so z-pass (like `pw2002`) adds
+///   the penumbra of neither wedge (LI 0, `raycast` 0.84) while z-fail adds wedge 18's
+///   (LI 194). `pw-fractal` 256² pixel (178, 112): p lies in wedge 357 0.0022 before it leaves
+///   through its front plane (372.3636 against 372.3658); z-pass adds the penumbra (+255,
+///   s = 1) and, because the front face's fragment passes LESS, also the umbra exit (+255),
+///   z-fail neither.
+/// * **Unbounded wedges.** 5 of the 629 wedges of `pw-fractal` have fewer than 3 faces: their
+///   five half-spaces are not bounded by the bottom plane (corner wedge 379 has a direction
+///   d with n·d < −0.04 for all five normals), so the faces do not enclose the points the
+///   inside test accepts. 64² pixel (54, 32): p lies in wedge 379, whose only face is on the
+///   side z-fail draws (LI 445 against 452).
+#[test]
+fn zpass_and_zfail_agree_where_the_parallel_rule_fires() {
+    let scene = parallel_corner_box(64);
+    let frame = Frame::render(&scene, GpuSettings::default()).unwrap();
+    let w = wedge_settings(&frame);
+    assert!(pw2002::frame_wedges(&frame, &w).unwrap().removed_parallel >= 1);
+    for passes in [Passes::Single, Passes::Three] {
+        let li = |test| li_restructured(&frame, &restructured(w, test, passes, Culling::ZminZmax));
+        let (a, b) = (li(WedgeTest::ZPass), li(WedgeTest::ZFail));
+        let diff = (0..a.len()).filter(|&i| a[i] != b[i]).count();
+        assert_eq!(diff, 0, "{passes:?}: {diff} pixels differ");
+    }
 }

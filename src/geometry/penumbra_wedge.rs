@@ -36,7 +36,8 @@
 //!   direction of the light ray through it is removed, and its two neighbours are shortened or
 //!   lengthened to meet at the removed edge's midpoint ("remove such edges, and shorten &
 //!   connect its neighbors"). The rule is optional so that a test can show what happens
-//!   without it.
+//!   without it. The moved vertices no longer lie on the top caps' boundary, so the rule also
+//!   adds patch triangles to the top caps that keep the outer soft shadow volume closed.
 //!
 //! # Light intensity (Paper I §4.2, equations 1–3)
 //! [`light_intensity`]: s_l and s_r from the front/back distances along the left and right side
@@ -228,7 +229,8 @@ pub struct WedgeOptions {
 pub struct WedgeSet {
     /// Wedges, mesh by mesh, loop by loop, in walk order.
     pub wedges: Vec<Wedge>,
-    /// Top caps: the light-facing triangles of every mesh (outward = toward the light).
+    /// Top caps: the light-facing triangles of every mesh (outward = toward the light), plus
+    /// the patches that join them to loops shortened by the near-parallel rule (§8).
     pub top_caps: Vec<[DVec3; 3]>,
     /// Bottom caps: fans over the far points `P_v` of every loop, facing away from the light.
     pub bottom_caps: Vec<[DVec3; 3]>,
@@ -280,8 +282,17 @@ pub fn nearly_parallel(a: DVec3, b: DVec3, c: DVec3) -> bool {
 }
 
 /// Remove near-parallel edges of a closed loop of vertex positions, joining the neighbours at
-/// the removed edge's midpoint; returns the removed count.
-fn apply_parallel_rule(lp: &mut Vec<DVec3>, c: DVec3) -> usize {
+/// the removed edge's midpoint (Paper I §8); returns the removed count.
+///
+/// The wedges then start at the new loop while the top caps (the light-facing triangles) end
+/// at the mesh's silhouette, so each removal also pushes to `patches` the triangles that carry
+/// the top cap from the old loop to the new one (Paper II §5: the caps and front planes must
+/// close the soft shadow volume exactly, else z-fail counts leak). Replacing `x→p→q→y` by
+/// `x→m→y` (m the midpoint of p, q) adds `(x, m, p)`, `(m, y, q)` and the zero-area
+/// `(p, m, q)`: their boundary is `x→m→y` minus `x→p→q→y`, every edge shared with exactly the
+/// same vertices, so the rasterized surface stays watertight even where the snapped `p, m, q`
+/// are not collinear.
+fn apply_parallel_rule(lp: &mut Vec<DVec3>, c: DVec3, patches: &mut Vec<[DVec3; 3]>) -> usize {
     let mut removed = 0;
     while lp.len() >= 3 {
         let m = lp.len();
@@ -289,7 +300,10 @@ fn apply_parallel_rule(lp: &mut Vec<DVec3>, c: DVec3) -> usize {
             break;
         };
         let j = (i + 1) % m;
-        lp[i] = (lp[i] + lp[j]) * 0.5;
+        let (x, p, q, y) = (lp[(i + m - 1) % m], lp[i], lp[j], lp[(j + 1) % m]);
+        let mid = (p + q) * 0.5;
+        patches.extend([[x, mid, p], [mid, y, q], [p, mid, q]]);
+        lp[i] = mid;
         lp.remove(j);
         removed += 1;
     }
@@ -533,7 +547,7 @@ pub fn build_wedges(meshes: &[(&Mesh, &Adjacency)], o: &WedgeOptions) -> Result<
         for lp in silhouette_loops(&sil).map_err(|e| format!("mesh {}: {e}", mesh.name))? {
             let mut pts: Vec<DVec3> = lp.iter().map(|&k| sil[k].a.as_dvec3()).collect();
             if o.parallel_rule {
-                set.removed_parallel += apply_parallel_rule(&mut pts, o.center);
+                set.removed_parallel += apply_parallel_rule(&mut pts, o.center, &mut set.top_caps);
             }
             if pts.len() >= 2 {
                 loop_wedges(&pts, o, &mut set);

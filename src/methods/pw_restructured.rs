@@ -22,6 +22,28 @@
 //!   face carries only penumbra and its umbra is drawn with that quad
 //!   ([`Wedge::umbra_front_quad`](crate::geometry::penumbra_wedge::Wedge::umbra_front_quad)),
 //!   submitted after all wedges.
+//! * **Light spikes are the paper's approximation, not a bug** (measured on
+//!   `cube-of-spheres-sphere`, 256², light radius 0.5 over spheres of radius 0.18): this method
+//!   is lighter than `raycast` by more than 0.25 at 224 pixels. 173 lie on the spheres next to
+//!   their silhouette seen from the light center, with the same LI in this method and in
+//!   `pw2002` (both `side_planes` forms): 138 light-facing facets at LI 255 (`raycast` < 0.75)
+//!   and 35 facets just past the silhouette at LI 64–251 (`raycast` 0–0.63). The wedges know
+//!   only that one silhouette, not the sphere's own curvature (the single-silhouette
+//!   approximation, Paper III §5.3).
+//!   The other 51 are the thin spikes on the floor. At each, one sphere on its own adds light
+//!   (LI > 255 from that sphere's wedges alone, impossible for one occluder): its loop's side
+//!   planes cross (Paper I Fig. 6; zigzag silhouettes of tessellated spheres under a larger
+//!   light), so its wedges no longer partition the region behind its front planes, and the
+//!   eye ray reaches a point inside a wedge (e.g. pixel (85, 140): s = 185/255) without
+//!   crossing that loop's umbra surface. The wedge's penumbra is then added without the
+//!   umbra's −255. Paper II §1 names the case ("artifacts may appear when the light source is
+//!   so large that there is no umbra region at all"). 33 of the 51 have exactly the LI of
+//!   `pw2002` with `side_planes = cancel` (Paper I §5); the other 18 are 255 or 510 lighter
+//!   than it because the outer-volume quad of a degenerate wedge is a bow-tie whose far half
+//!   is wound the other way. The quad is kept: against `pw2002`/`cancel` it changes 529
+//!   pixels, always by whole multiples of 255 (383 closer to `raycast`, 52 farther), and it
+//!   cuts the pixels off by more than 0.25 from 4171 to 3858 and the largest error from 1.0
+//!   to 0.84.
 //! * **Three-pass** (§6.1): the front planes go to an 8-bit stencil cleared to 128 (the offset
 //!   trick for an unsigned, saturating stencil): front-facing fragments DECR, then back-facing
 //!   ones INCR (on depth pass for z-pass, depth fail for z-fail); a full-screen pass adds
