@@ -106,6 +106,7 @@ impl<'s> Frame<'s> {
         let tiling = Tiling::new(scene.width, scene.height, gpu.tile_size)
             .map_err(|e| InputError::at(&scene.source, "options.gpu.tile_size", e))?;
         let proj = Projection::for_scene(scene);
+        check_camera_outside_geometry(scene, proj.near)?;
         let start = Instant::now();
         let mut prims = Vec::new();
         let mut prim_owner = Vec::new();
@@ -282,6 +283,35 @@ impl<'s> Frame<'s> {
     }
 }
 
+/// DESIGN.md "Bad input": the camera must not sit inside geometry. If the eye or a point of
+/// the near-plane rectangle is inside or on a closed mesh, the near plane cuts it open and
+/// every shadow-volume count is wrong (z-fail only repairs near-plane points inside shadow
+/// *volumes*, not inside occluders), so the scene is rejected naming the mesh, the point and
+/// the near distance ([`crate::plan::near_plane_points`], the same ray-parity test as for
+/// lights, [`crate::scene::validate::point_touches`]).
+fn check_camera_outside_geometry(scene: &Scene, near: f64) -> Result<(), InputError> {
+    for p in crate::plan::near_plane_points(scene, near) {
+        for (i, mesh) in scene.meshes.iter().enumerate() {
+            if let Some(why) = crate::scene::validate::point_touches(mesh, p.as_vec3()) {
+                let what = if p == scene.camera.eye {
+                    "the eye".to_string()
+                } else {
+                    format!("the near plane (near = {near})")
+                };
+                return Err(InputError::at(
+                    &scene.source,
+                    "camera",
+                    format!(
+                        "camera inside geometry: {what} at ({}, {}, {}) is {why} meshes[{i}] ({})",
+                        p.x, p.y, p.z, mesh.name
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Set up every primitive (in parallel, order kept) and return the raster triangles in
 /// submission order with the setup counters.
 pub fn setup_all(
@@ -314,4 +344,36 @@ pub fn setup_all(
         counters += c;
     }
     (tris, counters)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::builtin;
+
+    #[test]
+    fn camera_inside_geometry_is_rejected() {
+        let mut s = builtin::load("single-quad").unwrap();
+        s.width = 16;
+        s.height = 16;
+        Frame::render(&s, GpuSettings::default()).unwrap();
+        // The eye inside the floor slab (top face y = 0, thickness 0.1).
+        s.camera.eye = DVec3::new(0.0, -0.05, 2.0);
+        let e = Frame::render(&s, GpuSettings::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("single-quad: camera: camera inside geometry: the eye at (")
+                && e.contains("is inside meshes[0] (floor)"),
+            "{e}"
+        );
+        // The eye above the floor, but a near plane reaching into it.
+        s.camera.eye.y = 0.02;
+        s.camera.target = DVec3::new(0.0, -1.0, 1.5);
+        s.camera.near = Some(0.1);
+        let e = Frame::render(&s, GpuSettings::default())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("the near plane (near = 0.1)"), "{e}");
+    }
 }

@@ -43,11 +43,10 @@ pub fn representative_light_points(scene: &Scene) -> Vec<Vec3> {
     pts
 }
 
-/// Whether any point of the near-plane rectangle (a 9×9 grid plus the eye) lies in the hard
-/// shadow of any of `lights`: then z-pass counts are wrong (the near plane clips a shadow
-/// volume) and z-fail is needed. A point is in shadow when the segment to the light point
-/// crosses a triangle (exact f64 segment–triangle test).
-pub fn eye_in_shadow(scene: &Scene, near: f64, lights: &[Vec3]) -> bool {
+/// The eye and a 9×9 grid on the near-plane rectangle at distance `near` (its corners and
+/// edges included), in world space: the points where the near plane can meet a shadow volume
+/// ([`eye_in_shadow`]) or geometry ([`crate::frame::Frame::render`]).
+pub fn near_plane_points(scene: &Scene, near: f64) -> Vec<DVec3> {
     let cam = &scene.camera;
     let fwd = (cam.target - cam.eye).normalize();
     let right = fwd.cross(cam.up).normalize();
@@ -62,7 +61,15 @@ pub fn eye_in_shadow(scene: &Scene, near: f64, lights: &[Vec3]) -> bool {
             pts.push(cam.eye + fwd * near + right * (s * half_w) + up * (t * half_h));
         }
     }
-    pts.iter().any(|p| {
+    pts
+}
+
+/// Whether any of the [`near_plane_points`] lies in the hard shadow of any of `lights`: then
+/// z-pass counts are wrong (the near plane clips a shadow volume) and z-fail is needed. A
+/// point is in shadow when the segment to the light point crosses a triangle (exact f64
+/// segment–triangle test).
+pub fn eye_in_shadow(scene: &Scene, near: f64, lights: &[Vec3]) -> bool {
+    near_plane_points(scene, near).iter().any(|p| {
         lights
             .iter()
             .any(|l| segment_blocked(scene, *p, l.as_dvec3()))

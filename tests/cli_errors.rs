@@ -91,6 +91,10 @@ const BAD_FILES: &[(&str, &[&str])] = &[
     ("nan-light.toml", &["NaN", "nan", "finite"]),
     ("zero-light.toml", &["zero"]),
     ("unknown-method.toml", &["unknown method"]),
+    (
+        "camera-inside-mesh.toml",
+        &["camera inside geometry", "near plane"],
+    ),
 ];
 
 #[test]

@@ -59,7 +59,7 @@ pub fn validate(scene: &Scene) -> Result<(), InputError> {
     }
     for (k, light) in scene.lights.iter().enumerate() {
         for (i, mesh) in scene.meshes.iter().enumerate() {
-            if let Some(why) = light_touches(mesh, light.center) {
+            if let Some(why) = point_touches(mesh, light.center) {
                 return Err(err(
                     &light_object(scene, k, "light"),
                     format!(
@@ -284,7 +284,7 @@ fn validate_mesh(m: &Mesh) -> Result<(), String> {
 /// A ray passing within 1e-9 (barycentric) of an edge is ambiguous and another fixed,
 /// non-axis-aligned direction is tried. Two-sided quads have even parity everywhere off
 /// their plane, as they should.
-fn light_touches(m: &Mesh, c: Vec3) -> Option<&'static str> {
+pub fn point_touches(m: &Mesh, c: Vec3) -> Option<&'static str> {
     let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
     for p in &m.positions {
         lo = lo.min(*p);
