@@ -411,10 +411,11 @@ fn zfail_umbra_surface_is_closed_also_where_the_parallel_rule_moves_vertices() {
 /// crossings; on `parallel_corner_box` (where the near-parallel rule fires) they also agree on
 /// every penumbra contribution, so the LI buffers are equal bit for bit.
 ///
-/// They are not equal everywhere on the lit-eye built-ins (64²: 1 pixel of `cylinder`, 1 of
-/// `pw-2002`, 3 of `pw-fractal`, 2 of `cube-of-spheres-sphere`, none of `pw-columns`; 256²:
-/// `cylinder` 1, `pw-2002` 8, `pw-fractal` 83, `cube-of-spheres-sphere` 11, `pw-columns` 3).
-/// Two causes were found by tracing single pixels (not every pixel was traced):
+/// They are not equal everywhere on the lit-eye built-ins (default `pw-restructured` settings;
+/// 64²: 1 pixel of `cylinder`, 1 of `pw-2002`, 1 of `pw-fractal`, 2 of
+/// `cube-of-spheres-sphere`, none of `pw-columns`; 256²: `cylinder` 1, `pw-2002` 3,
+/// `pw-fractal` 29, `cube-of-spheres-sphere` 11, `pw-columns` 3). One cause was found by
+/// tracing single pixels (not every pixel was traced):
 /// * **Depth ties.** The receiver point p lies within about one D24 step of a wedge face,
 ///   where the depth test of the rasterized face (its interpolated f32 depth, quantized,
 ///   against the stored depth) and the world-space inside test of the penumbra (at the
@@ -428,11 +429,12 @@ fn zfail_umbra_surface_is_closed_also_where_the_parallel_rule_moves_vertices() {
 ///   through its front plane (372.3636 against 372.3658); z-pass adds the penumbra (+255,
 ///   s = 1) and, because the front face's fragment passes LESS, also the umbra exit (+255),
 ///   z-fail neither.
-/// * **Unbounded wedges.** 5 of the 629 wedges of `pw-fractal` have fewer than 3 faces: their
-///   five half-spaces are not bounded by the bottom plane (corner wedge 379 has a direction
-///   d with n·d < −0.04 for all five normals), so the faces do not enclose the points the
-///   inside test accepts. 64² pixel (54, 32): p lies in wedge 379, whose only face is on the
-///   side z-fail draws (LI 445 against 452).
+///
+/// A second cause is fixed: wedges not bounded by their bottom plane or empty (5 corner wedges
+/// of `pw-fractal`, 4 wedges of `pw-2002`), whose faces did not enclose the points the inside
+/// test accepts; their side planes now fall back to planes through the light ray
+/// (`every_wedge_is_bounded_and_closed_by_its_faces`). Before that fix the counts were 64²:
+/// `pw-fractal` 2; 256²: `pw-2002` 8, `pw-fractal` 43; the others unchanged.
 #[test]
 fn zpass_and_zfail_agree_where_the_parallel_rule_fires() {
     let scene = parallel_corner_box(64);
@@ -492,9 +494,12 @@ fn open_face_edges(w: &penumbra::geometry::penumbra_wedge::Wedge) -> usize {
 /// every face edge is matched by the reverse edge of another face, and `contains` agrees with
 /// the faces' winding number at sample points (the edge's light rays near and far, the
 /// vertex centroid, and points scattered around the wedge), so the faces the methods rasterize
-/// enclose exactly the points whose penumbra they add.
+/// enclose exactly the points whose penumbra they add. With one light, every front line also
+/// leaves its vertex within `FRONT_LINE_CONE` angular radii of the light ray (Paper I §8:
+/// nearly parallel front planes do not define a side plane).
 #[test]
 fn every_wedge_is_bounded_and_closed_by_its_faces() {
+    use penumbra::geometry::penumbra_wedge::FRONT_LINE_CONE;
     let mut failures = Vec::new();
     for name in [
         "cylinder",
@@ -506,7 +511,21 @@ fn every_wedge_is_bounded_and_closed_by_its_faces() {
     ] {
         let scene = small(name, 32);
         let frame = Frame::render(&scene, GpuSettings::default()).unwrap();
-        let set = pw2002::frame_wedges(&frame, &wedge_settings(&frame)).unwrap();
+        let ws = wedge_settings(&frame);
+        let set = pw2002::frame_wedges(&frame, &ws).unwrap();
+        if scene.lights.len() == 1 {
+            let (c, r) = (ws.wedge.center, ws.wedge.radius);
+            for (i, w) in set.wedges.iter().enumerate() {
+                let u = w.b - c;
+                let cone = FRONT_LINE_CONE * (r / u.length()).asin();
+                let off = (w.far_front[1] - w.b).normalize().dot(u.normalize()).acos();
+                if off > cone * (1.0 + 1e-9) {
+                    failures.push(format!(
+                        "{name} wedge {i}: front line {off} rad off the ray"
+                    ));
+                }
+            }
+        }
         let mut seed = 0x2545_f491_4f6c_dd1du64;
         let mut rnd = move || {
             seed ^= seed << 13;
