@@ -28,6 +28,15 @@
 //!   (collinear neighbouring edges), their intersection line is ill-defined; the side plane is
 //!   then the plane through the vertex spanned by the light ray `v − c` and the averaged quad
 //!   normal.
+//! * **Every wedge bounded and closed.** Where the paper's side plane leaves a neighbouring
+//!   wedge empty or not bounded by its bottom plane (back planes nearly parallel, a plane that
+//!   does not separate the two edges, or a corner wedge next to an edge close to the light
+//!   ray, Paper I §8), the side planes next to that wedge are replaced, first by the plane
+//!   through the front–front line and the light ray, then by the degenerate-case plane above,
+//!   until every wedge is a bounded polyhedron closed by its faces (`side_plane`). A
+//!   front–front line more than [`FRONT_LINE_CONE`] angular radii of the light off the light
+//!   ray through its vertex (nearly parallel front planes) is not used at all: the
+//!   degenerate-case plane is taken directly.
 //! * **Acute corners (Fig. 7).** At a convex silhouette corner whose quad normals turn by more
 //!   than 90° (interior angle below 90°), `ceil(turn / 18°) − 1` extra wedges are inserted, with
 //!   zero-length edges at the vertex and quad normals interpolated (slerp) between the two
@@ -65,6 +74,15 @@ pub const EXTRA_WEDGE_STEP: f64 = std::f64::consts::PI / 10.0;
 
 /// Relative tolerance for plane membership during face enumeration (times the far distance).
 const FACE_TOL: f64 = 1e-7;
+
+/// How far the front–front line of a side plane may leave the light ray through its vertex,
+/// in angular radii of the light seen from the vertex, before the side plane falls back to the
+/// plane through the light ray and the averaged quad normal (see `side_plane`). The paper's
+/// lines stay within 1.27 radii on `cylinder` and `pw-columns`, 2.14 on `pw-2002` and 3.05 on
+/// `cube-of-spheres-sphere` (large light, Fig. 6); nearly parallel front planes next to corner
+/// wedges of `pw-fractal` gave 8 and 11 (and 80° off the ray next to a wedge that was not
+/// closed), spreading those wedges' penumbra far from the light's actual penumbra.
+pub const FRONT_LINE_CONE: f64 = 4.0;
 
 /// Cross products shorter than this are treated as degenerate (parallel planes).
 const DEGENERATE: f64 = 1e-6;
@@ -396,84 +414,223 @@ fn loop_wedges(lp: &[DVec3], o: &WedgeOptions, set: &mut WedgeSet) {
         return;
     }
     let fb: Vec<(DVec3, DVec3)> = edges.iter().map(|e| front_back(e, c, o.radius)).collect();
-    // Side plane j sits between edge j and edge j+1 at vertex edges[j].b.
-    let mut sides = Vec::with_capacity(k);
-    for j in 0..k {
-        let (e1, e2) = (&edges[j], &edges[(j + 1) % k]);
-        let v = e1.b;
-        let (nf1, nb1) = fb[j];
-        let (nf2, nb2) = fb[(j + 1) % k];
-        let df = nf1.cross(nf2);
-        let db = nb1.cross(nb2);
-        let mut navg = (e1.n + e2.n).normalize_or_zero();
-        if navg == DVec3::ZERO {
-            navg = e1.n;
+    // Side plane j sits between edge j and edge j+1 at vertex edges[j].b. Paper I §4.1 first;
+    // both side planes of a wedge that is not bounded and closed step down one `SideLevel`,
+    // until every wedge is closed or its side planes are at the last level (see `side_plane`).
+    let mut level = vec![SideLevel::Paper; k];
+    let (sides, wedges) = loop {
+        let sides: Vec<Side> = (0..k)
+            .map(|j| side_plane(&edges, &fb, j, o, level[j]))
+            .collect();
+        let wedges: Vec<Wedge> = (0..k)
+            .map(|j| make_wedge(&edges[j], fb[j], &sides[(j + k - 1) % k], &sides[j], o))
+            .collect();
+        let mut changed = false;
+        for (j, w) in wedges.iter().enumerate() {
+            if !is_closed(w) {
+                for s in [(j + k - 1) % k, j] {
+                    changed |= level[s] != SideLevel::Ray;
+                    level[s] = level[s].next();
+                }
+            }
         }
-        let ns = df.cross(db);
-        let mut normal = if df.length() > DEGENERATE
-            && db.length() > DEGENERATE
-            && ns.length() > DEGENERATE * DEGENERATE
-        {
-            ns.normalize()
-        } else {
-            (v - c).cross(navg).normalize_or_zero()
-        };
-        if normal.dot(e1.dir + e2.dir) < 0.0 {
-            normal = -normal;
+        if !changed {
+            break (sides, wedges);
         }
-        let mut line = if df.length() > DEGENERATE {
-            df.normalize()
-        } else {
-            normal.cross(nf1).normalize_or_zero()
-        };
-        if line.dot(v - c) < 0.0 {
-            line = -line;
-        }
-        let sd = (navg - normal * navg.dot(normal)).normalize_or_zero();
-        sides.push((Plane::through(v, normal), sd, v + line * o.far));
-    }
-    let fars: Vec<DVec3> = sides.iter().map(|s| s.2).collect();
-    for j in 0..k {
-        let e = &edges[j];
-        let (nf, nb) = fb[j];
-        let prev = &sides[(j + k - 1) % k];
-        let next = &sides[j];
-        let (pa, pb) = (prev.2, next.2);
-        let mut zn = (pb - pa).cross(e.n);
-        if zn.length() < DEGENERATE {
-            zn = ((pa + pb) * 0.5 - c).normalize_or_zero();
-        }
-        let mut bottom = Plane::through(pa, zn);
-        if bottom.eval(e.a) > 0.0 {
-            bottom = bottom.flipped();
-        }
-        let planes = [
-            Plane::through(e.a, nf),
-            Plane::through(e.a, nb),
-            prev.0.flipped(),
-            next.0,
-            bottom,
-        ];
-        let canon = [e.a, e.b, pa, pb];
-        let faces = wedge_faces(&planes, &canon, o.far);
-        set.wedges.push(Wedge {
-            a: e.a,
-            b: e.b,
-            dir: e.dir,
-            n: e.n,
-            extra: e.extra,
-            planes,
-            left_dir: prev.1,
-            right_dir: next.1,
-            far_front: [pa, pb],
-            faces,
-        });
-    }
+    };
+    set.wedges.extend(wedges);
     // Far cap: reverse loop order so shared edges P_a→P_b of the front faces are traversed
     // oppositely (outward, away from the light).
     for i in 1..k.saturating_sub(1) {
-        set.bottom_caps.push([fars[0], fars[i + 1], fars[i]]);
+        set.bottom_caps
+            .push([sides[0].far, sides[i + 1].far, sides[i].far]);
     }
+}
+
+/// A side plane shared by two neighbouring wedges, with its ray direction (§4.2) and the far
+/// point `P_v` of its front line.
+struct Side {
+    plane: Plane,
+    ray: DVec3,
+    far: DVec3,
+}
+
+/// How a side plane is built (see [`side_plane`]), from the paper's construction to the most
+/// robust fallback.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SideLevel {
+    /// Paper I §4.1: through the front–front and the back–back intersection lines.
+    Paper,
+    /// Through the front–front intersection line and the light ray through the vertex.
+    FrontLine,
+    /// Through the light ray through the vertex and the averaged quad normal.
+    Ray,
+}
+
+impl SideLevel {
+    fn next(self) -> Self {
+        match self {
+            SideLevel::Paper => SideLevel::FrontLine,
+            _ => SideLevel::Ray,
+        }
+    }
+}
+
+/// The side plane between edge j and edge j+1 at their common vertex v.
+///
+/// Paper I §4.1: the plane through the intersection line of the two front planes and that of
+/// the two back planes, far point `P_v` on the front–front line. Paper I §8 warns that this
+/// "side plane construction will not be robust" for edges nearly along the light ray, and it
+/// fails in two ways the paper does not list: where the two back planes are nearly parallel
+/// or the plane does not separate the two edges (`pw-2002`: short edges at right-angled box
+/// corners), and where a corner wedge (Fig. 7) meets an edge close to the light ray, whose
+/// front plane is tilted almost onto the corner wedge's, so that the front–front line runs far
+/// off the light ray (`pw-fractal`). The wedges next to such a plane are then empty or not
+/// bounded by their bottom plane. `loop_wedges` therefore steps the side planes next to a
+/// wedge that is not bounded and closed ([`is_closed`]) down this list until it is (the first
+/// two need a front–front line within [`FRONT_LINE_CONE`] of the light ray, else the last is
+/// taken):
+/// * [`SideLevel::FrontLine`]: the plane through the front–front line and the light ray
+///   `v − c`; the front faces still meet on the front–front line, so they stay the quads
+///   `(b, a, P_a, P_b)` of the outer soft shadow volume.
+/// * [`SideLevel::Ray`] (also used when the paper's lines are degenerate): the plane through
+///   v spanned by the light ray and the averaged quad normal, the limit of the paper's plane
+///   for a point light (both lines become the light ray). It separates the two edges and is
+///   never close to a front or back plane, so the wedges on both sides are bounded. `P_v` lies
+///   on the bisector of the two front lines in the plane, shared by both wedges, so the outer
+///   soft shadow volume stays closed through it.
+///
+/// Both wedges use the same plane, so the C⁰ continuity of §4.2 is kept.
+fn side_plane(
+    edges: &[LoopEdge],
+    fb: &[(DVec3, DVec3)],
+    j: usize,
+    o: &WedgeOptions,
+    level: SideLevel,
+) -> Side {
+    let c = o.center;
+    let k = edges.len();
+    let (e1, e2) = (&edges[j], &edges[(j + 1) % k]);
+    let v = e1.b;
+    let (nf1, nb1) = fb[j];
+    let (nf2, nb2) = fb[(j + 1) % k];
+    let df = nf1.cross(nf2);
+    let db = nb1.cross(nb2);
+    let mut navg = (e1.n + e2.n).normalize_or_zero();
+    if navg == DVec3::ZERO {
+        navg = e1.n;
+    }
+    let away = |l: DVec3| {
+        let l = l.normalize_or_zero();
+        if l.dot(v - c) < 0.0 {
+            -l
+        } else {
+            l
+        }
+    };
+    let ray = (v - c).normalize_or_zero();
+    let paper = df.cross(db);
+    let front_ray = away(df).cross(ray);
+    let near_ray = away(df).dot(ray)
+        >= (FRONT_LINE_CONE * (o.radius / (v - c).length()).min(1.0).asin())
+            .min(std::f64::consts::FRAC_PI_2)
+            .cos();
+    let (normal, line) = if level == SideLevel::Paper
+        && near_ray
+        && df.length() > DEGENERATE
+        && db.length() > DEGENERATE
+        && paper.length() > DEGENERATE * DEGENERATE
+    {
+        (paper.normalize(), away(df))
+    } else if level != SideLevel::Ray
+        && near_ray
+        && df.length() > DEGENERATE
+        && front_ray.length() > DEGENERATE
+    {
+        (front_ray.normalize(), away(df))
+    } else {
+        let normal = ray.cross(navg).normalize_or_zero();
+        (
+            normal,
+            away(away(normal.cross(nf1)) + away(normal.cross(nf2))),
+        )
+    };
+    let normal = if normal.dot(e1.dir + e2.dir) < 0.0 {
+        -normal
+    } else {
+        normal
+    };
+    Side {
+        plane: Plane::through(v, normal),
+        ray: (navg - normal * navg.dot(normal)).normalize_or_zero(),
+        far: v + line * o.far,
+    }
+}
+
+/// The wedge of edge `e` between side planes `prev` (left) and `next` (right), closed by the
+/// bottom plane through the far points.
+fn make_wedge(
+    e: &LoopEdge,
+    fb: (DVec3, DVec3),
+    prev: &Side,
+    next: &Side,
+    o: &WedgeOptions,
+) -> Wedge {
+    let (nf, nb) = fb;
+    let (pa, pb) = (prev.far, next.far);
+    let mut zn = (pb - pa).cross(e.n);
+    if zn.length() < DEGENERATE {
+        zn = ((pa + pb) * 0.5 - o.center).normalize_or_zero();
+    }
+    let mut bottom = Plane::through(pa, zn);
+    if bottom.eval(e.a) > 0.0 {
+        bottom = bottom.flipped();
+    }
+    let planes = [
+        Plane::through(e.a, nf),
+        Plane::through(e.a, nb),
+        prev.plane.flipped(),
+        next.plane,
+        bottom,
+    ];
+    let faces = wedge_faces(&planes, &[e.a, e.b, pa, pb], o.far);
+    Wedge {
+        a: e.a,
+        b: e.b,
+        dir: e.dir,
+        n: e.n,
+        extra: e.extra,
+        planes,
+        left_dir: prev.ray,
+        right_dir: next.ray,
+        far_front: [pa, pb],
+        faces,
+    }
+}
+
+/// Whether a wedge is a bounded region with at least four faces: no direction d has
+/// `n·d ≤ 0` for all five plane normals. Such a direction, if any, is an edge direction of the
+/// recession cone, which lies on two of the planes: `±(n_i × n_j)`.
+fn is_closed(w: &Wedge) -> bool {
+    if w.faces.len() < 4 {
+        return false;
+    }
+    let p = &w.planes;
+    for i in 0..5 {
+        for j in i + 1..5 {
+            let d = p[i].n.cross(p[j].n);
+            if d.length() < DEGENERATE {
+                continue;
+            }
+            let d = d.normalize();
+            for d in [d, -d] {
+                if p.iter().all(|pl| pl.n.dot(d) <= DEGENERATE) {
+                    return false;
+                }
+            }
+        }
+    }
+    true
 }
 
 /// The faces of the intersection of five half-spaces, by vertex enumeration. Vertices within
