@@ -181,7 +181,7 @@ impl CoverageSource<'_> {
                 let Some([a, b]) = projected_edge_in_light(&self.light, p, w.e0, w.e1) else {
                     return [0.0; 3];
                 };
-                let s = quad_side(&self.light, p, w.e0, w.e1);
+                let s = quad_side(self.light.center, p, w.e0, w.e1);
                 t.lookup(a, b, filter).map(|v| (s * v) as f32)
             }
             _ => [edge_coverage_exact(&self.light, p, w.e0, w.e1) as f32; 3],
