@@ -27,10 +27,10 @@
 //! **Spherical lights** (§4.2.1) — light space with the receiver at the origin, the light center
 //! at z = 1 and radius 1; the edge is clipped to the cone x² + y² = z² (0 < z ≤ 1: between
 //! the receiver and the facing disk, [`coverage::clip_to_light_cone`]), projected to z = 1,
-//! and the same sector-minus-triangle on the unit disk ([`coverage::sector_minus_triangle`]). `coverage = "tables"` uses the
-//! paper's tables ([`crate::light::lookup_tables`]); `"exact"` uses f64 `atan2` and the exact
-//! sector area for the sphere, and exact clipping ([`coverage::edge_coverage_exact`]) for the
-//! rectangle.
+//! and the same sector-minus-triangle on the unit disk ([`coverage::sector_minus_triangle`]).
+//! `coverage = "tables"` uses the paper's tables ([`crate::light::lookup_tables`]); `"exact"`
+//! uses f64 `atan2` and the exact sector area for the sphere, and exact clipping
+//! ([`coverage::edge_coverage_exact`]) for the rectangle.
 //!
 //! Options: `coverage = tables|exact`, `filter = bilinear|nearest` (area table), `split =
 //! stencil|plane`, `wedge = tight|bounding-sphere`, `overlap = off|loops`, `light_split = 1…4`,
