@@ -506,6 +506,26 @@ mod tests {
     }
 
     #[test]
+    fn sphere_edge_covers_the_circular_segment_and_nothing_behind_the_disk() {
+        // A sphere of radius 0.5 at the origin seen from p = (0, 0, 3): the facing disk lies in
+        // z = 0. A long edge along x at y = 0.125, z = 1.5 projects (scale 2) onto the chord
+        // y = 0.25 = r/2: the segment beyond it is (acos ½ − ½·√¾)/π of the disk. The same
+        // edge at z = −1 (beyond the disk's plane, inside the cone from p widened past it)
+        // hides nothing.
+        let p = DVec3::new(0.0, 0.0, 3.0);
+        let edge = |z: f64| (DVec3::new(-5.0, 0.125, z), DVec3::new(5.0, 0.125, z));
+        let (e0, e1) = edge(1.5);
+        let c = sphere_edge_coverage_exact(DVec3::ZERO, 0.5, p, e0, e1);
+        let expected = (0.5f64.acos() - 0.5 * 0.75f64.sqrt()) / PI;
+        assert!((c.abs() - expected).abs() < 1e-12, "{c} vs {expected}");
+        let reversed = sphere_edge_coverage_exact(DVec3::ZERO, 0.5, p, e1, e0);
+        assert!((reversed + c).abs() < 1e-15, "{reversed} vs {c}");
+        let (e0, e1) = edge(-1.0);
+        assert_eq!(sphere_edge_coverage_exact(DVec3::ZERO, 0.5, p, e0, e1), 0.0);
+        assert_eq!(clip_to_light_cone(DVec3::ZERO, 0.5, p, e0, e1), None);
+    }
+
+    #[test]
     fn projected_edge_matches_segment_coverage() {
         let l = unit_light();
         let p = DVec3::new(0.3, -0.2, 3.0);
