@@ -5,10 +5,12 @@
 use glam::{DVec2, DVec3};
 use penumbra::gpu::counters::Counters;
 use penumbra::gpu::split_blend::{SplitFormat, SplitTarget, SplitVTile};
-use penumbra::light::coverage::{projected_edge_in_light, segment_coverage, RectLight};
+use penumbra::light::coverage::{
+    clip_to_light_cone, projected_edge_in_light, segment_coverage, RectLight,
+};
 use penumbra::light::lookup_tables::{AreaShape, SplitTable, TableFilter};
 use penumbra::methods::ssv_optimized::{
-    clip_to_light_cone, overlap_combine, sector_minus_triangle, CoverageMode, LightModel,
+    overlap_combine, sector_minus_triangle, CoverageMode, LightModel,
 };
 use penumbra::scene::builtin;
 

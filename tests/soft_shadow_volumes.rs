@@ -14,7 +14,7 @@
 
 use glam::{DVec2, DVec3, Vec3};
 use penumbra::frame::{Frame, GpuSettings};
-use penumbra::geometry::ssv_wedge::SsvWedge;
+use penumbra::geometry::ssv_wedge::{SsvWedge, WedgeLight};
 use penumbra::gpu::counters::Counters;
 use penumbra::gpu::vbuffer::{VBuffer8Tile, VBufferFormat, VBufferTile};
 use penumbra::light::coverage::{
@@ -369,7 +369,7 @@ proptest! {
         let a = point_above(&l, e0.0, e0.1, e0.2);
         let b = point_above(&l, e1.0, e1.1, e1.2);
         let c = edge_coverage_exact(&l, pw, a, b);
-        if let Some(w) = SsvWedge::new(&l, a, b) {
+        if let Some(w) = SsvWedge::new(&WedgeLight::Rect(l), a, b) {
             prop_assert!(c.abs() < 1e-9 || w.contains(pw), "coverage {c} outside the wedge");
         }
     }

@@ -1,5 +1,5 @@
 //! Robust penumbra wedges of the soft shadow volume algorithm (Paper III §3.1, Figure 5) for a
-//! rectangular light.
+//! rectangular or a spherical light ([`WedgeLight`]).
 //!
 //! For a silhouette edge `e0 e1` and a light with center `c`:
 //!
@@ -17,6 +17,15 @@
 //!    of the corner with the largest angle from `t`. The left plane is the same construction at
 //!    `A` with `t` pointing the other way.
 //!
+//! For a **sphere** (the paper's own construction: Paper III §3.1 "barely touch the light
+//! source", Paper IV §4.1 "our previously presented method created wedges from bounding
+//! spheres") steps 2 and 3 use the sphere instead of the corners: seen along the axis, the
+//! sphere is a disk of its radius around the projected center, and the planes are its two
+//! tangents through the axis. The wedge then holds every point that sees part of the sphere
+//! through the edge, hence every point whose coverage of the facing disk
+//! ([`crate::light::coverage::sphere_edge_coverage_exact`]) the edge changes: that disk lies in
+//! the sphere.
+//!
 //! The wedge is the intersection of the four inner half spaces (Figure 5d); its faces are the
 //! front and back quads and the left and right triangles, each extended to infinity away from
 //! the light (vertices at w = 0, as the shadow volume quads, [`super::shadow_volume`]). Every
@@ -24,16 +33,85 @@
 //!
 //! # Degenerate wedges (a choice the paper leaves open)
 //!
-//! When the light's corners span half a turn or more around the top edge or around a side
-//! axis (the edge is very close to a large light, or the line of the edge passes through the
-//! light), no four planes bound the penumbra volume as above. [`SsvWedge::new`] then returns
-//! `None` and the caller treats the whole space as inside the wedge — correct, because the
-//! coverage it then computes for every pixel is exactly 0 outside the real penumbra volume
-//! (Paper III §3.2.2 and [`crate::light::coverage`]), only slower.
+//! When the light's corners (or the sphere) span half a turn or more around the top edge or
+//! around a side axis (the edge is very close to a large light, or the line of the edge passes
+//! through the light), no four planes bound the penumbra volume as above. [`SsvWedge::new`]
+//! then returns `None` and the caller treats the whole space as inside the wedge — correct,
+//! because the coverage it then computes for every pixel is exactly 0 outside the real
+//! penumbra volume (Paper III §3.2.2 and [`crate::light::coverage`]), only slower.
 
 use crate::gpu::transform::{ClipVertex, Projection};
 use crate::light::coverage::RectLight;
+use crate::scene::{Light, LightShape};
 use glam::{DVec2, DVec3};
+
+/// The light a wedge is built around (module doc).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum WedgeLight {
+    /// A rectangle: the wedge touches its four corners.
+    Rect(RectLight),
+    /// A sphere: the wedge's planes are tangent to it.
+    Sphere {
+        /// Center.
+        center: DVec3,
+        /// Radius.
+        radius: f64,
+    },
+}
+
+impl WedgeLight {
+    /// The light of a `rect`, `textured_rect` or `sphere` scene light; `None` for other shapes.
+    pub fn from_light(light: &Light) -> Option<Self> {
+        match light.shape {
+            LightShape::Sphere { radius } => Some(WedgeLight::Sphere {
+                center: light.center.as_dvec3(),
+                radius: radius as f64,
+            }),
+            _ => RectLight::from_light(light).map(WedgeLight::Rect),
+        }
+    }
+
+    /// The light center `c`.
+    pub fn center(&self) -> DVec3 {
+        match self {
+            WedgeLight::Rect(l) => l.center,
+            WedgeLight::Sphere { center, .. } => *center,
+        }
+    }
+
+    /// The light seen in the plane through `o` spanned by the orthonormal `x`, `y` (projected
+    /// along `x × y`): its two points of smallest and largest angle around `o` measured from
+    /// `x`, when it spans less than half a turn and does not contain `o`.
+    fn angular_extremes(&self, o: DVec3, x: DVec3, y: DVec3) -> Option<(DVec2, DVec2)> {
+        let local = |q: DVec3| DVec2::new((q - o).dot(x), (q - o).dot(y));
+        match self {
+            WedgeLight::Rect(l) => angular_extremes(rect_corners(l).map(local)),
+            WedgeLight::Sphere { center, radius } => {
+                let (lo, hi) = tangent_angles(local(*center), *radius)?;
+                Some((DVec2::from_angle(lo), DVec2::from_angle(hi)))
+            }
+        }
+    }
+}
+
+/// The angles (from the x axis, `lo < hi`) of the two tangents from the origin to the disk of
+/// `radius` around `m`: `atan2(m) ∓ asin(radius/|m|)`; `None` when the origin is not outside
+/// the disk.
+fn tangent_angles(m: DVec2, radius: f64) -> Option<(f64, f64)> {
+    let d = m.length();
+    if d.is_nan() || d <= radius {
+        return None;
+    }
+    let half = (radius / d).asin();
+    let phi = m.y.atan2(m.x);
+    Some((phi - half, phi + half))
+}
+
+/// The four corners of a rectangular light, in order around it.
+fn rect_corners(l: &RectLight) -> [DVec3; 4] {
+    let c = l.center;
+    [c - l.u - l.v, c + l.u - l.v, c + l.u + l.v, c - l.u + l.v]
+}
 
 /// A wedge vertex: a finite point or a direction at infinity (w = 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -86,14 +164,8 @@ pub struct SsvWedge {
 impl SsvWedge {
     /// The wedge of edge `e0 e1` under `light` (module doc); `None` when it is degenerate
     /// (module doc, "Degenerate wedges").
-    pub fn new(light: &RectLight, e0: DVec3, e1: DVec3) -> Option<SsvWedge> {
-        let c = light.center;
-        let corners = [
-            c - light.u - light.v,
-            c + light.u - light.v,
-            c + light.u + light.v,
-            c - light.u + light.v,
-        ];
+    pub fn new(light: &WedgeLight, e0: DVec3, e1: DVec3) -> Option<SsvWedge> {
+        let c = light.center();
         let (near, far) = if (e0 - c).length() <= (e1 - c).length() {
             (e0, e1)
         } else {
@@ -105,8 +177,7 @@ impl SsvWedge {
         // Front and back planes: the corners' sector around the axis A B (step 2).
         let r0 = reject(c - a, d).try_normalize()?;
         let r1 = d.cross(r0);
-        let local = |q: DVec3| DVec2::new((q - a).dot(r0), (q - a).dot(r1));
-        let (q_min, q_max) = angular_extremes(corners.map(local))?;
+        let (q_min, q_max) = light.angular_extremes(a, r0, r1)?;
         let front = HalfSpace {
             origin: a,
             normal: (r1 * q_max.x - r0 * q_max.y).try_normalize()?,
@@ -116,8 +187,8 @@ impl SsvWedge {
             normal: (r0 * q_min.y - r1 * q_min.x).try_normalize()?,
         };
         // Side planes (step 3).
-        let right = side_plane(b, b - a, c, &corners)?;
-        let left = side_plane(a, a - b, c, &corners)?;
+        let right = side_plane(b, b - a, light)?;
+        let left = side_plane(a, a - b, light)?;
         let away = (a - c).normalize() + (b - c).normalize();
         let edge_dir = |p: &HalfSpace, q: &HalfSpace| -> Option<DVec3> {
             let l = p.normal.cross(q.normal).try_normalize()?;
@@ -207,22 +278,34 @@ fn angular_extremes(q: [DVec2; 4]) -> Option<(DVec2, DVec2)> {
 }
 
 /// The side plane through `at` (module doc, step 3); `outward` points from the other top
-/// vertex to `at`.
-fn side_plane(at: DVec3, outward: DVec3, c: DVec3, corners: &[DVec3; 4]) -> Option<HalfSpace> {
+/// vertex to `at`. The whole light must lie on the light side (angles from `t` in (0, π)).
+fn side_plane(at: DVec3, outward: DVec3, light: &WedgeLight) -> Option<HalfSpace> {
     let t = outward.try_normalize()?;
-    let g = reject(c - at, t).try_normalize()?;
-    let mut best: Option<DVec2> = None;
-    for q in corners {
-        let p = DVec2::new((*q - at).dot(t), (*q - at).dot(g));
-        if p.y <= 0.0 {
-            return None;
+    let g = reject(light.center() - at, t).try_normalize()?;
+    let q = match light {
+        WedgeLight::Rect(l) => {
+            let mut best: Option<DVec2> = None;
+            for q in rect_corners(l) {
+                let p = DVec2::new((q - at).dot(t), (q - at).dot(g));
+                if p.y <= 0.0 {
+                    return None;
+                }
+                // Largest angle from t in (0, π): p is counter-clockwise of the best so far.
+                if best.is_none_or(|b| b.perp_dot(p) > 0.0) {
+                    best = Some(p);
+                }
+            }
+            best?
         }
-        // Largest angle from t in (0, π): p is counter-clockwise of the best so far.
-        if best.is_none_or(|b| b.perp_dot(p) > 0.0) {
-            best = Some(p);
+        WedgeLight::Sphere { center, radius } => {
+            let m = DVec2::new((*center - at).dot(t), (*center - at).dot(g));
+            let (lo, hi) = tangent_angles(m, *radius)?;
+            if lo <= 0.0 || hi >= std::f64::consts::PI {
+                return None;
+            }
+            DVec2::from_angle(hi)
         }
-    }
-    let q = best?;
+    };
     Some(HalfSpace {
         origin: at,
         normal: (g * q.x - t * q.y).try_normalize()?,

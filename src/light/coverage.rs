@@ -42,9 +42,25 @@
 //! [`projected_edge_in_light`] and [`segment_coverage`] split the same computation at the point
 //! where the 4D coverage texture of Paper III §3.3 indexes it: the projected edge clipped to the
 //! light square, and the coverage as a function of that clipped edge alone.
+//!
+//! # Sphere lights (Paper III §5.3, Paper IV §4.2.1)
+//!
+//! A sphere of center `c` and radius `r` is seen from a receiver `p` as the disk of radius `r`
+//! through `c` perpendicular to `p − c` — the convention of the ray-cast reference
+//! ([`crate::light::sampling`]). Everything above carries over with that disk as the light:
+//! the same quad `Q`, projected from `p` onto the disk's plane after clipping to the slab
+//! between `p` and that plane, signed by the same [`quad_side`]. The projection of `Q` is
+//! bounded by the projected edge and the rays from `c` through its endpoints, so inside the
+//! disk it is the part of the sector between those rays beyond the chord — *sector minus
+//! triangle* (Paper IV §4.2.1, Fig. 5a; the same formula with the square is Paper IV
+//! §4.2.2's rectangular shader). [`clip_to_light_cone`] gives the chord in the unit disk,
+//! [`sector_minus_triangle`] the area and [`sphere_edge_coverage_exact`] the signed coverage.
+//! Paper III §5.3 computes this in the shader, without a coverage texture.
 
+use crate::light::lookup_tables::AreaShape;
 use crate::scene::{Light, LightShape};
 use glam::{DVec2, DVec3, DVec4};
+use std::f64::consts::PI;
 
 /// A rectangular (parallelogram) light in f64 with its affine frame (module doc,
 /// "Representation"): `center + s·u + t·v`, `s, t ∈ [−1, 1]` (Paper III §3.2.2: "a rectangular
@@ -114,7 +130,7 @@ impl RectLight {
 /// positive when `det(e0 − c, e1 − c, p − c) > 0` (module doc, "Sign"). Zero when `p` lies in
 /// the light's plane or in the plane of the quad.
 pub fn edge_coverage_exact(light: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
-    let sign = quad_side(light, p, e0, e1);
+    let sign = quad_side(light.center, p, e0, e1);
     if sign == 0.0 {
         return 0.0;
     }
@@ -136,10 +152,9 @@ pub fn edge_coverage_exact(light: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) ->
     sign * clipped_area_fraction(&projected)
 }
 
-/// `+1`, `−1` or `0`: the sign of `det(e0 − c, e1 − c, p − c)` (module doc, "Sign"), the side of
-/// the quad's plane `p` is on.
-pub fn quad_side(light: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
-    let c = light.center;
+/// `+1`, `−1` or `0`: the sign of `det(e0 − c, e1 − c, p − c)` for the light center `c`
+/// (module doc, "Sign"), the side of the quad's plane `p` is on.
+pub fn quad_side(c: DVec3, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
     let d = (e0 - c).cross(e1 - c).dot(p - c);
     if d > 0.0 {
         1.0
@@ -220,6 +235,126 @@ pub fn clip_polygon_to_box(poly: &[DVec2], lo: DVec2, hi: DVec2) -> Vec<DVec2> {
     out = clip_polygon(&out, |p: DVec2| hi.x - p.x);
     out = clip_polygon(&out, |p: DVec2| p.y - lo.y);
     clip_polygon(&out, |p: DVec2| hi.y - p.y)
+}
+
+/// Signed exact coverage of the disk that the sphere light (`center`, `radius`) shows to `p` by
+/// the semi-infinite hard shadow quad of edge `e0 e1` (module doc, "Sphere lights"; Paper III
+/// §5.3): the covered area divided by the disk's area, in `[−1, 1]`, with the sign of
+/// [`quad_side`] as [`edge_coverage_exact`] for a rectangle. Zero when `p` is in the plane of
+/// the quad or inside the sphere.
+pub fn sphere_edge_coverage_exact(
+    center: DVec3,
+    radius: f64,
+    p: DVec3,
+    e0: DVec3,
+    e1: DVec3,
+) -> f64 {
+    let sign = quad_side(center, p, e0, e1);
+    if sign == 0.0 {
+        return 0.0;
+    }
+    match clip_to_light_cone(center, radius, p, e0, e1) {
+        Some([a, b]) => sign * exact_sector_minus_triangle(a, b, AreaShape::Disk),
+        None => 0.0,
+    }
+}
+
+/// The edge `e0 e1` in the light space of receiver `p` (Paper IV §4.2.1: `p` at the origin,
+/// the light center at z = 1, the radius 1), clipped to the cone x² + y² ≤ z² over the facing
+/// disk and to the slab 0 < z ≤ 1 between `p` and the disk's plane, and projected to z = 1:
+/// the chord of the unit disk that bounds the projected quad (module doc, "Sphere lights").
+/// Clipping the edge rather than the quad to the slab is enough: the quad runs from the edge
+/// away from the center, which lies in the plane z = 1, so beyond a point with z ≤ 1 it stays
+/// at z ≤ 1, and its part that reaches z ≤ 0 projects onto the rest of the sector beyond the
+/// chord. `None` when nothing of the edge is left (or `p` is inside the light).
+pub fn clip_to_light_cone(
+    center: DVec3,
+    radius: f64,
+    p: DVec3,
+    e0: DVec3,
+    e1: DVec3,
+) -> Option<[DVec2; 2]> {
+    let w = center - p;
+    let dist = w.length();
+    if dist <= radius || !dist.is_finite() {
+        return None;
+    }
+    let z = w / dist;
+    let x = z.any_orthonormal_vector();
+    let y = z.cross(x);
+    let to_light = |e: DVec3| {
+        let d = e - p;
+        DVec3::new(d.dot(x) / radius, d.dot(y) / radius, d.dot(z) / dist)
+    };
+    let (q0, q1) = (to_light(e0), to_light(e1));
+    let d = q1 - q0;
+    let g = |t: f64| {
+        let q = q0 + d * t;
+        q.x * q.x + q.y * q.y - q.z * q.z
+    };
+    // Breakpoints: roots of g (the cone) and of z = 0 and z = 1 in (0, 1).
+    let qa = d.x * d.x + d.y * d.y - d.z * d.z;
+    let qb = q0.x * d.x + q0.y * d.y - q0.z * d.z;
+    let qc = q0.x * q0.x + q0.y * q0.y - q0.z * q0.z;
+    let mut ts = vec![0.0, 1.0];
+    if qa.abs() > 1e-300 {
+        let disc = qb * qb - qa * qc;
+        if disc >= 0.0 {
+            let s = disc.sqrt();
+            let r = -(qb + qb.signum() * s);
+            if r != 0.0 {
+                ts.push(r / qa);
+                ts.push(qc / r);
+            }
+        }
+    } else if qb != 0.0 {
+        ts.push(-qc / (2.0 * qb));
+    }
+    if d.z != 0.0 {
+        ts.push(-q0.z / d.z);
+        ts.push((1.0 - q0.z) / d.z);
+    }
+    ts.retain(|t| (0.0..=1.0).contains(t));
+    ts.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    let mut span: Option<(f64, f64)> = None;
+    for k in 0..ts.len() - 1 {
+        let (t0, t1) = (ts[k], ts[k + 1]);
+        let m = 0.5 * (t0 + t1);
+        let zm = (q0 + d * m).z;
+        if t1 > t0 && g(m) <= 0.0 && zm > 0.0 && zm <= 1.0 {
+            span = Some(match span {
+                None => (t0, t1),
+                Some((s0, _)) => (s0, t1),
+            });
+        }
+    }
+    let (t0, t1) = span?;
+    let project = |t: f64| {
+        let q = q0 + d * t;
+        DVec2::new(q.x / q.z, q.y / q.z)
+    };
+    let (a, b) = (project(t0), project(t1));
+    (a.is_finite() && b.is_finite()).then_some([a, b])
+}
+
+/// The analytic coverage of Paper IV §4.2.2 Fig. 6a and §4.2.1 Fig. 5a: with `sector` the
+/// fraction of the light (`shape`, centered at the origin) between the rays through `a` and `b`
+/// (along the minor arc), the fraction beyond the chord `a b`: `sector` minus the triangle
+/// (origin, a, b) over the light's area, clamped to [0, 1]. `a` and `b` lie in the light.
+pub fn sector_minus_triangle(a: DVec2, b: DVec2, shape: AreaShape, sector: f64) -> f64 {
+    let total = match shape {
+        AreaShape::Square => 4.0,
+        AreaShape::Disk => PI,
+    };
+    let triangle = 0.5 * a.perp_dot(b).abs() / total;
+    (sector - triangle).clamp(0.0, 1.0)
+}
+
+/// [`sector_minus_triangle`] with the exact sector: f64 `atan2` of the two points and
+/// [`AreaShape::sector_fraction`].
+pub fn exact_sector_minus_triangle(a: DVec2, b: DVec2, shape: AreaShape) -> f64 {
+    let sector = shape.sector_fraction(a.y.atan2(a.x), b.y.atan2(b.x));
+    sector_minus_triangle(a, b, shape, sector)
 }
 
 /// The central projection from a receiver point onto the light plane in the light frame
@@ -368,6 +503,26 @@ mod tests {
         let c = edge_coverage_exact(&l, p, e0, e1);
         assert!((c.abs() - 0.25).abs() < 1e-12, "{c}");
         assert_eq!(edge_coverage_exact(&l, p, e1, e0), -c);
+    }
+
+    #[test]
+    fn sphere_edge_covers_the_circular_segment_and_nothing_behind_the_disk() {
+        // A sphere of radius 0.5 at the origin seen from p = (0, 0, 3): the facing disk lies in
+        // z = 0. A long edge along x at y = 0.125, z = 1.5 projects (scale 2) onto the chord
+        // y = 0.25 = r/2: the segment beyond it is (acos ½ − ½·√¾)/π of the disk. The same
+        // edge at z = −1 (beyond the disk's plane, inside the cone from p widened past it)
+        // hides nothing.
+        let p = DVec3::new(0.0, 0.0, 3.0);
+        let edge = |z: f64| (DVec3::new(-5.0, 0.125, z), DVec3::new(5.0, 0.125, z));
+        let (e0, e1) = edge(1.5);
+        let c = sphere_edge_coverage_exact(DVec3::ZERO, 0.5, p, e0, e1);
+        let expected = (0.5f64.acos() - 0.5 * 0.75f64.sqrt()) / PI;
+        assert!((c.abs() - expected).abs() < 1e-12, "{c} vs {expected}");
+        let reversed = sphere_edge_coverage_exact(DVec3::ZERO, 0.5, p, e1, e0);
+        assert!((reversed + c).abs() < 1e-15, "{reversed} vs {c}");
+        let (e0, e1) = edge(-1.0);
+        assert_eq!(sphere_edge_coverage_exact(DVec3::ZERO, 0.5, p, e0, e1), 0.0);
+        assert_eq!(clip_to_light_cone(DVec3::ZERO, 0.5, p, e0, e1), None);
     }
 
     #[test]

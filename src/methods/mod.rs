@@ -72,10 +72,10 @@ pub fn supports(method: &str, shape: &LightShape) -> bool {
         "pw2002" | "pw-restructured" => matches!(shape, LightShape::Sphere { .. }),
         // Paper IV §4.2: the rectangular and the spherical shader.
         "ssv-optimized" => matches!(shape, LightShape::Rect { .. } | LightShape::Sphere { .. }),
-        // Paper III §3.2.2, §3.3: rectangular and textured rectangular lights.
+        // Paper III §3.2.2, §3.3: rectangular and textured rectangular lights; §5.3: spheres.
         "ssv" => matches!(
             shape,
-            LightShape::Rect { .. } | LightShape::TexturedRect { .. }
+            LightShape::Rect { .. } | LightShape::TexturedRect { .. } | LightShape::Sphere { .. }
         ),
         _ => false,
     }

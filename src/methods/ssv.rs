@@ -1,22 +1,22 @@
 //! `ssv`: the geometry-based soft shadow volume algorithm (Paper III, Assarsson &
-//! Akenine-Möller, SIGGRAPH 2003) for rectangular and textured rectangular lights.
+//! Akenine-Möller, SIGGRAPH 2003) for rectangular, textured rectangular and spherical lights.
 //!
 //! * **Pass 1** (§3.2.1): the hard shadow quads from the light center
 //!   ([`shadow_volume_triangles`], its submission order) add −1.0 (entering, front-facing) and
 //!   +1.0 (leaving, back-facing) to a V-buffer cleared to 1.0, exactly as the stencil counts of
 //!   `hard-sv` (z-pass; z-fail with caps when the eye is in shadow, chosen as `hard-sv` does).
 //! * **Pass 2** (§3.2.2): one wedge per possible silhouette edge of the same edges, in the same
-//!   order ([`SsvWedge`], §3.1). For every pixel covered by the wedge's front-facing triangles,
-//!   the receiver point `p` is tested against the wedge's four planes; inside, the signed
-//!   coverage of the edge's semi-infinite hard shadow quad is added — positive when `p` is on
-//!   the umbra side of the quad (the paper's "negative half space"). The sum over the
-//!   silhouette is Green's theorem: exact for occluders without the single-silhouette or
-//!   overlap artifacts (§5.3).
+//!   order ([`SsvWedge`], §3.1; built around the sphere itself for a sphere light). For every
+//!   pixel covered by the wedge's front-facing triangles, the receiver point `p` is tested
+//!   against the wedge's four planes; inside, the signed coverage of the edge's semi-infinite
+//!   hard shadow quad is added — positive when `p` is on the umbra side of the quad (the
+//!   paper's "negative half space"). The sum over the silhouette is Green's theorem: exact for
+//!   occluders without the single-silhouette or overlap artifacts (§5.3).
 //! * **Coverage** (`coverage`): `exact` clips the projected quad against the light
-//!   ([`edge_coverage_exact`], §3.2.2); `texture` looks the clipped projected edge up in the 4D
-//!   coverage texture (§3.3) of `texture-n` (8…64, default 32) with `filter`
-//!   (`nearest` (default; the paper: "for normal scenes, this filtering is not necessary"),
-//!   `bilinear`, `quadrilinear`).
+//!   ([`edge_coverage_exact`], §3.2.2; for a sphere [`sphere_edge_coverage_exact`], below);
+//!   `texture` looks the clipped projected edge up in the 4D coverage texture (§3.3) of
+//!   `texture-n` (8…64, default 32) with `filter` (`nearest` (default; the paper: "for normal
+//!   scenes, this filtering is not necessary"), `bilinear`, `quadrilinear`).
 //! * **V-buffer** (`vbuffer`, [`crate::gpu::vbuffer`]): `f32` (default), `f16`, and `8bit`
 //!   (§4.2): pass 1 goes to the 8-bit stencil ([`stencil_shadow`], wrap) and pass 2 to the
 //!   saturating R (add) / G (subtract) channels; resolved as `1 − stencil + (R − G)/63`.
@@ -33,10 +33,17 @@
 //!   near plane), that wedge is drawn as a full-screen quad instead; the inside test still
 //!   decides per pixel, so the result is the same, only more pixels are tested. Degenerate
 //!   wedges ([`SsvWedge::new`] returns `None`) are handled the same way.
-//! * Sphere lights: §5.3 says pass 2 is "trivial to modify" for a sphere, with the
-//!   computations in the shader and no coverage texture; that variant is not implemented here
-//!   (`ssv` supports `rect` and `textured_rect`; Paper IV's spherical shader is in
-//!   `ssv-optimized`).
+//! * Sphere lights (§5.3: pass 2 is "trivial to modify" for a sphere, "we do not use a
+//!   precomputed coverage texture ... all computations can be done in the pixel shader"):
+//!   pass 1 is unchanged (hard quads from the center); the wedges are built around the
+//!   sphere (§3.1's bounding-sphere construction, [`WedgeLight::Sphere`]); the coverage is the
+//!   signed fraction of the disk through the center facing `p` — the sphere as the `raycast`
+//!   reference sees it — covered by the projected quad, computed exactly as sector minus
+//!   triangle ([`sphere_edge_coverage_exact`], the same arithmetic as `ssv-optimized`'s
+//!   spherical shader, Paper IV §4.2.1), with the rectangle's sign convention and every
+//!   V-buffer format. Following §5.3, there is no coverage texture for spheres:
+//!   `coverage = "texture"` with a sphere light is an input error naming `options.ssv.coverage`
+//!   (the 4D texture of §3.3 is indexed by the edge clipped to the rectangle).
 //! * Final visibility: the resolved V-buffer clamped to [0, 1] (overlapping occluders can
 //!   drive the Green's sum below 0, §5.3 "object overlap artifact"); background pixels are 1.
 
@@ -48,7 +55,7 @@ use crate::error::InputError;
 use crate::frame::{setup_all, Frame, Receiver};
 use crate::geometry::shadow_volume::{shadow_volume_triangles, Capping};
 use crate::geometry::silhouette::{light_facing, possible_silhouettes};
-use crate::geometry::ssv_wedge::SsvWedge;
+use crate::geometry::ssv_wedge::{SsvWedge, WedgeLight};
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::raster::{bin, draw, no_tile_culling};
@@ -57,7 +64,9 @@ use crate::gpu::transform::ClipVertex;
 use crate::gpu::vbuffer::{
     VBuffer8Tile, VBufferF16Tile, VBufferF32Tile, VBufferFormat, VBufferRgbTile, VBufferTile,
 };
-use crate::light::coverage::{edge_coverage_exact, projected_edge_in_light, quad_side, RectLight};
+use crate::light::coverage::{
+    edge_coverage_exact, projected_edge_in_light, quad_side, sphere_edge_coverage_exact,
+};
 use crate::light::coverage_texture::{
     coverage_texture, CoverageFilter, CoverageTexture, CoverageTextureKey, DEFAULT_N, MAX_N, MIN_N,
 };
@@ -128,6 +137,13 @@ pub fn read_settings(frame: &Frame) -> Result<(SsvSettings, &'static str), Input
             "textured lights need coverage = \"texture\" (the RGB coverage texture, Paper III §3.3)",
         ));
     }
+    if matches!(scene.light().shape, LightShape::Sphere { .. }) && coverage == "texture" {
+        return Err(bad(
+            "coverage",
+            "sphere lights need coverage = \"exact\" (Paper III §5.3: no coverage texture for \
+             spheres; the 4D texture of §3.3 is defined over a rectangle)",
+        ));
+    }
     if textured && vbuffer != VBufferFormat::RgbF32 {
         return Err(bad(
             "vbuffer",
@@ -166,7 +182,7 @@ struct EdgeWedge {
 
 /// Everything pass 2 needs per fragment.
 struct CoverageSource<'a> {
-    light: RectLight,
+    light: WedgeLight,
     mode: CoverageMode,
     texture: Option<Arc<CoverageTexture>>,
     receivers: &'a [Option<Receiver>],
@@ -176,15 +192,21 @@ struct CoverageSource<'a> {
 impl CoverageSource<'_> {
     /// The signed per-channel coverage of edge `w` at `p` (module doc).
     fn coverage(&self, w: &EdgeWedge, p: DVec3) -> [f32; 3] {
+        let light = match self.light {
+            WedgeLight::Rect(light) => light,
+            WedgeLight::Sphere { center, radius } => {
+                return [sphere_edge_coverage_exact(center, radius, p, w.e0, w.e1) as f32; 3];
+            }
+        };
         match (self.mode, &self.texture) {
             (CoverageMode::Texture { filter, .. }, Some(t)) => {
-                let Some([a, b]) = projected_edge_in_light(&self.light, p, w.e0, w.e1) else {
+                let Some([a, b]) = projected_edge_in_light(&light, p, w.e0, w.e1) else {
                     return [0.0; 3];
                 };
-                let s = quad_side(&self.light, p, w.e0, w.e1);
+                let s = quad_side(light.center, p, w.e0, w.e1);
                 t.lookup(a, b, filter).map(|v| (s * v) as f32)
             }
-            _ => [edge_coverage_exact(&self.light, p, w.e0, w.e1) as f32; 3],
+            _ => [edge_coverage_exact(&light, p, w.e0, w.e1) as f32; 3],
         }
     }
 }
@@ -203,7 +225,8 @@ pub struct SsvRender {
     pub seconds: [f64; 2],
 }
 
-/// Render `ssv` with `settings` on `frame` (the light must be a rectangle).
+/// Render `ssv` with `settings` on `frame` (the light must be a rectangle or a sphere, with
+/// exact coverage for a sphere: [`read_settings`] checks both).
 pub fn render(frame: &Frame, settings: &SsvSettings) -> SsvRender {
     match settings.vbuffer {
         VBufferFormat::F32 => render_with::<VBufferF32Tile>(frame, settings),
@@ -216,7 +239,7 @@ pub fn render(frame: &Frame, settings: &SsvSettings) -> SsvRender {
 fn render_with<V: VBufferTile>(frame: &Frame, settings: &SsvSettings) -> SsvRender {
     let scene = frame.scene;
     let tiling = &frame.tiling;
-    let light = RectLight::from_light(scene.light()).expect("ssv supports rectangular lights");
+    let light = WedgeLight::from_light(scene.light()).expect("ssv supports rects and spheres");
     let center = scene.light().center;
     let mut vbuf: Vec<V> = (0..tiling.tile_count())
         .map(|_| V::cleared(tiling.tile_len()))
@@ -373,7 +396,7 @@ fn near_radius(frame: &Frame) -> f64 {
 /// its light-facing triangle) has the shadow quad `b, a, a∞` whose normal points out of the
 /// volume, so `e0 = b`, `e1 = a` puts the umbra on the positive side of
 /// [`crate::light::coverage`]'s sign.
-fn edge_wedges(frame: &Frame, light: &RectLight) -> Vec<EdgeWedge> {
+fn edge_wedges(frame: &Frame, light: &WedgeLight) -> Vec<EdgeWedge> {
     let center = frame.scene.light().center;
     let mut out = Vec::new();
     for (mesh, adj) in frame.scene.meshes.iter().zip(&frame.adjacency) {

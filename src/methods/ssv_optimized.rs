@@ -25,11 +25,12 @@
 //! coverage is the light's area between the rays from the light center through the clipped
 //! endpoints (area table at the two atan2 angles) minus the triangle (center, p0, p1).
 //! **Spherical lights** (§4.2.1) — light space with the receiver at the origin, the light center
-//! at z = 1 and radius 1; the edge is clipped to the cone x² + y² = z² (z ≥ 0), projected to
-//! z = 1, and the same sector-minus-triangle on the unit disk. `coverage = "tables"` uses the
-//! paper's tables ([`crate::light::lookup_tables`]); `"exact"` uses f64 `atan2` and the exact
-//! sector area for the sphere, and exact clipping ([`coverage::edge_coverage_exact`]) for the
-//! rectangle.
+//! at z = 1 and radius 1; the edge is clipped to the cone x² + y² = z² (0 < z ≤ 1: between
+//! the receiver and the facing disk, [`coverage::clip_to_light_cone`]), projected to z = 1,
+//! and the same sector-minus-triangle on the unit disk ([`coverage::sector_minus_triangle`]).
+//! `coverage = "tables"` uses the paper's tables ([`crate::light::lookup_tables`]); `"exact"`
+//! uses f64 `atan2` and the exact sector area for the sphere, and exact clipping
+//! ([`coverage::edge_coverage_exact`]) for the rectangle.
 //!
 //! Options: `coverage = tables|exact`, `filter = bilinear|nearest` (area table), `split =
 //! stencil|plane`, `wedge = tight|bounding-sphere`, `overlap = off|loops`, `light_split = 1…4`,
@@ -80,7 +81,6 @@ use crate::light::lookup_tables::{AreaShape, AreaTable, Atan2CubeMap, SplitTable
 use crate::plan::{eye_in_shadow, BufferPlan, MethodPlan};
 use crate::scene::LightShape;
 use glam::{DVec2, DVec3, Vec3};
-use std::f64::consts::PI;
 use std::time::Instant;
 
 /// How the shaders compute coverage.
@@ -220,7 +220,7 @@ impl LightModel {
                 }
             }
             (LightModel::Sphere { center, radius }, _) => {
-                match clip_to_light_cone(*center, *radius, p, e0, e1) {
+                match coverage::clip_to_light_cone(*center, *radius, p, e0, e1) {
                     Some([a, b]) => sector_minus_triangle(a, b, AreaShape::Disk, mode),
                     None => 0.0,
                 }
@@ -229,94 +229,22 @@ impl LightModel {
     }
 }
 
-/// The analytic coverage of §4.2.2 Fig. 6a (and §4.2.1 Fig. 5a): the area of the light
-/// (`shape`, centered at the origin) between the rays through `a` and `b` minus the triangle
-/// (origin, a, b), as a fraction of the light's area, clamped to [0, 1].
+/// The shaders' coverage of §4.2.2 Fig. 6a and §4.2.1 Fig. 5a: the clipped, projected edge
+/// `a b` through [`coverage::sector_minus_triangle`], with the sector from the paper's tables
+/// (atan2 cube map, area table) or exact ([`coverage::exact_sector_minus_triangle`]).
 pub fn sector_minus_triangle(a: DVec2, b: DVec2, shape: AreaShape, mode: CoverageMode) -> f64 {
-    let sector = match mode {
-        CoverageMode::Exact => shape.sector_fraction(a.y.atan2(a.x), b.y.atan2(b.x)),
+    match mode {
+        CoverageMode::Exact => coverage::exact_sector_minus_triangle(a, b, shape),
         CoverageMode::Tables(filter) => {
             let map = Atan2CubeMap::get();
-            AreaTable::get(shape).sector_fraction(map.atan2(a.y, a.x), map.atan2(b.y, b.x), filter)
-        }
-    };
-    let total = match shape {
-        AreaShape::Square => 4.0,
-        AreaShape::Disk => PI,
-    };
-    let triangle = 0.5 * a.perp_dot(b).abs() / total;
-    (sector - triangle).clamp(0.0, 1.0)
-}
-
-/// §4.2.1: the edge `e0 e1` in the light space of receiver `p` (p at the origin, the light
-/// center at z = 1, radius 1), clipped to the cone x² + y² ≤ z², z ≥ 0, and projected to z = 1.
-/// `None` when nothing of the edge is inside the cone (or `p` is inside the light).
-pub fn clip_to_light_cone(
-    center: DVec3,
-    radius: f64,
-    p: DVec3,
-    e0: DVec3,
-    e1: DVec3,
-) -> Option<[DVec2; 2]> {
-    let w = center - p;
-    let dist = w.length();
-    if dist <= radius || !dist.is_finite() {
-        return None;
-    }
-    let z = w / dist;
-    let x = z.any_orthonormal_vector();
-    let y = z.cross(x);
-    let to_light = |e: DVec3| {
-        let d = e - p;
-        DVec3::new(d.dot(x) / radius, d.dot(y) / radius, d.dot(z) / dist)
-    };
-    let (q0, q1) = (to_light(e0), to_light(e1));
-    let d = q1 - q0;
-    let g = |t: f64| {
-        let q = q0 + d * t;
-        q.x * q.x + q.y * q.y - q.z * q.z
-    };
-    // Breakpoints: roots of g (the cone) and of z in (0, 1).
-    let qa = d.x * d.x + d.y * d.y - d.z * d.z;
-    let qb = q0.x * d.x + q0.y * d.y - q0.z * d.z;
-    let qc = q0.x * q0.x + q0.y * q0.y - q0.z * q0.z;
-    let mut ts = vec![0.0, 1.0];
-    if qa.abs() > 1e-300 {
-        let disc = qb * qb - qa * qc;
-        if disc >= 0.0 {
-            let s = disc.sqrt();
-            let r = -(qb + qb.signum() * s);
-            if r != 0.0 {
-                ts.push(r / qa);
-                ts.push(qc / r);
-            }
-        }
-    } else if qb != 0.0 {
-        ts.push(-qc / (2.0 * qb));
-    }
-    if d.z != 0.0 {
-        ts.push(-q0.z / d.z);
-    }
-    ts.retain(|t| (0.0..=1.0).contains(t));
-    ts.sort_by(|a, b| a.partial_cmp(b).unwrap());
-    let mut span: Option<(f64, f64)> = None;
-    for k in 0..ts.len() - 1 {
-        let (t0, t1) = (ts[k], ts[k + 1]);
-        let m = 0.5 * (t0 + t1);
-        if t1 > t0 && g(m) <= 0.0 && (q0 + d * m).z > 0.0 {
-            span = Some(match span {
-                None => (t0, t1),
-                Some((s0, _)) => (s0, t1),
-            });
+            let sector = AreaTable::get(shape).sector_fraction(
+                map.atan2(a.y, a.x),
+                map.atan2(b.y, b.x),
+                filter,
+            );
+            coverage::sector_minus_triangle(a, b, shape, sector)
         }
     }
-    let (t0, t1) = span?;
-    let project = |t: f64| {
-        let q = q0 + d * t;
-        DVec2::new(q.x / q.z, q.y / q.z)
-    };
-    let (a, b) = (project(t0), project(t1));
-    (a.is_finite() && b.is_finite()).then_some([a, b])
 }
 
 /// Read the `ssv-optimized` options (module doc).
