@@ -516,6 +516,9 @@ fn every_wedge_is_bounded_and_closed_by_its_faces() {
         let frame = Frame::render(&scene, GpuSettings::default()).unwrap();
         let ws = wedge_settings(&frame);
         let set = pw2002::frame_wedges(&frame, &ws).unwrap();
+        if set.open_wedges != 0 {
+            failures.push(format!("{name}: {} open wedges reported", set.open_wedges));
+        }
         if scene.lights.len() == 1 {
             let (c, r) = (ws.wedge.center, ws.wedge.radius);
             for (i, w) in set.wedges.iter().enumerate() {

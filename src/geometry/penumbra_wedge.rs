@@ -256,6 +256,10 @@ pub struct WedgeSet {
     pub removed_parallel: usize,
     /// Extra corner wedges inserted.
     pub extra_wedges: usize,
+    /// Wedges still not bounded and closed by their faces with the most robust side planes
+    /// (0 on every built-in scene; reported in the stats so that a scene where the
+    /// construction fails is visible).
+    pub open_wedges: usize,
 }
 
 impl WedgeSet {
@@ -267,6 +271,7 @@ impl WedgeSet {
         self.bottom_caps.extend(other.bottom_caps);
         self.removed_parallel += other.removed_parallel;
         self.extra_wedges += other.extra_wedges;
+        self.open_wedges += other.open_wedges;
     }
 }
 
@@ -438,6 +443,7 @@ fn loop_wedges(lp: &[DVec3], o: &WedgeOptions, set: &mut WedgeSet) {
             break (sides, wedges);
         }
     };
+    set.open_wedges += wedges.iter().filter(|w| !is_closed(w)).count();
     set.wedges.extend(wedges);
     // Far cap: reverse loop order so shared edges P_a→P_b of the front faces are traversed
     // oppositely (outward, away from the light).

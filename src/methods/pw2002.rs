@@ -313,6 +313,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             "wedges": set.wedges.len(),
             "extra_corner_wedges": set.extra_wedges,
             "removed_parallel_edges": set.removed_parallel,
+            "open_wedges": set.open_wedges,
             "gpu": frame.gpu,
         }),
     };

@@ -541,6 +541,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             "mode": mode,
             "resolved": s,
             "wedges": set.wedges.len(),
+            "open_wedges": set.open_wedges,
             "gpu": frame.gpu,
         }),
     };
