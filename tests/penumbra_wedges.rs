@@ -363,14 +363,14 @@ fn zfail_umbra_surface(
     tris
 }
 
-/// Directed edges of `tris` not cancelled by the same edge in the opposite direction (with
-/// bit-identical clip-space vertices): none for a closed, consistently oriented surface.
-fn open_edges(tris: &[[ClipVertex; 3]]) -> usize {
-    let key = |v: &ClipVertex| v.0.map(f32::to_bits);
-    let mut count: BTreeMap<([u32; 4], [u32; 4]), i32> = BTreeMap::new();
-    for t in tris {
-        for i in 0..3 {
-            let (u, v) = (key(&t[i]), key(&t[(i + 1) % 3]));
+/// Directed edges of the closed polygons `polys` not cancelled by the same edge in the
+/// opposite direction (vertices compared by their bits through `K`): none for a closed,
+/// consistently oriented surface.
+fn unmatched_edges<K: Ord + Copy>(polys: impl Iterator<Item = Vec<K>>) -> usize {
+    let mut count: BTreeMap<(K, K), i32> = BTreeMap::new();
+    for poly in polys {
+        for i in 0..poly.len() {
+            let (u, v) = (poly[i], poly[(i + 1) % poly.len()]);
             match u.cmp(&v) {
                 Ordering::Less => *count.entry((u, v)).or_default() += 1,
                 Ordering::Greater => *count.entry((v, u)).or_default() -= 1,
@@ -379,6 +379,15 @@ fn open_edges(tris: &[[ClipVertex; 3]]) -> usize {
         }
     }
     count.values().filter(|c| **c != 0).count()
+}
+
+/// Directed edges of `tris` not cancelled by the reverse edge (bit-identical clip-space
+/// vertices).
+fn open_edges(tris: &[[ClipVertex; 3]]) -> usize {
+    unmatched_edges(
+        tris.iter()
+            .map(|t| t.iter().map(|v| v.0.map(f32::to_bits)).collect()),
+    )
 }
 
 /// Paper II §5: z-fail needs the umbra surface (top caps, front planes, bottom caps) closed.
@@ -477,19 +486,11 @@ fn face_winding(w: &penumbra::geometry::penumbra_wedge::Wedge, p: glam::DVec3) -
 /// Directed face edges of `w` not matched by the reverse edge of another face (bit-identical
 /// vertices): none when the faces close a polyhedron.
 fn open_face_edges(w: &penumbra::geometry::penumbra_wedge::Wedge) -> usize {
-    let key = |v: glam::DVec3| v.to_array().map(f64::to_bits);
-    let mut count: BTreeMap<([u64; 3], [u64; 3]), i32> = BTreeMap::new();
-    for (_, poly) in &w.faces {
-        for i in 0..poly.len() {
-            let (u, v) = (key(poly[i]), key(poly[(i + 1) % poly.len()]));
-            match u.cmp(&v) {
-                Ordering::Less => *count.entry((u, v)).or_default() += 1,
-                Ordering::Greater => *count.entry((v, u)).or_default() -= 1,
-                Ordering::Equal => {}
-            }
-        }
-    }
-    count.values().filter(|c| **c != 0).count()
+    unmatched_edges(w.faces.iter().map(|(_, poly)| {
+        poly.iter()
+            .map(|v| v.to_array().map(f64::to_bits))
+            .collect()
+    }))
 }
 
 /// Every wedge of every sphere-light built-in is a bounded convex region whose face polygons

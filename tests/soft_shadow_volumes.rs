@@ -12,6 +12,8 @@
 //! |ssv − raycast| ≤ 2/k at every pixel. Jitter errors are unbiased, so the mean is far
 //! smaller; we require mean ≤ 1/(2k).
 
+mod common;
+use common::{gray, K};
 use glam::{DVec2, DVec3, Vec3};
 use penumbra::frame::{Frame, GpuSettings};
 use penumbra::geometry::ssv_wedge::{SsvWedge, WedgeLight};
@@ -31,20 +33,11 @@ use penumbra::scene::{builtin, OptionValue, Scene};
 use proptest::prelude::*;
 use std::sync::Arc;
 
-const K: f64 = 32.0;
-
 fn small(name: &str) -> Scene {
     let mut s = builtin::load(name).unwrap();
     s.width = 64;
     s.height = 64;
     s
-}
-
-fn gray(v: &Visibility) -> Vec<f32> {
-    match v {
-        Visibility::Gray(v) => v.clone(),
-        Visibility::Rgb(v) => v.iter().map(|c| c[0]).collect(),
-    }
 }
 
 fn exact_f32() -> SsvSettings {
@@ -57,21 +50,7 @@ fn exact_f32() -> SsvSettings {
 
 #[test]
 fn ssv_exact_matches_raycast_on_single_quad() {
-    let mut s = small("single-quad");
-    s.methods = Some(vec!["raycast".into(), "ssv".into()]);
-    let runs = render_scene(&s).unwrap();
-    let ssv = runs.iter().find(|r| r.method == "ssv").unwrap();
-    let e = ssv.error.expect("error vs the reference");
-    eprintln!("single-quad 64²: ssv exact vs raycast {e:?}");
-    assert!(e.max_abs <= 2.0 / K + 1e-5, "max {} > 2/k", e.max_abs);
-    assert!(
-        e.mean_abs <= 1.0 / (2.0 * K),
-        "mean {} > 1/(2k)",
-        e.mean_abs
-    );
-    let vis = gray(&ssv.output.visibility);
-    assert!(vis.iter().filter(|v| **v > 0.05 && **v < 0.95).count() > 50);
-    assert!(vis.contains(&0.0), "the quad has an umbra");
+    common::assert_ssv_agrees_with_raycast(small("single-quad"), 2.0 / K + 1e-5, "single-quad 64²");
 }
 
 /// The occluder of `single-quad` cut in two along x = `cut` (two closed two-sided quads that

@@ -23,20 +23,19 @@
 //! mean is far smaller; as for the rectangle (`tests/soft_shadow_volumes.rs`) we require
 //! mean ≤ 1/(2k). Measured: 64² max 0.0081, mean 0.00027; 256² max 0.0106, mean 0.00025.
 
+mod common;
+use common::{gray, K};
 use glam::{DVec2, DVec3, Vec3};
 use penumbra::frame::{Frame, GpuSettings};
 use penumbra::geometry::ssv_wedge::{SsvWedge, WedgeLight};
 use penumbra::gpu::vbuffer::VBufferFormat;
 use penumbra::light::coverage::{polygon_area, sphere_edge_coverage_exact};
 use penumbra::methods::hard_sv::ShadowTest;
-use penumbra::methods::output::Visibility;
 use penumbra::methods::ssv::{read_settings, render, CoverageMode, SsvSettings};
 use penumbra::render::render_scene;
 use penumbra::scene::procedural::two_sided_quad;
 use penumbra::scene::{builtin, LightShape, OptionValue, Scene};
 use proptest::prelude::*;
-
-const K: f64 = 32.0;
 
 /// `single-quad` at 64² with its 1×1 rectangle replaced by a sphere of radius 0.5 (same
 /// center, 3 above the floor, 2 above the quad).
@@ -46,13 +45,6 @@ fn sphere_quad() -> Scene {
     s.height = 64;
     s.lights[0].shape = LightShape::Sphere { radius: 0.5 };
     s
-}
-
-fn gray(v: &Visibility) -> Vec<f32> {
-    match v {
-        Visibility::Gray(v) => v.clone(),
-        Visibility::Rgb(v) => v.iter().map(|c| c[0]).collect(),
-    }
 }
 
 fn exact(vbuffer: VBufferFormat) -> SsvSettings {
@@ -70,22 +62,11 @@ fn ssv_visibility(scene: &Scene, settings: &SsvSettings) -> Vec<f32> {
 
 #[test]
 fn ssv_exact_matches_raycast_on_single_quad_under_a_sphere() {
-    let mut s = sphere_quad();
-    s.methods = Some(vec!["raycast".into(), "ssv".into()]);
-    let runs = render_scene(&s).unwrap();
-    let ssv = runs.iter().find(|r| r.method == "ssv").unwrap();
-    let e = ssv.error.expect("error vs the reference");
-    eprintln!("single-quad, sphere light, 64²: ssv exact vs raycast {e:?}");
-    let max_tol = 2.0 * (2.371 * K + 13.0) / (K * K) + 1e-5;
-    assert!(e.max_abs <= max_tol, "max {} > {max_tol}", e.max_abs);
-    assert!(
-        e.mean_abs <= 1.0 / (2.0 * K),
-        "mean {} > 1/(2k)",
-        e.mean_abs
+    common::assert_ssv_agrees_with_raycast(
+        sphere_quad(),
+        2.0 * (2.371 * K + 13.0) / (K * K) + 1e-5,
+        "single-quad, sphere light, 64²",
     );
-    let vis = gray(&ssv.output.visibility);
-    assert!(vis.iter().filter(|v| **v > 0.05 && **v < 0.95).count() > 50);
-    assert!(vis.contains(&0.0), "the quad has an umbra");
 }
 
 /// The occluder of the sphere scene cut in two along x = `cut` (two closed two-sided quads
