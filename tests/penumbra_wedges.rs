@@ -234,6 +234,7 @@ fn hard_cases() -> Vec<Scene> {
         small("pw-2002", 32),                         // overlapping boxes
         small("pw-fractal", 32),                      // zigzag silhouettes, high vertex degrees
         small("pw-columns", 32),                      // contact: columns stand on the floor
+        small("two-lights", 32),                      // two lights in one LI buffer
     ];
     // Edges nearly parallel to the light: the cylinder's vertical edges under a light almost
     // straight above its rim.
