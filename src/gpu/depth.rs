@@ -1,6 +1,6 @@
 //! Depth formats, depth quantization and the depth test (DESIGN.md "Depth").
 //!
-//! * D24 unorm (default): `D24 = round_half_even(f32(z_w · 16777215))`, z_w clamped to [0,1]
+//! * D24 unorm (default): `D24 = round_half_even(f32(z_w · 16777215))`, z_w clamped to [0, 1]
 //!   first (OpenGL clamps interpolated depth to the depth range).
 //! * D32F: the clamped f32 z_w itself; stored as its bit pattern, compared as f32.
 //!
@@ -27,7 +27,7 @@ impl DepthFormat {
         }
     }
 
-    /// The stored value of window depth `z_w` (clamped to [0,1]).
+    /// The stored value of window depth `z_w` (clamped to [0, 1]).
     pub fn quantize(self, z_w: f32) -> u32 {
         let z = z_w.clamp(0.0, 1.0);
         match self {

@@ -66,7 +66,7 @@ pub struct RasterTriangle {
     z_origin: [f64; 3],
     /// Depth plane slopes per pixel in x and y.
     z_slope: [f64; 2],
-    /// Smallest and largest vertex window depth (clamped to [0,1]) — the triangle's depth range
+    /// Smallest and largest vertex window depth (clamped to [0, 1]) — the triangle's depth range
     /// for hierarchical-Z tests.
     pub z_range: [f32; 2],
 }

@@ -100,7 +100,7 @@ impl Projection {
     }
 
     /// The world point seen at the center of pixel (`x`, `y`) (row 0 at the top) at window depth
-    /// `z_w` in [0,1]: the inverse of the viewport and projection, in f64.
+    /// `z_w` in [0, 1]: the inverse of the viewport and projection, in f64.
     pub fn unproject(&self, x: u32, y: u32, z_w: f64) -> DVec3 {
         let ndc_x = (x as f64 + 0.5) / self.width as f64 * 2.0 - 1.0;
         let ndc_y = 1.0 - (y as f64 + 0.5) / self.height as f64 * 2.0;

@@ -12,7 +12,7 @@
 //! would need extrapolation.) Sub-texture `(a, b)` holds the first endpoint at `(s_a, t_b)`,
 //! its texel `(i, j)` the second endpoint at `(s_i, t_j)`; the sub-textures are tiled into one
 //! `n² × n²` texture, big-texture column `a·n + i`, row `b·n + j`. Each texel stores
-//! `round(255·f)` with `f` = [`segment_coverage`] computed by exact clipping (n = 32: 1024×1024
+//! `round(255·f)` with `f` = [`segment_coverage`](crate::light::coverage::segment_coverage) computed by exact clipping (n = 32: 1024×1024
 //! bytes, 1 MB). The texture does not depend on the light's size or aspect: area ratios are
 //! affine invariant, so one texture per `n` serves every rectangular light.
 //!

@@ -129,7 +129,7 @@ pub struct Atan2CubeMap {
     pub faces: Vec<UnormTexture2D>,
 }
 
-/// The face and (s, t) ∈ [0,1]² that OpenGL's cube-map addressing gives direction `d`
+/// The face and (s, t) ∈ [0, 1]² that OpenGL's cube-map addressing gives direction `d`
 /// (major axis ties: X, then Y, then Z).
 fn cube_face(d: [f64; 3]) -> (usize, f64, f64) {
     let [x, y, z] = d;

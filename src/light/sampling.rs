@@ -46,7 +46,7 @@ use glam::{DVec3, Vec3};
 pub struct LightSample {
     /// The sample position in world space.
     pub position: Vec3,
-    /// Per-channel (RGB) weight of the sample in [0,1].
+    /// Per-channel (RGB) weight of the sample in [0, 1].
     pub weight: [f32; 3],
 }
 

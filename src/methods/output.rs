@@ -1,4 +1,4 @@
-//! What every method hands back: a visibility buffer in [0,1] (DESIGN.md "Methods": all
+//! What every method hands back: a visibility buffer in [0, 1] (DESIGN.md "Methods": all
 //! methods are compared on the same footing), optional raw buffers for inspection, and the
 //! stats that go into `stats.json`.
 
@@ -8,9 +8,9 @@ use serde::Serialize;
 /// Per-pixel visibility of the light, row 0 at the top, row-major.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Visibility {
-    /// One value per pixel in [0,1].
+    /// One value per pixel in [0, 1].
     Gray(Vec<f32>),
-    /// One value per pixel and RGB channel in [0,1] (textured/coloured lights).
+    /// One value per pixel and RGB channel in [0, 1] (textured/coloured lights).
     Rgb(Vec<[f32; 3]>),
 }
 
@@ -90,7 +90,7 @@ pub struct MethodStats {
 /// The result of running one method on one scene.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MethodOutput {
-    /// Visibility in [0,1].
+    /// Visibility in [0, 1].
     pub visibility: Visibility,
     /// Extra raw buffers (e.g. the stencil).
     pub raw_images: Vec<RawImage8>,

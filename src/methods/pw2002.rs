@@ -66,7 +66,7 @@ pub enum MultiLight {
     /// clamped once at the end. Where shadows of one light overlap (two occluders of the same
     /// light), that light's umbra is subtracted twice and eats into the other lights' share.
     SharedLi,
-    /// One LI buffer per light, each clamped to [0,255], visibilities averaged
+    /// One LI buffer per light, each clamped to [0, 255], visibilities averaged
     /// ([`super::light_average`]): n times the LI memory and passes, no cross-light error.
     PerLight,
 }

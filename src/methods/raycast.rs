@@ -74,7 +74,7 @@
 //! ray by at most a few ulps of M (plus ~1e-7 D), far less than the padding, so a box that
 //! holds a blocking triangle is never culled; a ray parallel to a slab that grazes a padded
 //! face exactly (where `0·∞` gives NaN and the box may be rejected) cannot touch a triangle,
-//! which lies at least `pad` inside. The bins are widened by [`BIN_MARGIN`]` × (D + M)`,
+//! which lies at least `pad` inside. The bins are widened by `BIN_MARGIN × (D + M)`,
 //! which covers the f64 rounding of the projections; the clip depth `ε·h/2` keeps half of
 //! `ε` to spare.
 //!

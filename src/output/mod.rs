@@ -9,7 +9,7 @@
 //! | `visibility.exr` | OpenEXR, RGB f32 (gray replicated into the three channels) |
 //! | `visibility.pfm` | PFM with the exact f32 bits (`Pf` gray / `PF` RGB) — what goldens compare |
 //! | `<name>.png` | each [`RawImage8`] (e.g. `hard-sv`'s `stencil.png`), 8-bit grayscale, values as stored |
-//! | `stats.json` | [`MethodStats`] as pretty-printed JSON |
+//! | `stats.json` | [`MethodStats`](crate::methods::output::MethodStats) as pretty-printed JSON |
 //!
 //! **No partial output** (DESIGN.md "Bad input"): every file is encoded in memory first, so
 //! an encoding error writes nothing; then each file is written to a hidden temporary name in
@@ -28,7 +28,7 @@ use std::path::{Path, PathBuf};
 /// Converts one linear-light value to an 8-bit sRGB code with the sRGB OETF
 /// (IEC 61966-2-1): `12.92·x` for `x ≤ 0.0031308`, else `1.055·x^(1/2.4) − 0.055`.
 ///
-/// The input is clamped to [0,1] first (NaN maps to 0). The curve is evaluated in f64 and the
+/// The input is clamped to [0, 1] first (NaN maps to 0). The curve is evaluated in f64 and the
 /// code is `round_half_even(255·y)`: ties go to the even code, the same rounding rule the
 /// emulated GPU uses for its quantizations. `powf` comes from the platform's libm, so this is
 /// used only for viewing images (the shaded `image.png`, diff panels), never for goldens.

@@ -467,7 +467,7 @@ fn build_mesh(m: &MeshDef, i: usize, source: &str, base_dir: &Path) -> Result<Me
         .map_err(|e| InputError::at(source, format!("meshes[{i}] ({display})"), e.message))
 }
 
-/// Loads an image as linear RGB in [0,1]: 8- and 16-bit images are sRGB-decoded, float
+/// Loads an image as linear RGB in [0, 1]: 8- and 16-bit images are sRGB-decoded, float
 /// images (EXR) are taken as linear. Alpha is ignored.
 fn load_texture(path: &Path) -> Result<RgbTexture, String> {
     let name = path.display().to_string();

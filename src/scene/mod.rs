@@ -7,7 +7,7 @@
 //! amounts scaled by 255/n, every other method renders each light on its own
 //! ([`Scene::with_only_light`]) and averages ([`crate::methods::run`]).
 //!
-//! Files are TOML or JSON with one schema ([`file`]); built-in scenes are generated in code
+//! Files are TOML or JSON with one schema ([`mod@file`]); built-in scenes are generated in code
 //! ([`builtin`]); OBJ meshes are loaded with `tobj` ([`obj`]). Everything that reaches a
 //! [`Scene`] has been validated ([`validate`]): finite numbers, non-degenerate light and
 //! camera, closed two-manifold meshes.
@@ -38,7 +38,7 @@ pub struct Camera {
     pub near: Option<f64>,
 }
 
-/// An RGB texture with linear f32 texels in [0,1], row 0 at the top (used by textured lights).
+/// An RGB texture with linear f32 texels in [0, 1], row 0 at the top (used by textured lights).
 #[derive(Debug, Clone, PartialEq)]
 pub struct RgbTexture {
     /// Width in texels.
@@ -109,7 +109,7 @@ pub struct Mesh {
 
 /// Raw per-method options as written in `[options.METHOD]` or with `--opt METHOD.KEY=VALUE`.
 /// Values are kept as strings/numbers/bools; each method validates its own keys
-/// ([`crate::methods::MethodOptions`]).
+/// ([`crate::methods::options::OptionReader`]).
 pub type RawOptions = BTreeMap<String, BTreeMap<String, OptionValue>>;
 
 /// One option value as written by the user.
@@ -155,7 +155,7 @@ pub struct Scene {
     pub methods: Option<Vec<String>>,
     /// Per-method options, not yet validated against each method's keys.
     pub options: RawOptions,
-    /// Ambient term of the shaded image, in [0,1].
+    /// Ambient term of the shaded image, in [0, 1].
     pub ambient: f32,
 }
 

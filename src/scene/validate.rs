@@ -5,10 +5,10 @@
 //! vertex, colours); camera with `vfov_deg` in (0,180), `eye ≠ target`, `up` not parallel to
 //! the view direction, `near > 0` if given; 1 to [`MAX_LIGHTS`] lights, each of positive size (radius > 0; `u`, `v`
 //! non-zero and not parallel; disk normal non-zero; a non-empty texture of `width·height`
-//! texels in `[0,1]`); at least one mesh, each a closed, consistently wound two-manifold
+//! texels in `[0, 1]`); at least one mesh, each a closed, consistently wound two-manifold
 //! ([`crate::geometry::adjacency::build`], the message names the offending edge) that is not
 //! inside out (signed volume not negative; flat two-sided meshes have volume 0); every light
-//! centre strictly outside every mesh (bounding box, then ray parity); `ambient` in `[0,1]`;
+//! centre strictly outside every mesh (bounding box, then ray parity); `ambient` in `[0, 1]`;
 //! a `methods` list, if given, not empty (the names are checked by the methods registry).
 
 use super::{Camera, Light, LightShape, Mesh, Scene};
@@ -235,7 +235,7 @@ fn validate_light(l: &Light) -> Result<(), (&'static str, String)> {
     }
 }
 
-/// Mesh checks: finite vertices, a colour in [0,1], at least one triangle, closed two-manifold.
+/// Mesh checks: finite vertices, a colour in [0, 1], at least one triangle, closed two-manifold.
 fn validate_mesh(m: &Mesh) -> Result<(), String> {
     if let Some(i) = m.positions.iter().position(|p| !p.is_finite()) {
         let p = m.positions[i];
