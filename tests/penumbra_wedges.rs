@@ -236,6 +236,15 @@ fn hard_cases() -> Vec<Scene> {
         small("pw-columns", 32),                      // contact: columns stand on the floor
         small("two-lights", 32),                      // two lights in one LI buffer
     ];
+    // Acute silhouette corners (Fig. 7 corner wedges) under a small sphere light.
+    let mut s = penumbra::scene::file::load_scene_file(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenes/hard/acute-corner-sphere.toml"
+    )))
+    .unwrap();
+    s.width = 32;
+    s.height = 32;
+    v.push(s);
     // Edges nearly parallel to the light: the cylinder's vertical edges under a light almost
     // straight above its rim.
     let mut s = small("cylinder", 32);
