@@ -296,25 +296,36 @@ pub fn clip_to_light_cone(
     let qa = d.x * d.x + d.y * d.y - d.z * d.z;
     let qb = q0.x * d.x + q0.y * d.y - q0.z * d.z;
     let qc = q0.x * q0.x + q0.y * q0.y - q0.z * q0.z;
-    let mut ts = vec![0.0, 1.0];
+    // At most 6 candidates (0, 1, two cone roots, z = 0, z = 1): a fixed array, since this
+    // runs per fragment. NaN candidates fail the range test and are left out.
+    let mut buf = [0.0f64; 6];
+    let mut len = 0;
+    let mut push = |t: f64| {
+        if (0.0..=1.0).contains(&t) {
+            buf[len] = t;
+            len += 1;
+        }
+    };
+    push(0.0);
+    push(1.0);
     if qa.abs() > 1e-300 {
         let disc = qb * qb - qa * qc;
         if disc >= 0.0 {
             let s = disc.sqrt();
             let r = -(qb + qb.signum() * s);
             if r != 0.0 {
-                ts.push(r / qa);
-                ts.push(qc / r);
+                push(r / qa);
+                push(qc / r);
             }
         }
     } else if qb != 0.0 {
-        ts.push(-qc / (2.0 * qb));
+        push(-qc / (2.0 * qb));
     }
     if d.z != 0.0 {
-        ts.push(-q0.z / d.z);
-        ts.push((1.0 - q0.z) / d.z);
+        push(-q0.z / d.z);
+        push((1.0 - q0.z) / d.z);
     }
-    ts.retain(|t| (0.0..=1.0).contains(t));
+    let ts = &mut buf[..len];
     ts.sort_by(|a, b| a.partial_cmp(b).unwrap());
     let mut span: Option<(f64, f64)> = None;
     for k in 0..ts.len() - 1 {
