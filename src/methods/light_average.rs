@@ -8,12 +8,12 @@
 //! and the sum is divided by n once (fixed order: independent of threads). A gray and an RGB
 //! result average to RGB (gray replicated). Stats: the scene pass appears once; every pass of
 //! light k is named `light<k>/<pass>`; raw images are named `<name>-light<k>`; the plan lists
-//! the per-light plans.
+//! the per-light plans (their buffers are allocated once per light, in turn).
 
 use super::output::{MethodOutput, RawImage8, Visibility};
 use crate::error::InputError;
 use crate::frame::Frame;
-use crate::gpu::counters::Counters;
+use crate::plan::MethodPlan;
 use crate::scene::Scene;
 use std::time::Instant;
 
@@ -52,27 +52,20 @@ pub fn run(
         }));
         plans.push(out.stats.plan);
     }
-    let mut totals = Counters::default();
-    for p in &passes {
-        totals += p.counters;
-    }
+    let plan = MethodPlan {
+        method: method.into(),
+        passes: passes.iter().map(|p| p.name.clone()).collect(),
+        buffers: vec![],
+        settings: serde_json::json!({
+            "lights": lights,
+            "combine": "mean of per-light visibilities (f32 sum in light order, / n)",
+            "per_light": plans,
+        }),
+    };
     Ok(MethodOutput {
         visibility,
         raw_images,
-        stats: super::output::MethodStats {
-            method: method.into(),
-            width: frame.scene.width,
-            height: frame.scene.height,
-            wall_seconds: start.elapsed().as_secs_f64(),
-            plan: serde_json::json!({
-                "method": method,
-                "lights": lights,
-                "combine": "mean of per-light visibilities (f32 sum in light order, / n)",
-                "per_light": plans,
-            }),
-            passes,
-            totals,
-        },
+        stats: super::method_stats(method, frame, start, &plan, passes),
     })
 }
 
