@@ -146,11 +146,7 @@ fn sphere_lights(scene: &Scene) -> Result<Vec<WedgeOptions>, InputError> {
             }),
             _ => Err(InputError::at(
                 &scene.source,
-                if scene.is_multi_light() {
-                    format!("lights[{k}]")
-                } else {
-                    "light".to_string()
-                },
+                scene.light_object(k, "light"),
                 "penumbra wedges need a sphere light",
             )),
         })

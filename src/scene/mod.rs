@@ -172,6 +172,20 @@ impl Scene {
         self.lights.len() > 1
     }
 
+    /// The name of light `k`'s field `object` (written `light` or `light.FIELD`) in messages:
+    /// unchanged for a single-light scene, `lights[K]` / `lights[K].FIELD` when the scene has
+    /// several lights.
+    pub fn light_object(&self, k: usize, object: &str) -> String {
+        if self.is_multi_light() {
+            format!(
+                "lights[{k}]{}",
+                object.strip_prefix("light").unwrap_or(object)
+            )
+        } else {
+            object.to_string()
+        }
+    }
+
     /// A copy of this scene lit by light `k` alone (same camera, meshes, methods, options).
     pub fn with_only_light(&self, k: usize) -> Scene {
         Scene {

@@ -34,7 +34,7 @@ pub fn validate(scene: &Scene) -> Result<(), InputError> {
         ));
     }
     for (k, light) in scene.lights.iter().enumerate() {
-        validate_light(light).map_err(|(o, m)| err(&light_object(scene, k, o), m))?;
+        validate_light(light).map_err(|(o, m)| err(&scene.light_object(k, o), m))?;
     }
     if !(scene.ambient.is_finite() && (0.0..=1.0).contains(&scene.ambient)) {
         return Err(err(
@@ -61,7 +61,7 @@ pub fn validate(scene: &Scene) -> Result<(), InputError> {
         for (i, mesh) in scene.meshes.iter().enumerate() {
             if let Some(why) = point_touches(mesh, light.center) {
                 return Err(err(
-                    &light_object(scene, k, "light"),
+                    &scene.light_object(k, "light"),
                     format!(
                         "light intersects geometry: the light center {} is {why} meshes[{i}] ({})",
                         fmt_f32v(light.center),
@@ -72,19 +72,6 @@ pub fn validate(scene: &Scene) -> Result<(), InputError> {
         }
     }
     Ok(())
-}
-
-/// The name of light `k`'s field `object` (written `light.FIELD`) in messages: unchanged for a
-/// single-light scene, `lights[K].FIELD` when the scene has several lights.
-fn light_object(scene: &Scene, k: usize, object: &str) -> String {
-    if scene.is_multi_light() {
-        format!(
-            "lights[{k}]{}",
-            object.strip_prefix("light").unwrap_or(object)
-        )
-    } else {
-        object.to_string()
-    }
 }
 
 /// Formats a vector as `(x, y, z)` with Rust's shortest round-trip digits.
