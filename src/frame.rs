@@ -25,6 +25,22 @@ use std::time::Instant;
 /// The pixel at which no geometry was drawn.
 pub const BACKGROUND: u32 = u32::MAX;
 
+/// Two front-facing triangles covering the viewport at the near plane: what a method draws for
+/// a volume it cannot rasterize by its faces (the eye inside or near it), so that every pixel
+/// runs its fragment program and the program's own inside test decides.
+pub const FULL_SCREEN: [[ClipVertex; 3]; 2] = [
+    [
+        ClipVertex([-1.0, -1.0, 0.0, 1.0]),
+        ClipVertex([1.0, -1.0, 0.0, 1.0]),
+        ClipVertex([1.0, 1.0, 0.0, 1.0]),
+    ],
+    [
+        ClipVertex([-1.0, -1.0, 0.0, 1.0]),
+        ClipVertex([1.0, 1.0, 0.0, 1.0]),
+        ClipVertex([-1.0, 1.0, 0.0, 1.0]),
+    ],
+];
+
 /// Pipeline settings shared by every pass of a frame (`[options.gpu]`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub struct GpuSettings {
@@ -188,6 +204,17 @@ impl<'s> Frame<'s> {
             prim_rows: self.prim_rows.clone(),
             depth_receivers: self.depth_receivers.clone(),
         }
+    }
+
+    /// The distance from the eye to the corners of the near-plane rectangle: a volume whose
+    /// faces come closer to the eye than this may be clipped by the near plane (methods then
+    /// draw it as [`FULL_SCREEN`]).
+    pub fn near_plane_radius(&self) -> f64 {
+        let cam = &self.scene.camera;
+        let near = self.proj.near;
+        let half_h = near * (cam.vfov_deg.to_radians() * 0.5).tan();
+        let half_w = half_h * self.scene.width as f64 / self.scene.height as f64;
+        (near * near + half_h * half_h + half_w * half_w).sqrt()
     }
 
     /// Number of pixels.

@@ -26,6 +26,21 @@ pub enum Capping {
     Capped,
 }
 
+/// The two triangles `(b, a, a∞)`, `(b, a∞, b∞)` of the shadow quad of silhouette edge a → b
+/// from the clip coordinates of its ends (`near = [a, b]`) and of their extrusions to infinity
+/// (`far = [a∞, b∞]`): the winding that makes the quad's normal point out of the volume.
+pub fn quad_triangles(near: [ClipVertex; 2], far: [ClipVertex; 2]) -> [[ClipVertex; 3]; 2] {
+    let ([a, b], [fa, fb]) = (near, far);
+    [[b, a, fa], [b, fa, fb]]
+}
+
+/// The shadow quad of one silhouette edge a → b from light point `light`, exactly as
+/// [`shadow_volume_triangles`] builds it for the same edge (same vertex transforms).
+pub fn silhouette_quad(proj: &Projection, light: Vec3, a: Vec3, b: Vec3) -> [[ClipVertex; 3]; 2] {
+    let far = |x: Vec3| proj.clip_direction(away_from_light(x, light));
+    quad_triangles([proj.clip_point(a), proj.clip_point(b)], [far(a), far(b)])
+}
+
 /// The clip-space triangles of the shadow volumes of `meshes` from light point `light`,
 /// in submission order.
 pub fn shadow_volume_triangles(
@@ -52,8 +67,7 @@ pub fn shadow_volume_triangles(
         }
         for e in possible_silhouettes(mesh, adj, &facing) {
             let (a, b) = (e.va as usize, e.vb as usize);
-            out.push([near[b], near[a], far[a]]);
-            out.push([near[b], far[a], far[b]]);
+            out.extend(quad_triangles([near[a], near[b]], [far[a], far[b]]));
         }
         if capping == Capping::Capped {
             for (t, f) in mesh.triangles.iter().zip(&facing) {

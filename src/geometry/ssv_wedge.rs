@@ -85,7 +85,7 @@ impl WedgeLight {
     fn angular_extremes(&self, o: DVec3, x: DVec3, y: DVec3) -> Option<(DVec2, DVec2)> {
         let local = |q: DVec3| DVec2::new((q - o).dot(x), (q - o).dot(y));
         match self {
-            WedgeLight::Rect(l) => angular_extremes(rect_corners(l).map(local)),
+            WedgeLight::Rect(l) => angular_extremes(l.corners().map(local)),
             WedgeLight::Sphere { center, radius } => {
                 let (lo, hi) = tangent_angles(local(*center), *radius)?;
                 Some((DVec2::from_angle(lo), DVec2::from_angle(hi)))
@@ -105,12 +105,6 @@ fn tangent_angles(m: DVec2, radius: f64) -> Option<(f64, f64)> {
     let half = (radius / d).asin();
     let phi = m.y.atan2(m.x);
     Some((phi - half, phi + half))
-}
-
-/// The four corners of a rectangular light, in order around it.
-fn rect_corners(l: &RectLight) -> [DVec3; 4] {
-    let c = l.center;
-    [c - l.u - l.v, c + l.u - l.v, c + l.u + l.v, c - l.u + l.v]
 }
 
 /// A wedge vertex: a finite point or a direction at infinity (w = 0).
@@ -285,7 +279,7 @@ fn side_plane(at: DVec3, outward: DVec3, light: &WedgeLight) -> Option<HalfSpace
     let q = match light {
         WedgeLight::Rect(l) => {
             let mut best: Option<DVec2> = None;
-            for q in rect_corners(l) {
+            for q in l.corners() {
                 let p = DVec2::new((q - at).dot(t), (q - at).dot(g));
                 if p.y <= 0.0 {
                     return None;

@@ -296,6 +296,14 @@ pub fn quad_inner_halfspace(c: DVec3, a: DVec3, b: DVec3) -> HalfSpace {
     }
 }
 
+/// The box wedges are clipped to (module doc, "Finite wedges"): the scene's bounds enlarged
+/// by 1% of their diagonal plus 10⁻³.
+pub fn wedge_clip_box(scene: &crate::scene::Scene) -> (DVec3, DVec3) {
+    let (lo, hi) = scene.bounds();
+    let margin = (hi - lo).length() as f64 * 0.01 + 1e-3;
+    (lo.as_dvec3() - margin, hi.as_dvec3() + margin)
+}
+
 /// The inner (umbra side) and outer halves of the wedge of silhouette edge `a → b` for a light
 /// with center `c` and the given corners, clipped to the box `[lo, hi]`.
 pub fn wedge_halves(
@@ -306,15 +314,53 @@ pub fn wedge_halves(
     lo: DVec3,
     hi: DVec3,
 ) -> [ConvexPolyhedron; 2] {
+    wedge_halves_and_planes(c, corners, a, b, lo, hi).0
+}
+
+/// [`wedge_halves`] and the wedge's facet half-spaces ([`wedge_halfspaces`]) they were cut
+/// from.
+pub fn wedge_halves_and_planes(
+    c: DVec3,
+    corners: &[DVec3],
+    a: DVec3,
+    b: DVec3,
+    lo: DVec3,
+    hi: DVec3,
+) -> ([ConvexPolyhedron; 2], Vec<HalfSpace>) {
+    let planes = wedge_halfspaces(c, corners, a, b);
     let mut wedge = ConvexPolyhedron::aabb(lo, hi);
-    for h in wedge_halfspaces(c, corners, a, b) {
-        wedge = wedge.clip(&h);
+    for h in &planes {
+        wedge = wedge.clip(h);
         if wedge.is_empty() {
-            return [wedge.clone(), wedge];
+            return ([wedge.clone(), wedge], planes);
         }
     }
     let (inner, outer, _) = wedge.split(&quad_inner_halfspace(c, a, b));
-    [inner, outer]
+    ([inner, outer], planes)
+}
+
+/// The planes among `planes` that bound `half`: those holding at least three of its vertices
+/// (within 10⁻⁹ of the polyhedron's size) — the "outside bounding planes" of a half-wedge
+/// (Forest et al. 2006 §4.2, after Lengyel), without the planes of the clip box and the cut.
+pub fn bounding_planes(half: &ConvexPolyhedron, planes: &[HalfSpace]) -> Vec<HalfSpace> {
+    let size = half
+        .vertices()
+        .map(|v| v.abs().max_element())
+        .fold(1.0, f64::max);
+    planes
+        .iter()
+        .filter(|h| {
+            let mut on: Vec<DVec3> = half
+                .vertices()
+                .filter(|v| h.distance(**v).abs() <= 1e-9 * size)
+                .copied()
+                .collect();
+            on.sort_by(|a, b| (a.x, a.y, a.z).partial_cmp(&(b.x, b.y, b.z)).unwrap());
+            on.dedup();
+            on.len() >= 3
+        })
+        .copied()
+        .collect()
 }
 
 /// The whole wedge (not split), clipped to the box.

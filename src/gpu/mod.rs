@@ -5,7 +5,8 @@
 //! [`fixed`] (sub-pixel snapping), [`setup`] (edge functions, fill rule, facing, depth plane),
 //! [`tiling`] and [`raster`] (tile traversal, parallel draw), [`depth`] and [`stencil`]
 //! (fixed-function tests and ops), [`buffers`] (typed, counted per-tile storage and
-//! hierarchical Z), [`vbuffer`] (the V-buffer formats of Paper III §4), [`counters`].
+//! hierarchical Z), [`vbuffer`] (the V-buffer formats of Paper III §4), [`pack4ub`] (8-bit values
+//! packed into 32-bit float channels, Forest et al. 2006 §4.3), [`counters`].
 
 pub mod buffers;
 pub mod clip;
@@ -13,6 +14,7 @@ pub mod counters;
 pub mod depth;
 pub mod fixed;
 pub mod li_buffer;
+pub mod pack4ub;
 pub mod raster;
 pub mod setup;
 pub mod split_blend;

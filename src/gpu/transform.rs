@@ -110,6 +110,55 @@ impl Projection {
     }
 }
 
+/// A world-space plane carried into window coordinates: `f(x, y, z_w) = a·x + b·y + c·z_w + d`
+/// for pixel column `x`, row `y` (row 0 at the top; the pixel center is at +½, folded into
+/// `d`) and window depth `z_w`, with the sign of the world plane's equation at the point seen
+/// there (for points in front of the eye). This is the plane a vertex program hands a fragment
+/// program "transformed in viewport-space" (Forest et al. 2006 §4.2, Fig. 7).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WindowPlane {
+    /// Coefficient of the pixel column.
+    pub a: f64,
+    /// Coefficient of the pixel row.
+    pub b: f64,
+    /// Coefficient of the window depth.
+    pub c: f64,
+    /// Constant term (pixel centers included).
+    pub d: f64,
+}
+
+impl WindowPlane {
+    /// The plane's function at the center of pixel (`x`, `y`) and depth `z_w`.
+    pub fn at(&self, x: u32, y: u32, z_w: f64) -> f64 {
+        self.a * x as f64 + self.b * y as f64 + self.c * z_w + self.d
+    }
+
+    /// Whether the whole footprint of pixel (`x`, `y`) — the square of side 1 around its
+    /// center, at depth `z_w` — is on the positive side (Fig. 7: "the rasterized fragment is
+    /// rejected if its corresponding real-world fragment is outside any plane").
+    pub fn footprint_outside(&self, x: u32, y: u32, z_w: f64) -> bool {
+        self.at(x, y, z_w) - 0.5 * (self.a.abs() + self.b.abs()) > 0.0
+    }
+}
+
+impl Projection {
+    /// The world plane `normal · X − offset` in window coordinates ([`WindowPlane`]): the
+    /// plane in clip space is `(P·V)⁻ᵀ·(normal, −offset)`, and `x_ndc = (x + ½)·2/W − 1`,
+    /// `y_ndc = 1 − (y + ½)·2/H`, `z_ndc = 2·z_w − 1` (the viewport of [`Projection::unproject`]);
+    /// its value there is the world equation divided by the clip w, which is positive in front
+    /// of the eye.
+    pub fn window_plane(&self, normal: DVec3, offset: f64) -> WindowPlane {
+        let pc = self.inv_view_proj.transpose() * normal.extend(-offset);
+        let (w, h) = (self.width as f64, self.height as f64);
+        WindowPlane {
+            a: pc.x * 2.0 / w,
+            b: -pc.y * 2.0 / h,
+            c: 2.0 * pc.z,
+            d: pc.x * (1.0 / w - 1.0) + pc.y * (1.0 - 1.0 / h) - pc.z + pc.w,
+        }
+    }
+}
+
 fn round_clip(v: DVec4) -> ClipVertex {
     ClipVertex([v.x as f32, v.y as f32, v.z as f32, v.w as f32])
 }
@@ -131,6 +180,23 @@ pub fn viewport(v: ClipVertex, width: u32, height: u32) -> [f32; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn window_plane_has_the_sign_and_zero_of_the_world_plane() {
+        let proj = Projection::new(&cam(), 64, 48, 0.1);
+        let normal = DVec3::new(0.3, -0.5, 0.8).normalize();
+        let offset = 0.2;
+        let wp = proj.window_plane(normal, offset);
+        for (x, y, z) in [(3, 5, 0.97), (40, 20, 0.995), (63, 47, 0.9)] {
+            let p = proj.unproject(x, y, z);
+            let world = normal.dot(p) - offset;
+            let win = wp.at(x, y, z);
+            assert_eq!(world > 0.0, win > 0.0, "({x}, {y}, {z})");
+            // The ratio is 1/w_clip, the same for every plane at that point.
+            let h = proj.view_proj * p.extend(1.0);
+            assert!((win - world / h.w).abs() < 1e-9 * (1.0 + world.abs() / h.w));
+        }
+    }
 
     fn cam() -> Camera {
         Camera {

@@ -119,6 +119,18 @@ impl RectLight {
         self.center + local.x * self.u + local.y * self.v + local.z * self.normal
     }
 
+    /// The four corners, in order around the light: `(s, t)` = (−1, −1), (1, −1), (1, 1),
+    /// (−1, 1).
+    pub fn corners(&self) -> [DVec3; 4] {
+        let c = self.center;
+        [
+            c - self.u - self.v,
+            c + self.u - self.v,
+            c + self.u + self.v,
+            c - self.u + self.v,
+        ]
+    }
+
     /// The light's area `4·|u × v|`.
     pub fn area(&self) -> f64 {
         4.0 * self.u.cross(self.v).length()
@@ -192,6 +204,47 @@ pub fn projected_edge_in_light(
         return None;
     }
     Some([a.truncate() / a.z, b.truncate() / b.z])
+}
+
+/// The edge `e0 e1` projected from `p` onto the light plane, in light coordinates `(s, t)`,
+/// *not* clipped to the light square: the edge is clipped to the slab between the light plane
+/// and a **local near plane** parallel to it at `(1 − near_fraction)` of `p`'s distance from the
+/// light (Forest et al. 2006 §4.2, Fig. 9, after Lengyel: a point of the edge that does not
+/// lie between `p` and the light plane "cannot be projected onto the area light plane"; the
+/// near plane keeps the projection finite). The endpoints keep the edge's direction. `None`
+/// when nothing of the edge lies in the slab or `p` is in the light plane.
+///
+/// With `near_fraction = 0` this is the projection [`projected_edge_in_light`] clips; a
+/// positive fraction drops the part of the edge within `near_fraction·h_p` of `p`'s level,
+/// whose projection lies farther than `d / near_fraction` from the projection of `p` (`d` the
+/// edge's distance from `p` across the light normal), i.e. outside the light unless the edge
+/// passes that close to `p`.
+pub fn projected_edge_near_clipped(
+    light: &RectLight,
+    p: DVec3,
+    e0: DVec3,
+    e1: DVec3,
+    near_fraction: f64,
+) -> Option<[DVec2; 2]> {
+    let projection = ProjectionFromPoint::new(light, p)?;
+    let mut a = light.local(e0).extend(1.0);
+    let mut b = light.local(e1).extend(1.0);
+    let [far, _] = projection.slab_planes();
+    let near = DVec4::new(
+        0.0,
+        0.0,
+        -projection.flip,
+        projection.p.z * (1.0 - near_fraction),
+    );
+    for plane in [far, near] {
+        clip_segment(&mut a, &mut b, |x| plane.dot(x))?;
+    }
+    let (a, b) = (projection.apply(a), projection.apply(b));
+    if a.z <= 0.0 || b.z <= 0.0 {
+        return None;
+    }
+    let (a, b) = (a.truncate() / a.z, b.truncate() / b.z);
+    (a.is_finite() && b.is_finite()).then_some([a, b])
 }
 
 /// Unsigned coverage of the light square by the region beyond the segment `a b` (light

@@ -13,10 +13,14 @@
 //! - [`coverage_texture`]: the 4D coverage texture of Paper III §3.3 (grey and RGB for textured
 //!   lights), computed once per light shape and cached.
 //!
+//! - [`radial_parts`]: the light split into four radial parts and the occluded area and
+//!   bounding rectangle of one edge per part (Forest et al. 2006 §3.1, §4.2, §4.3).
+//!
 //! - [`lookup_tables`]: the lookup tables of Paper IV's optimized shaders (atan2 cube map, area
 //!   tables, split table) at the paper's sizes and bit depths (§4.2.1, §4.2.2, §4.3, §6).
 
 pub mod coverage;
 pub mod coverage_texture;
 pub mod lookup_tables;
+pub mod radial_parts;
 pub mod sampling;

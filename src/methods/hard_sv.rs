@@ -101,6 +101,28 @@ pub fn read_settings(
     ))
 }
 
+/// The two-sided stencil state that counts shadow-volume boundaries (module doc): z-pass
+/// increments on front faces passing the depth test and decrements on back faces; z-fail
+/// increments on back faces failing it and decrements on front faces; wrapping or saturating.
+pub fn volume_stencil_state(test: ShadowTest, overflow: StencilOverflow) -> StencilState {
+    let (incr, decr) = match overflow {
+        StencilOverflow::Wrap => (StencilOp::IncrWrap, StencilOp::DecrWrap),
+        StencilOverflow::Saturate => (StencilOp::Incr, StencilOp::Decr),
+    };
+    let keep = StencilOp::Keep;
+    // (front face, back face) ops for (depth fail, depth pass).
+    match test {
+        ShadowTest::ZPass => StencilState {
+            front: StencilFace::always(keep, incr),
+            back: StencilFace::always(keep, decr),
+        },
+        ShadowTest::ZFail => StencilState {
+            front: StencilFace::always(decr, keep),
+            back: StencilFace::always(incr, keep),
+        },
+    }
+}
+
 /// Render the hard shadow volumes of every mesh from light point `light` into a fresh 8-bit
 /// stencil buffer (tile-major) against the frame's depth buffer. Returns the stencil tiles and
 /// the counters (setup + rasterization).
@@ -115,22 +137,7 @@ pub fn stencil_shadow(
     };
     let meshes: Vec<_> = frame.scene.meshes.iter().zip(&frame.adjacency).collect();
     let prims = shadow_volume_triangles(&meshes, light, &frame.proj, capping);
-    let (incr, decr) = match s.overflow {
-        StencilOverflow::Wrap => (StencilOp::IncrWrap, StencilOp::DecrWrap),
-        StencilOverflow::Saturate => (StencilOp::Incr, StencilOp::Decr),
-    };
-    let keep = StencilOp::Keep;
-    // (front face, back face) ops for (depth fail, depth pass).
-    let state = match s.test {
-        ShadowTest::ZPass => StencilState {
-            front: StencilFace::always(keep, incr),
-            back: StencilFace::always(keep, decr),
-        },
-        ShadowTest::ZFail => StencilState {
-            front: StencilFace::always(decr, keep),
-            back: StencilFace::always(incr, keep),
-        },
-    };
+    let state = volume_stencil_state(s.test, s.overflow);
     let depth = DepthState {
         func: DepthFunc::Less,
         write: false,

@@ -13,6 +13,7 @@ pub mod pw_restructured;
 pub mod raycast;
 pub mod ssv;
 pub mod ssv_optimized;
+pub mod wedge_blending;
 
 use crate::error::InputError;
 use crate::frame::Frame;
@@ -31,6 +32,7 @@ pub const ALL: &[&str] = &[
     "pw-restructured",
     "ssv-optimized",
     "ssv",
+    "wedge-blending",
 ];
 
 /// The reference every other method's error is measured against.
@@ -77,6 +79,8 @@ pub fn supports(method: &str, shape: &LightShape) -> bool {
             shape,
             LightShape::Rect { .. } | LightShape::TexturedRect { .. } | LightShape::Sphere { .. }
         ),
+        // Forest et al. 2006 §4.2: rectangular lights, in light space [−1, 1]².
+        "wedge-blending" => matches!(shape, LightShape::Rect { .. }),
         _ => false,
     }
 }
@@ -142,6 +146,7 @@ fn run_one_light(method: &str, frame: &Frame) -> Result<MethodOutput, InputError
         "ssv" => ssv::run(frame),
         "pw2002" => pw2002::run(frame),
         "pw-restructured" => pw_restructured::run(frame),
+        "wedge-blending" => wedge_blending::run(frame),
         _ => Err(InputError::at(
             &frame.scene.source,
             "methods",
@@ -254,6 +259,7 @@ fn check_options_one_light(method: &str, frame: &Frame) -> Result<(), InputError
         "pw-restructured" => pw_restructured::read_settings(frame).map(drop),
         "ssv" => ssv::read_settings(frame).map(drop),
         "ssv-optimized" => ssv_optimized::options(frame).map(drop),
+        "wedge-blending" => wedge_blending::options(frame).map(drop),
         _ => Err(InputError::at(
             &frame.scene.source,
             "methods",

@@ -52,7 +52,7 @@ use super::hard_sv::{StencilShadowSettings, Submission};
 use super::options::OptionReader;
 use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
-use crate::frame::{setup_all, Frame, Receiver};
+use crate::frame::{setup_all, Frame, Receiver, FULL_SCREEN};
 use crate::geometry::shadow_volume::{shadow_volume_triangles, Capping};
 use crate::geometry::silhouette::{light_facing, possible_silhouettes};
 use crate::geometry::ssv_wedge::{SsvWedge, WedgeLight};
@@ -265,7 +265,7 @@ fn render_with<V: VBufferTile>(frame: &Frame, settings: &SsvSettings) -> SsvRend
     let t2 = Instant::now();
     let pass1_seconds = t2.duration_since(t1).as_secs_f64();
     let edges = edge_wedges(frame, &light);
-    let eye_radius = near_radius(frame);
+    let eye_radius = frame.near_plane_radius();
     let eye = scene.camera.eye;
     let mut prims: Vec<[ClipVertex; 3]> = Vec::new();
     let mut owner: Vec<u32> = Vec::new();
@@ -366,29 +366,6 @@ fn render_with<V: VBufferTile>(frame: &Frame, settings: &SsvSettings) -> SsvRend
         wedges: (edges.len(), full_screen),
         seconds: [pass1_seconds, t2.elapsed().as_secs_f64()],
     }
-}
-
-/// Two triangles covering the viewport (front-facing), for wedges drawn full-screen.
-const FULL_SCREEN: [[ClipVertex; 3]; 2] = [
-    [
-        ClipVertex([-1.0, -1.0, 0.0, 1.0]),
-        ClipVertex([1.0, -1.0, 0.0, 1.0]),
-        ClipVertex([1.0, 1.0, 0.0, 1.0]),
-    ],
-    [
-        ClipVertex([-1.0, -1.0, 0.0, 1.0]),
-        ClipVertex([1.0, 1.0, 0.0, 1.0]),
-        ClipVertex([-1.0, 1.0, 0.0, 1.0]),
-    ],
-];
-
-/// The distance from the eye to the corners of the near-plane rectangle.
-fn near_radius(frame: &Frame) -> f64 {
-    let cam = &frame.scene.camera;
-    let near = frame.proj.near;
-    let half_h = near * (cam.vfov_deg.to_radians() * 0.5).tan();
-    let half_w = half_h * frame.scene.width as f64 / frame.scene.height as f64;
-    (near * near + half_h * half_h + half_w * half_w).sqrt()
 }
 
 /// The possible silhouette edges of every mesh from the light center, in the submission order

@@ -65,9 +65,9 @@ use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, BACKGROUND};
 use crate::geometry::loops::silhouette_loops;
-use crate::geometry::shadow_volume::{shadow_volume_triangles, Capping};
-use crate::geometry::silhouette::{away_from_light, light_facing, possible_silhouettes};
-use crate::geometry::tight_wedge::{wedge_halves, whole_wedge, ConvexPolyhedron};
+use crate::geometry::shadow_volume::{shadow_volume_triangles, silhouette_quad, Capping};
+use crate::geometry::silhouette::{light_facing, possible_silhouettes};
+use crate::geometry::tight_wedge::{wedge_clip_box, wedge_halves, whole_wedge, ConvexPolyhedron};
 use crate::gpu::buffers::{alloc_tiles, StencilTile};
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
@@ -173,10 +173,7 @@ impl LightModel {
                 .collect()
         };
         match self {
-            LightModel::Rect(r) if tight => [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
-                .iter()
-                .map(|(s, t)| r.center + r.u * *s + r.v * *t)
-                .collect(),
+            LightModel::Rect(r) if tight => r.corners().to_vec(),
             LightModel::Rect(r) => cube(r.center, (r.u + r.v).length().max((r.u - r.v).length())),
             LightModel::Sphere { center, radius } => cube(*center, *radius),
         }
@@ -367,15 +364,6 @@ fn silhouettes(frame: &Frame, c: Vec3) -> Result<Vec<Vec<[DVec3; 2]>>, InputErro
     Ok(loops)
 }
 
-/// The hard shadow quad of one silhouette edge a → b from light point `c`, exactly as
-/// [`shadow_volume_triangles`] builds it: `(b, a, a∞)`, `(b, a∞, b∞)`.
-fn edge_quad(frame: &Frame, c: Vec3, e: &[DVec3; 2]) -> [[ClipVertex; 3]; 2] {
-    let (a, b) = (e[0].as_vec3(), e[1].as_vec3());
-    let near = |x: Vec3| frame.proj.clip_point(x);
-    let far = |x: Vec3| frame.proj.clip_direction(away_from_light(x, c));
-    [[near(b), near(a), far(a)], [near(b), far(a), far(b)]]
-}
-
 /// Render one group (pass 1 quads + the wedges of `edges`) for light piece `light` into a
 /// fresh split V-buffer; returns the resolved, clamped visibility per pixel (row-major) and the
 /// counters.
@@ -395,9 +383,7 @@ fn render_group(
         v: SplitVTile::cleared(full, len),
         stencil: StencilTile::cleared(0, len),
     });
-    let (lo, hi) = frame.scene.bounds();
-    let margin = (hi - lo).length() as f64 * 0.01 + 1e-3;
-    let (lo, hi) = (lo.as_dvec3() - margin, hi.as_dvec3() + margin);
+    let (lo, hi) = wedge_clip_box(frame.scene);
     let corners = light.corners(s.tight_wedges);
     let c = light.center();
 
@@ -634,7 +620,10 @@ fn piece_visibility(
     let mut covered = vec![0.0f32; frame.pixel_count()];
     let mut counters = Counters::default();
     for l in &loops {
-        let quads: Vec<[ClipVertex; 3]> = l.iter().flat_map(|e| edge_quad(frame, c, e)).collect();
+        let quads: Vec<[ClipVertex; 3]> = l
+            .iter()
+            .flat_map(|e| silhouette_quad(&frame.proj, c, e[0].as_vec3(), e[1].as_vec3()))
+            .collect();
         let (v, cnt) = render_group(frame, light, quads, l, s, receivers);
         counters += cnt;
         for (acc, v) in covered.iter_mut().zip(&v) {

@@ -1,0 +1,863 @@
+//! `wedge-blending`: realistic soft shadows by penumbra-wedges blending (Forest, Barthe &
+//! Paulin, Graphics Hardware 2006) for rectangular lights, in light space where the light is
+//! `[−1, 1]²` (§4.2).
+//!
+//! The penumbra-wedge methods add every silhouette's occlusion into one buffer, so where two
+//! silhouettes occlude the same part of the light it is counted twice (§3, Fig. 5). Forest et
+//! al. keep, per fragment and per radial part of the light, a bounding rectangle of the
+//! occluded region, and subtract an estimate of the overlap when a silhouette is blended into
+//! the result. Per silhouette, three passes (§4):
+//!
+//! 1. **Shadow volume** (§4.1): the silhouette's hard shadow quads from the light center into
+//!    an 8-bit stencil (two-sided, wrap; z-pass, or z-fail with caps when the eye is in shadow,
+//!    decided like `ssv`); then every shaded pixel's silhouette vBuffer is initialized to the
+//!    count in all four radial parts with the whole part as rectangle ([`PartState::hard`]).
+//! 2. **Penumbra wedges** (§4.2, §4.3): every edge's wedge (the tight wedge of a rectangular
+//!    light, [`crate::geometry::tight_wedge`]) split by the hard shadow quad's plane into an
+//!    inner and an outer half; the outer halves of all edges are drawn first, then the inner
+//!    halves ("First, we compute a rectangle that bounds the occluded light region defined by
+//!    the outer-half-wedges. Then we rasterize the inner-half-wedges"), each in edge order.
+//!    A half-wedge's front faces are rasterized; per fragment, in this order, each counted
+//!    when it rejects: the **depth test** of the face against the scene depth (for the half
+//!    behind the hard quad as seen from the eye the quad is one of these faces — the depth
+//!    test that rejects receivers "on the wrong side of the shadow-volume quadrilateral",
+//!    Fig. 8); the **outside bounding planes** of the half (its wedge planes other than the
+//!    quad's, [`bounding_planes`]) tested in viewport space against the pixel's footprint
+//!    (Fig. 7, [`WindowPlane::footprint_outside`]); and the **side of the hard quad** the
+//!    receiver is on (for the half in front of the quad, whose quad face is a back face), as
+//!    the exact sign `ssv` uses ([`quad_side`]). A receiver on the quad's plane belongs to
+//!    neither half (its coverage is 0). The shader then projects the edge with the local near
+//!    plane, clips it to the light and to each radial part
+//!    ([`edge_in_parts`]) and, per part the edge reaches, adds (outer) or subtracts (inner)
+//!    the occluded area and updates the rectangle or the maximum X and Y
+//!    ([`PartState::add_outer`], [`PartState::add_inner`]).
+//! 3. **Blend** (§3.2, §4.3): where the silhouette vBuffer holds anything, each part is
+//!    blended into the final vBuffer ([`blend::blend_part`]: ε = (A_f/B_f)(A_s/B_s)β only
+//!    where both occlusions are positive, the paper's dynamic branch). Then the silhouette
+//!    vBuffer and the stencil are cleared.
+//!
+//! Finally the visibility is `1 − (Σ parts' occlusion)/4` (the parts are the four equal
+//! quarters of the light), clamped to [0, 1]; the unclamped value is kept and the pixels the
+//! clamp changed are counted (`clamped_pixels`).
+//!
+//! Storage (`packing`, [`vbuffer`]): `8bit` — the paper's two 32-bit scalars per part packed
+//! with PK4UB into two RGBA32F targets per vBuffer, quantized and clamped at every write,
+//! through a `target` that keeps every bit (`raw`), flushes denormals
+//! (`flush-denormals`) or canonicalizes NaNs (`canonical-nans`); `f32` — the same algorithm
+//! unpacked. `centroid = on` adds the center of gravity of §6. `adjust` says where the inner
+//! rectangle adjustment of Fig. 10 applies (default `inner-penumbra`; [`blend`] module doc). `order = reverse` blends the
+//! silhouettes in the opposite order (the result depends on it). `silhouettes = loops`
+//! (default; the issue's and the paper's "silhouette": one connected silhouette loop from the
+//! light center, [`silhouette_loops`]) or `meshes` (all loops of one mesh in one silhouette
+//! vBuffer).
+//!
+//! Choices where the paper is silent:
+//! * **Order.** Meshes in scene order, within a mesh its loops in the order
+//!   [`silhouette_loops`] finds them (by their first edge in adjacency order); within a
+//!   silhouette, edges in loop order.
+//! * **z-fail per loop.** A loop alone has no caps; its volume is closed by a triangle fan
+//!   over the loop from its first vertex (front cap, towards the light) and the same fan at
+//!   infinity (back cap). The fan differs from the mesh's own caps only between the fan and the
+//!   mesh surface, inside a convex occluder; receivers there (on a concave occluder) can be
+//!   misclassified. With `silhouettes = meshes` the mesh's own caps are used.
+//! * **Only where the silhouette was drawn.** Per tile, a flag records whether any fragment of
+//!   the silhouette reached it; the initialization, blend and clear passes visit only those
+//!   tiles (a tile-level fast clear: the GPU of the paper would clear and blend the whole
+//!   screen, which changes only the traffic counts, not the result).
+//! * **Penumbra overlap map.** The raw image `penumbrae` counts, per pixel, the silhouettes
+//!   whose occlusion (mean over the parts) lies strictly between 0.5/255 and 1 − 0.5/255
+//!   there: where two or more overlap is where the blending matters.
+//! * Receiver points are the depth-buffer points (f32), as `ssv`'s, so that one silhouette
+//!   gives `ssv`'s result and the error against `raycast` is the method's own.
+
+pub mod blend;
+pub mod vbuffer;
+
+use super::hard_sv::{volume_stencil_state, ShadowTest, StencilOverflow};
+use super::options::OptionReader;
+use super::output::{MethodOutput, PassStats, RawImage8, Visibility};
+use crate::error::InputError;
+use crate::frame::{setup_all, Frame, FULL_SCREEN};
+use crate::geometry::loops::silhouette_loops;
+use crate::geometry::shadow_volume::{shadow_volume_triangles, silhouette_quad, Capping};
+use crate::geometry::silhouette::{away_from_light, light_facing, possible_silhouettes};
+use crate::geometry::tight_wedge::{bounding_planes, wedge_clip_box, wedge_halves_and_planes};
+use crate::gpu::buffers::{alloc_tiles, StencilTile};
+use crate::gpu::counters::Counters;
+use crate::gpu::depth::{DepthFunc, DepthState};
+use crate::gpu::pack4ub::{FloatTarget, StoreEvents};
+use crate::gpu::raster::{bin, draw, no_tile_culling};
+use crate::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
+use crate::gpu::tiling::Tiling;
+use crate::gpu::transform::{ClipVertex, WindowPlane};
+use crate::light::coverage::{quad_side, RectLight};
+use crate::light::radial_parts::{edge_in_parts, PART_COUNT};
+use crate::plan::{eye_in_shadow, BufferPlan, MethodPlan};
+use crate::scene::LightShape;
+use blend::{blend_part, BlendCase, InnerAdjust, PartState, Rules};
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+use std::time::Instant;
+use vbuffer::{Packed8, PixelParts, UnpackedF32, VBufferStorage};
+
+/// How the vBuffers store a pixel (module doc, [`vbuffer`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum Packing {
+    /// PK4UB-packed 8-bit values in two RGBA32F targets (§4.3).
+    Bit8,
+    /// Unpacked f32 values.
+    F32,
+}
+
+/// What one silhouette vBuffer holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum Grouping {
+    /// One connected silhouette loop.
+    Loops,
+    /// All loops of one mesh.
+    Meshes,
+}
+
+/// All settings of one `wedge-blending` render.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct Settings {
+    /// vBuffer storage.
+    pub packing: Packing,
+    /// How the RGBA32F targets store packed patterns (8-bit packing only).
+    pub target: FloatTarget,
+    /// Center of gravity per part (§6).
+    pub centroid: bool,
+    /// Where the inner adjustment of Fig. 10 applies ([`blend`] module doc).
+    pub adjust: InnerAdjust,
+    /// Blend the silhouettes in reverse order.
+    pub reverse: bool,
+    /// Silhouette grouping.
+    pub grouping: Grouping,
+    /// z-pass or z-fail for the shadow-volume passes.
+    pub test: ShadowTest,
+}
+
+/// Read and check `[options.wedge-blending]`: `packing = 8bit|f32`,
+/// `target = raw|flush-denormals|canonical-nans`, `centroid = off|on`,
+/// `adjust = inner-penumbra|every-fragment`,
+/// `order = forward|reverse`, `silhouettes = loops|meshes`, `mode = auto|zpass|zfail`.
+pub fn options(frame: &Frame) -> Result<(Settings, &'static str), InputError> {
+    let scene = frame.scene;
+    let mut r = OptionReader::new(scene, "wedge-blending");
+    let packing = match r.choice("packing", &["8bit", "f32"], "8bit")? {
+        "f32" => Packing::F32,
+        _ => Packing::Bit8,
+    };
+    let target_name = r.choice(
+        "target",
+        &["raw", "flush-denormals", "canonical-nans"],
+        "raw",
+    )?;
+    let target = match target_name {
+        "flush-denormals" => FloatTarget::FlushDenormals,
+        "canonical-nans" => FloatTarget::CanonicalNans,
+        _ => FloatTarget::Raw,
+    };
+    let centroid = r.choice("centroid", &["off", "on"], "off")? == "on";
+    let adjust = match r.choice(
+        "adjust",
+        &["inner-penumbra", "every-fragment"],
+        "inner-penumbra",
+    )? {
+        "every-fragment" => InnerAdjust::EveryFragment,
+        _ => InnerAdjust::InnerPenumbra,
+    };
+    let reverse = r.choice("order", &["forward", "reverse"], "forward")? == "reverse";
+    let grouping = match r.choice("silhouettes", &["loops", "meshes"], "loops")? {
+        "meshes" => Grouping::Meshes,
+        _ => Grouping::Loops,
+    };
+    let mode = r.choice("mode", &["auto", "zpass", "zfail"], "auto")?;
+    r.finish()?;
+    if packing == Packing::F32 && target != FloatTarget::Raw {
+        return Err(InputError::at(
+            &scene.source,
+            "options.wedge-blending.target",
+            format!(
+                "target = \"{target_name}\" describes how RGBA32F targets store packed 8-bit \
+                 values; it needs packing = \"8bit\""
+            ),
+        ));
+    }
+    if !matches!(scene.light().shape, LightShape::Rect { .. }) {
+        return Err(InputError::at(
+            &scene.source,
+            "light",
+            "wedge-blending supports rect lights (Forest et al. 2006 §4.2)",
+        ));
+    }
+    let center = scene.light().center;
+    let test = match mode {
+        "zpass" => ShadowTest::ZPass,
+        "zfail" => ShadowTest::ZFail,
+        _ if eye_in_shadow(scene, frame.proj.near, &[center]) => ShadowTest::ZFail,
+        _ => ShadowTest::ZPass,
+    };
+    Ok((
+        Settings {
+            packing,
+            target,
+            centroid,
+            adjust,
+            reverse,
+            grouping,
+            test,
+        },
+        mode,
+    ))
+}
+
+/// One silhouette: its edges `a → b` (oriented as in their light-facing triangles) and its
+/// hard shadow volume (quads, plus caps for z-fail) in submission order.
+#[derive(Debug, Clone)]
+pub struct Silhouette {
+    /// Index of the mesh it belongs to.
+    pub mesh: usize,
+    /// Its edges, in loop order.
+    pub edges: Vec<[DVec3; 2]>,
+    /// Its shadow-volume triangles in clip space.
+    pub volume: Vec<[ClipVertex; 3]>,
+}
+
+/// The silhouettes of `frame`'s scene from the light center, in blending order (module doc).
+pub fn silhouettes(frame: &Frame, s: &Settings) -> Result<Vec<Silhouette>, InputError> {
+    let c = frame.scene.light().center;
+    let proj = &frame.proj;
+    let capping = match s.test {
+        ShadowTest::ZPass => Capping::Open,
+        ShadowTest::ZFail => Capping::Capped,
+    };
+    let mut out = Vec::new();
+    for (mi, (mesh, adj)) in frame.scene.meshes.iter().zip(&frame.adjacency).enumerate() {
+        let facing = light_facing(mesh, c);
+        let edges = possible_silhouettes(mesh, adj, &facing);
+        let loops = silhouette_loops(&edges)
+            .map_err(|e| InputError::at(&frame.scene.source, format!("meshes[{mi}]"), e))?;
+        let edge_of = |k: usize| [edges[k].a, edges[k].b];
+        match s.grouping {
+            Grouping::Meshes if !edges.is_empty() => out.push(Silhouette {
+                mesh: mi,
+                edges: loops
+                    .iter()
+                    .flatten()
+                    .map(|&k| edge_of(k).map(|v| v.as_dvec3()))
+                    .collect(),
+                volume: shadow_volume_triangles(&[(mesh, adj)], c, proj, capping),
+            }),
+            Grouping::Meshes => {}
+            Grouping::Loops => {
+                for l in &loops {
+                    let ends: Vec<[Vec3; 2]> = l.iter().map(|&k| edge_of(k)).collect();
+                    out.push(Silhouette {
+                        mesh: mi,
+                        edges: ends.iter().map(|e| e.map(|v| v.as_dvec3())).collect(),
+                        volume: loop_volume(proj, c, &ends, capping),
+                    });
+                }
+            }
+        }
+    }
+    if s.reverse {
+        out.reverse();
+    }
+    Ok(out)
+}
+
+/// The shadow volume of one loop (module doc, "z-fail per loop"): its quads, and with caps the
+/// fan over the loop from its first vertex and the reversed fan at infinity.
+fn loop_volume(
+    proj: &crate::gpu::transform::Projection,
+    c: Vec3,
+    ends: &[[Vec3; 2]],
+    capping: Capping,
+) -> Vec<[ClipVertex; 3]> {
+    let quads = ends
+        .iter()
+        .flat_map(|[a, b]| silhouette_quad(proj, c, *a, *b));
+    if capping == Capping::Open {
+        return quads.collect();
+    }
+    let near = |v: Vec3| proj.clip_point(v);
+    let far = |v: Vec3| proj.clip_direction(away_from_light(v, c));
+    let v0 = ends[0][0];
+    let fan: Vec<[Vec3; 2]> = ends[1..ends.len().saturating_sub(1)].to_vec();
+    let front = fan.iter().map(|[a, b]| [near(v0), near(*a), near(*b)]);
+    let back = fan.iter().map(|[a, b]| [far(v0), far(*b), far(*a)]);
+    front.chain(quads).chain(back).collect()
+}
+
+/// Work and rejection counts of the method (module doc), next to the traffic [`Counters`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct BlendingCounters {
+    /// Silhouettes processed.
+    pub silhouettes: u64,
+    /// Half-wedges drawn, and how many of them full-screen (eye within reach).
+    pub half_wedges: u64,
+    /// Half-wedges drawn as a full-screen quad.
+    pub half_wedges_full_screen: u64,
+    /// Half-wedge fragments rejected by the depth test (Fig. 8).
+    pub rejected_depth: u64,
+    /// Rejected by the outside bounding planes in viewport space (Fig. 7).
+    pub rejected_outside_planes: u64,
+    /// Rejected for lying on the other side of the hard quad (or on its plane).
+    pub rejected_quad_side: u64,
+    /// Fragments that passed every test but whose edge reaches no part of the light.
+    pub missed_light: u64,
+    /// (fragment, part) updates: the dynamic branch of §4.3 taken.
+    pub part_updates: u64,
+    /// Pixels where the blend pass read the final vBuffer.
+    pub blended_pixels: u64,
+    /// Parts copied into an empty final part.
+    pub parts_copied: u64,
+    /// Parts blended with ε (both occlusions positive).
+    pub parts_blended: u64,
+    /// Of those, parts where ε > 0 (an overlap was corrected).
+    pub parts_corrected: u64,
+    /// Parts added without ε (a negative occlusion, unpacked only).
+    pub parts_accumulated: u64,
+    /// Blended parts whose occlusion exceeded 1 and was limited to it ([`blend_part`]).
+    pub parts_limited: u64,
+    /// Occlusion values PK4UB clamped to [0, 1] at a write.
+    pub packing_clamps: u64,
+    /// Special float patterns written to the RGBA32F targets.
+    pub stores: StoreEvents,
+    /// Pixels whose resolved visibility was outside [0, 1] before the final clamp.
+    pub clamped_pixels: u64,
+}
+
+impl std::ops::AddAssign for BlendingCounters {
+    fn add_assign(&mut self, o: Self) {
+        self.silhouettes += o.silhouettes;
+        self.half_wedges += o.half_wedges;
+        self.half_wedges_full_screen += o.half_wedges_full_screen;
+        self.rejected_depth += o.rejected_depth;
+        self.rejected_outside_planes += o.rejected_outside_planes;
+        self.rejected_quad_side += o.rejected_quad_side;
+        self.missed_light += o.missed_light;
+        self.part_updates += o.part_updates;
+        self.blended_pixels += o.blended_pixels;
+        self.parts_copied += o.parts_copied;
+        self.parts_blended += o.parts_blended;
+        self.parts_corrected += o.parts_corrected;
+        self.parts_accumulated += o.parts_accumulated;
+        self.parts_limited += o.parts_limited;
+        self.packing_clamps += o.packing_clamps;
+        self.stores += o.stores;
+        self.clamped_pixels += o.clamped_pixels;
+    }
+}
+
+/// The passes of the method, in the order of [`BlendingRender::passes`].
+pub const PASS_NAMES: [&str; 5] = [
+    "wb-shadow-volumes",
+    "wb-init",
+    "wb-half-wedges",
+    "wb-blend",
+    "wb-resolve",
+];
+
+/// The result of one render.
+#[derive(Debug, Clone)]
+pub struct BlendingRender {
+    /// Visibility per pixel, row-major, clamped to [0, 1]; background 1.
+    pub visibility: Vec<f32>,
+    /// The visibility before the final clamp (background 1).
+    pub unclamped: Vec<f32>,
+    /// Per pixel, the number of silhouettes in whose penumbra it lies (module doc).
+    pub penumbrae: Vec<u8>,
+    /// Counters and wall seconds of each pass of [`PASS_NAMES`], summed over silhouettes.
+    pub passes: [(Counters, f64); 5],
+    /// Method counters.
+    pub counters: BlendingCounters,
+    /// The blend steps at the probed pixel ([`render_probed`]), in blending order.
+    pub trace: Vec<ProbeStep>,
+}
+
+/// One silhouette blended at a probed pixel: the values the blend pass read and wrote there.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ProbeStep {
+    /// Index of the silhouette in blending order.
+    pub silhouette: usize,
+    /// The mesh it belongs to.
+    pub mesh: usize,
+    /// The silhouette vBuffer's parts after the half-wedges (as unpacked).
+    pub silhouette_parts: PixelParts,
+    /// The final vBuffer's parts before the blend.
+    pub before: PixelParts,
+    /// And after.
+    pub after: PixelParts,
+    /// ε per part (0 where the part was not blended).
+    pub eps: [f32; PART_COUNT],
+}
+
+/// Per-tile storage.
+struct BlendTile<P> {
+    trace: Vec<ProbeStep>,
+    stencil: StencilTile,
+    silhouette: Vec<P>,
+    last: Vec<P>,
+    penumbrae: Vec<u8>,
+    /// Whether the current silhouette reached the tile.
+    dirty: bool,
+    counters: BlendingCounters,
+}
+
+/// One half-wedge to draw.
+struct HalfJob {
+    /// Index of the edge in the silhouette.
+    edge: usize,
+    /// The inner (umbra side) half.
+    inner: bool,
+    /// Its outside bounding planes in window coordinates.
+    planes: Vec<WindowPlane>,
+    /// Drawn as a full-screen quad (no depth test of its faces).
+    full_screen: bool,
+}
+
+/// Render `wedge-blending` on `frame` with settings `s`.
+pub fn render(frame: &Frame, s: &Settings) -> Result<BlendingRender, InputError> {
+    render_probed(frame, s, None)
+}
+
+/// [`render`], also recording every blend step at pixel `probe` = (column, row) in
+/// [`BlendingRender::trace`].
+pub fn render_probed(
+    frame: &Frame,
+    s: &Settings,
+    probe: Option<(u32, u32)>,
+) -> Result<BlendingRender, InputError> {
+    let probe = probe.map(|(x, y)| (y * frame.scene.width + x) as usize);
+    let silhouettes = silhouettes(frame, s)?;
+    Ok(match s.packing {
+        Packing::Bit8 => render_with(
+            frame,
+            s,
+            &silhouettes,
+            &Packed8 {
+                target: s.target,
+                centroid: s.centroid,
+            },
+            probe,
+        ),
+        Packing::F32 => render_with(
+            frame,
+            s,
+            &silhouettes,
+            &UnpackedF32 {
+                centroid: s.centroid,
+            },
+            probe,
+        ),
+    })
+}
+
+/// Visit the pixels of tile `t` inside the image: (tile-local index, row-major index).
+fn tile_pixels(tiling: &Tiling, t: usize, mut visit: impl FnMut(usize, usize)) {
+    let r = tiling.rect(t);
+    for y in r.y0..r.y1 {
+        for x in r.x0..r.x1 {
+            visit(tiling.local(x, y), (y * tiling.width + x) as usize);
+        }
+    }
+}
+
+/// Sum per-tile counters.
+fn sum_counters(parts: impl ParallelIterator<Item = Counters>) -> Counters {
+    parts.reduce(Counters::default, |mut a, b| {
+        a += b;
+        a
+    })
+}
+
+fn render_with<S: VBufferStorage>(
+    frame: &Frame,
+    s: &Settings,
+    silhouettes: &[Silhouette],
+    storage: &S,
+    probe: Option<usize>,
+) -> BlendingRender {
+    let tiling = &frame.tiling;
+    let light = RectLight::from_light(frame.scene.light()).expect("options checked a rect light");
+    let c = light.center;
+    let corners = light.corners();
+    let (lo, hi) = wedge_clip_box(frame.scene);
+    let receivers = frame.receivers();
+    let eye = frame.scene.camera.eye;
+    let eye_radius = frame.near_plane_radius();
+    let (sil_bytes, fin_bytes) = (storage.silhouette_bytes(), storage.final_bytes());
+    let cleared = storage.cleared();
+    let mut tiles = alloc_tiles(tiling, |_, len| BlendTile {
+        trace: Vec::new(),
+        stencil: StencilTile::cleared(0, len),
+        silhouette: vec![cleared; len],
+        last: vec![cleared; len],
+        penumbrae: vec![0; len],
+        dirty: false,
+        counters: BlendingCounters::default(),
+    });
+    let mut passes = [(Counters::default(), 0.0f64); 5];
+    let mut counters = BlendingCounters::default();
+    let less = DepthState {
+        func: DepthFunc::Less,
+        write: false,
+    };
+    let stencil_state = volume_stencil_state(s.test, StencilOverflow::Wrap);
+    let rules = Rules {
+        adjust: s.adjust,
+        centroid: s.centroid,
+    };
+
+    for (si, sil) in silhouettes.iter().enumerate() {
+        counters.silhouettes += 1;
+        // Pass 1: the shadow volume into the stencil.
+        let t0 = Instant::now();
+        let (tris, mut c1) = setup_all(&sil.volume, CullMode::None, tiling);
+        let bins = bin(tiling, &tris);
+        c1 += draw(
+            tiling,
+            &mut tiles,
+            &tris,
+            &bins,
+            no_tile_culling,
+            |t, tile, tri, f, cnt| {
+                let (pass, _) = frame.tiles[t].depth.test(&less, &f, cnt);
+                cnt.depth_passed += pass as u64;
+                tile.stencil
+                    .apply(&stencil_state, tri.front_facing, &f, pass, cnt);
+                tile.dirty = true;
+            },
+        );
+        passes[0].0 += c1;
+        passes[0].1 += t0.elapsed().as_secs_f64();
+
+        // Initialization: shaded pixels get the hard count in every part.
+        let t0 = Instant::now();
+        passes[1].0 += sum_counters(tiles.par_iter_mut().enumerate().map(|(t, tile)| {
+            let mut cnt = Counters::default();
+            if !tile.dirty {
+                return cnt;
+            }
+            tile_pixels(tiling, t, |i, _| {
+                cnt.stencil_read_bytes += 1;
+                let count = tile.stencil.values[i] as i8 as i32;
+                if count != 0 {
+                    let (px, clamps) = storage.store(
+                        &[PartState::hard(count); PART_COUNT],
+                        &mut tile.counters.stores,
+                    );
+                    tile.silhouette[i] = px;
+                    tile.counters.packing_clamps += clamps;
+                    cnt.color_write_bytes += sil_bytes;
+                }
+            });
+            cnt
+        }));
+        passes[1].1 += t0.elapsed().as_secs_f64();
+
+        // Pass 2: outer halves of every edge, then inner halves.
+        let t0 = Instant::now();
+        let mut jobs: Vec<HalfJob> = Vec::new();
+        let mut prims: Vec<[ClipVertex; 3]> = Vec::new();
+        let mut owner: Vec<u32> = Vec::new();
+        let mut culls: Vec<CullMode> = Vec::new();
+        let mut halves = Vec::with_capacity(sil.edges.len());
+        for [a, b] in &sil.edges {
+            halves.push(wedge_halves_and_planes(c, &corners, *a, *b, lo, hi));
+        }
+        for inner in [false, true] {
+            for (k, (pair, planes)) in halves.iter().enumerate() {
+                let half = &pair[if inner { 0 } else { 1 }];
+                if half.is_empty() {
+                    continue;
+                }
+                let full_screen = half.contains(eye, eye_radius);
+                let job = jobs.len() as u32;
+                jobs.push(HalfJob {
+                    edge: k,
+                    inner,
+                    planes: bounding_planes(half, planes)
+                        .iter()
+                        .map(|h| frame.proj.window_plane(h.normal, h.offset))
+                        .collect(),
+                    full_screen,
+                });
+                if full_screen {
+                    for f in FULL_SCREEN {
+                        prims.push(f);
+                        owner.push(job);
+                        culls.push(CullMode::None);
+                    }
+                    continue;
+                }
+                for face in &half.faces {
+                    for i in 1..face.len() - 1 {
+                        prims.push(
+                            [face[0], face[i], face[i + 1]]
+                                .map(|x| frame.proj.clip_point(x.as_vec3())),
+                        );
+                        owner.push(job);
+                        culls.push(CullMode::Back);
+                    }
+                }
+            }
+        }
+        counters.half_wedges += jobs.len() as u64;
+        counters.half_wedges_full_screen += jobs.iter().filter(|j| j.full_screen).count() as u64;
+        let mut c2 = Counters::default();
+        let mut tris: Vec<RasterTriangle> = Vec::new();
+        for (k, p) in prims.iter().enumerate() {
+            setup_triangle(
+                p,
+                k as u32,
+                culls[k],
+                tiling.width,
+                tiling.height,
+                &mut tris,
+                &mut c2,
+            );
+        }
+        let bins = bin(tiling, &tris);
+        c2 += draw(
+            tiling,
+            &mut tiles,
+            &tris,
+            &bins,
+            no_tile_culling,
+            |t, tile, tri, f, cnt| {
+                let job = &jobs[owner[tri.prim as usize] as usize];
+                let depth = &frame.tiles[t].depth;
+                let stored = if job.full_screen {
+                    depth.read(f.local, cnt)
+                } else {
+                    let (pass, _) = depth.test(&less, &f, cnt);
+                    if !pass {
+                        tile.counters.rejected_depth += 1;
+                        return;
+                    }
+                    cnt.depth_passed += 1;
+                    depth.values[f.local]
+                };
+                let Some(rcv) = receivers[(f.y * tiling.width + f.x) as usize] else {
+                    return;
+                };
+                let z_w = frame.gpu.depth.to_window(stored);
+                if job
+                    .planes
+                    .iter()
+                    .any(|pl| pl.footprint_outside(f.x, f.y, z_w))
+                {
+                    tile.counters.rejected_outside_planes += 1;
+                    return;
+                }
+                let p = rcv.point.as_dvec3();
+                let [a, b] = sil.edges[job.edge];
+                // ssv's sign: positive on the umbra side of the quad (b, a, a∞).
+                let side = quad_side(c, p, b, a);
+                if side == 0.0 || (side > 0.0) != job.inner {
+                    tile.counters.rejected_quad_side += 1;
+                    return;
+                }
+                cnt.fragments_shaded += 1;
+                tile.dirty = true;
+                let regions = edge_in_parts(&light, p, a, b);
+                if regions.iter().all(Option::is_none) {
+                    tile.counters.missed_light += 1;
+                    return;
+                }
+                cnt.color_read_bytes += sil_bytes;
+                let mut parts = storage.load(&tile.silhouette[f.local]);
+                for (part, region) in parts.iter_mut().zip(&regions) {
+                    let Some(r) = region else { continue };
+                    tile.counters.part_updates += 1;
+                    if job.inner {
+                        part.add_inner(r);
+                    } else {
+                        part.add_outer(r);
+                    }
+                }
+                let (px, clamps) = storage.store(&parts, &mut tile.counters.stores);
+                tile.silhouette[f.local] = px;
+                tile.counters.packing_clamps += clamps;
+                cnt.color_write_bytes += sil_bytes;
+            },
+        );
+        passes[2].0 += c2;
+        passes[2].1 += t0.elapsed().as_secs_f64();
+
+        // Pass 3: blend into the final vBuffer, then clear the silhouette vBuffer and stencil.
+        let t0 = Instant::now();
+        passes[3].0 += sum_counters(tiles.par_iter_mut().enumerate().map(|(t, tile)| {
+            let mut cnt = Counters::default();
+            if !tile.dirty {
+                return cnt;
+            }
+            tile_pixels(tiling, t, |i, g| {
+                cnt.color_read_bytes += sil_bytes;
+                let sp = storage.load(&tile.silhouette[i]);
+                if sp.iter().all(|p| p.occlusion == 0.0) {
+                    return;
+                }
+                let mean = sp.iter().map(|p| p.occlusion).sum::<f32>() / PART_COUNT as f32;
+                if mean > 0.5 / 255.0 && mean < 1.0 - 0.5 / 255.0 {
+                    tile.penumbrae[i] = tile.penumbrae[i].saturating_add(1);
+                }
+                tile.counters.blended_pixels += 1;
+                cnt.color_read_bytes += fin_bytes;
+                let mut fp = storage.load(&tile.last[i]);
+                let before = fp;
+                let mut eps = [0.0; PART_COUNT];
+                for (k, (f, sp)) in fp.iter_mut().zip(&sp).enumerate() {
+                    let (out, o) = blend_part(f, sp, rules);
+                    *f = out;
+                    eps[k] = o.eps;
+                    let k = &mut tile.counters;
+                    k.parts_limited += o.limited as u64;
+                    match o.case {
+                        BlendCase::Skipped => {}
+                        BlendCase::Copied => k.parts_copied += 1,
+                        BlendCase::Blended => {
+                            k.parts_blended += 1;
+                            k.parts_corrected += (o.eps > 0.0) as u64;
+                        }
+                        BlendCase::Accumulated => k.parts_accumulated += 1,
+                    }
+                }
+                let (px, clamps) = storage.store(&fp, &mut tile.counters.stores);
+                tile.last[i] = px;
+                if probe == Some(g) {
+                    tile.trace.push(ProbeStep {
+                        silhouette: si,
+                        mesh: sil.mesh,
+                        silhouette_parts: sp,
+                        before,
+                        after: storage.load(&px),
+                        eps,
+                    });
+                }
+                tile.counters.packing_clamps += clamps;
+                cnt.color_write_bytes += fin_bytes;
+            });
+            let r = tiling.rect(t);
+            let pixels = ((r.x1 - r.x0) * (r.y1 - r.y0)) as u64;
+            tile.silhouette.fill(cleared);
+            tile.stencil.values.fill(0);
+            cnt.color_write_bytes += pixels * sil_bytes;
+            cnt.stencil_write_bytes += pixels;
+            tile.dirty = false;
+            cnt
+        }));
+        passes[3].1 += t0.elapsed().as_secs_f64();
+    }
+
+    // Resolve.
+    let t0 = Instant::now();
+    let n = frame.pixel_count();
+    let mut unclamped = vec![1.0f32; n];
+    let mut penumbrae = vec![0u8; n];
+    let mut resolve = Counters::default();
+    let mut trace = Vec::new();
+    for (t, tile) in tiles.iter_mut().enumerate() {
+        counters += tile.counters;
+        trace.append(&mut tile.trace);
+        tile_pixels(tiling, t, |i, g| {
+            penumbrae[g] = tile.penumbrae[i];
+            if receivers[g].is_none() {
+                return;
+            }
+            resolve.color_read_bytes += fin_bytes;
+            let parts = storage.load(&tile.last[i]);
+            let occluded = parts.iter().map(|p| p.occlusion).sum::<f32>() * 0.25;
+            unclamped[g] = 1.0 - occluded;
+        });
+    }
+    let visibility: Vec<f32> = unclamped.iter().map(|v| v.clamp(0.0, 1.0)).collect();
+    counters.clamped_pixels = unclamped
+        .iter()
+        .zip(&visibility)
+        .filter(|(u, v)| u != v)
+        .count() as u64;
+    passes[4] = (resolve, t0.elapsed().as_secs_f64());
+    BlendingRender {
+        visibility,
+        unclamped,
+        penumbrae,
+        passes,
+        counters,
+        trace,
+    }
+}
+
+/// Run `wedge-blending` on a rendered frame.
+pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
+    let start = Instant::now();
+    let (s, mode) = options(frame)?;
+    let r = render(frame, &s)?;
+    let runs = r.counters.silhouettes;
+    let mut passes = vec![frame.pass.clone()];
+    for (name, (counters, seconds)) in PASS_NAMES.iter().zip(r.passes) {
+        passes.push(PassStats {
+            name: name.to_string(),
+            wall_seconds: seconds,
+            runs: if *name == "wb-resolve" { 1 } else { runs },
+            counters,
+        });
+    }
+    let (sil_bytes, fin_bytes, format) = match s.packing {
+        Packing::Bit8 => {
+            let st = Packed8 {
+                target: s.target,
+                centroid: s.centroid,
+            };
+            (st.silhouette_bytes(), st.final_bytes(), st.describe())
+        }
+        Packing::F32 => {
+            let st = UnpackedF32 {
+                centroid: s.centroid,
+            };
+            (st.silhouette_bytes(), st.final_bytes(), st.describe())
+        }
+    };
+    let buffers = vec![
+        BufferPlan::depth(&frame.gpu),
+        BufferPlan::stencil8(),
+        BufferPlan {
+            name: "silhouette-vbuffer".into(),
+            format: format.clone(),
+            bytes_per_sample: sil_bytes as u32,
+        },
+        BufferPlan {
+            name: "final-vbuffer".into(),
+            format,
+            bytes_per_sample: fin_bytes as u32,
+        },
+    ];
+    let footprint: u64 = buffers
+        .iter()
+        .map(|b| b.bytes_per_sample as u64 * frame.pixel_count() as u64)
+        .sum();
+    let plan = MethodPlan {
+        method: "wedge-blending".into(),
+        passes: passes.iter().map(|p| p.name.clone()).collect(),
+        buffers,
+        settings: serde_json::json!({
+            "mode": mode,
+            "resolved": s,
+            "gpu": frame.gpu,
+            "buffer_bytes": footprint,
+            "counters": r.counters,
+        }),
+    };
+    Ok(MethodOutput {
+        visibility: Visibility::Gray(r.visibility),
+        raw_images: vec![RawImage8 {
+            name: "penumbrae".into(),
+            values: r.penumbrae,
+        }],
+        stats: super::method_stats("wedge-blending", frame, start, &plan, passes),
+    })
+}
