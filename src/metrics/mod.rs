@@ -24,6 +24,8 @@ pub struct ErrorStats {
     pub mean_abs: f64,
     /// Percentage (0–100) of pixels with `|a − b| > 1/255` in some channel.
     pub pct_over_1_255: f64,
+    /// Percentage (0–100) of pixels with `|a − b| > 4/255` in some channel.
+    pub pct_over_4_255: f64,
     /// Number of pixels compared.
     pub pixels: u64,
 }
@@ -59,6 +61,15 @@ fn pixel_pairs(a: &Visibility, b: &Visibility, i: usize) -> ([f32; 3], [f32; 3],
 /// # Panics
 /// If the buffers have different pixel counts (a caller bug: both come from one render size).
 pub fn compare(a: &Visibility, b: &Visibility) -> ErrorStats {
+    compare_where(a, b, |_| true)
+}
+
+/// [`compare`] over the pixels `i` with `keep(i)` only (e.g. where penumbrae overlap);
+/// `pixels` counts them.
+///
+/// # Panics
+/// As [`compare`].
+pub fn compare_where(a: &Visibility, b: &Visibility, keep: impl Fn(usize) -> bool) -> ErrorStats {
     assert_eq!(
         a.len(),
         b.len(),
@@ -66,15 +77,18 @@ pub fn compare(a: &Visibility, b: &Visibility) -> ErrorStats {
         a.len(),
         b.len()
     );
-    let n = a.len();
+    let mut n = 0usize;
     let mut sum_sq = 0.0f64;
     let mut sum_abs = 0.0f64;
     let mut max_abs = 0.0f64;
     let mut samples = 0u64;
     let mut over = 0u64;
-    for i in 0..n {
+    let mut over4 = 0u64;
+    for i in (0..a.len()).filter(|i| keep(*i)) {
+        n += 1;
         let (ca, cb, k) = pixel_pairs(a, b, i);
         let mut off = false;
+        let mut off4 = false;
         for c in 0..k {
             let d = sample_diff(ca[c], cb[c]).abs();
             sum_sq += d * d;
@@ -86,9 +100,11 @@ pub fn compare(a: &Visibility, b: &Visibility) -> ErrorStats {
                 }
             }
             off |= d.is_nan() || d > ONE_8BIT_STEP;
+            off4 |= d.is_nan() || d > 4.0 * ONE_8BIT_STEP;
             samples += 1;
         }
         over += u64::from(off);
+        over4 += u64::from(off4);
     }
     if n == 0 {
         return ErrorStats {
@@ -96,6 +112,7 @@ pub fn compare(a: &Visibility, b: &Visibility) -> ErrorStats {
             max_abs: 0.0,
             mean_abs: 0.0,
             pct_over_1_255: 0.0,
+            pct_over_4_255: 0.0,
             pixels: 0,
         };
     }
@@ -104,6 +121,7 @@ pub fn compare(a: &Visibility, b: &Visibility) -> ErrorStats {
         max_abs,
         mean_abs: sum_abs / samples as f64,
         pct_over_1_255: 100.0 * over as f64 / n as f64,
+        pct_over_4_255: 100.0 * over4 as f64 / n as f64,
         pixels: n as u64,
     }
 }
@@ -199,6 +217,7 @@ mod tests {
                 max_abs: 0.0,
                 mean_abs: 0.0,
                 pct_over_1_255: 0.0,
+                pct_over_4_255: 0.0,
                 pixels: 4
             }
         );
@@ -214,6 +233,19 @@ mod tests {
         assert_eq!(s.mean_abs, 0.75 / 4.0);
         assert_eq!(s.rmse, ((0.25 + 0.0625) / 4.0f64).sqrt());
         assert_eq!(s.pct_over_1_255, 50.0);
+        assert_eq!(s.pct_over_4_255, 50.0);
+    }
+
+    #[test]
+    fn masked_comparison_counts_only_kept_pixels() {
+        let a = gray(&[0.0, 0.5, 1.0, 0.25]);
+        let b = gray(&[0.5, 0.5, 0.99, 0.25]);
+        let s = compare_where(&a, &b, |i| i >= 1);
+        assert_eq!(s.pixels, 3);
+        assert!((s.max_abs - 0.01).abs() < 1e-6);
+        // 0.01 is over 1/255 but not over 4/255.
+        assert!((s.pct_over_1_255 - 100.0 / 3.0).abs() < 1e-9);
+        assert_eq!(s.pct_over_4_255, 0.0);
     }
 
     #[test]

@@ -16,6 +16,8 @@
 //! | `pw-fractal` | Paper II Fig. 10 analogue: closed 24×24 midpoint-displacement landscape | sphere r 0.4 | 1440 |
 //! | `pw-2002` | Paper II Fig. 11 analogue: "2002" in seven-segment boxes at y = 0.9 | sphere r 0.25 | 276 |
 //! | `two-lights` | Paper I Fig. 16 analogue: the `cylinder` occluder and a box | two spheres r 0.3, 0.25 | 120 |
+//! | `forest-spheres` | Forest et al. 2006 Fig. 1: 3×3×3 spheres of 760 triangles (20 stacks × 20 slices), r 0.2, spacing 0.45 | rect ½-extents 0.6 | 20532 |
+//! | `forest-spheres-1`, `-4`, `-9` | the cost series of Fig. 12: 1 sphere, 2×2 and 3×3 in one layer | as `forest-spheres` | 772, 3052, 6852 |
 
 use super::procedural::{box_mesh, cylinder, two_sided_quad, uv_sphere};
 use super::{Camera, Light, LightShape, Mesh, RawOptions, Scene};
@@ -36,6 +38,10 @@ const NAMES: &[&str] = &[
     "pw-fractal",
     "pw-2002",
     "two-lights",
+    "forest-spheres",
+    "forest-spheres-1",
+    "forest-spheres-4",
+    "forest-spheres-9",
 ];
 
 /// Names of all built-in scenes.
@@ -56,6 +62,10 @@ pub fn load(name: &str) -> Option<Scene> {
         "pw-fractal" => pw_fractal(),
         "pw-2002" => pw_2002(),
         "two-lights" => two_lights(),
+        "forest-spheres" => forest_spheres([3, 3, 3]),
+        "forest-spheres-1" => forest_spheres([1, 1, 1]),
+        "forest-spheres-4" => forest_spheres([2, 1, 2]),
+        "forest-spheres-9" => forest_spheres([3, 1, 3]),
         _ => return None,
     };
     Some(Scene {
@@ -236,6 +246,33 @@ fn overlap_stress() -> Scene {
         Light {
             center: Vec3::new(0.0, 4.0, 0.0),
             shape: LightShape::Point,
+        },
+        meshes,
+    )
+}
+
+/// Forest, Barthe & Paulin 2006 Fig. 1 and §5.2: spheres of 760 triangles ("each sphere is
+/// discretized by 762 triangles"; 20 stacks × 20 slices is the nearest UV sphere) in a grid of
+/// `n = [x, y, z]` spheres centered above the floor under a rectangular light, so that their
+/// penumbrae overlap everywhere on the floor. `[3, 3, 3]` is the cube of the figure; fewer
+/// spheres give the cost series of Fig. 12 (same light, camera and spacing).
+fn forest_spheres(n: [u32; 3]) -> Scene {
+    let mut meshes = vec![floor([-4.0, 4.0], [-4.0, 4.0])];
+    let offset = |k: u32, count: u32| 0.45 * (k as f32 - 0.5 * (count - 1) as f32);
+    for i in 0..n[0] {
+        for j in 0..n[1] {
+            for k in 0..n[2] {
+                let c = Vec3::new(offset(i, n[0]), 1.2 + offset(j, n[1]), offset(k, n[2]));
+                let name = format!("sphere[{i},{j},{k}]");
+                meshes.push(uv_sphere(&name, c, 0.2, 20, 20, OCCLUDER));
+            }
+        }
+    }
+    scene(
+        camera([2.2, 3.0, 4.2], [-0.25, 0.4, -0.1], 50.0),
+        Light {
+            center: Vec3::new(0.3, 4.0, 0.2),
+            shape: rect(0.6),
         },
         meshes,
     )
