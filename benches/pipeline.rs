@@ -7,7 +7,10 @@
 //!   center ([`stencil_shadow`]) against a frame rendered once up front;
 //! * `method/nsample-n16`: the `nsample` method with `n = 16` (16 stencil passes and their
 //!   accumulation) on that frame;
-//! * `method/raycast-samples16`: the `raycast` reference with `samples = 16` on that frame.
+//! * `method/raycast-samples16`: the `raycast` reference with `samples = 16` on that frame;
+//! * `method/ssv`, `method/wedge-blending-8bit`, `method/wedge-blending-f32`: the soft shadow
+//!   volumes of Paper III and penumbra-wedges blending (Forest et al. 2006, packed and
+//!   unpacked) side by side on that frame.
 //!
 //! The method benchmarks run [`penumbra::methods::run`] on a prebuilt frame, so they exclude
 //! the depth pass (measured on its own) and the shading of the image.
@@ -84,11 +87,29 @@ fn pipeline(c: &mut Criterion) {
     let mut group = c.benchmark_group("method");
     group.sampling_mode(SamplingMode::Flat);
     group.measurement_time(Duration::from_secs(5));
-    for (name, method) in [("nsample-n16", "nsample"), ("raycast-samples16", "raycast")] {
+    for (name, method) in [
+        ("nsample-n16", "nsample"),
+        ("raycast-samples16", "raycast"),
+        ("ssv", "ssv"),
+        ("wedge-blending-8bit", "wedge-blending"),
+    ] {
         group.bench_function(name, |b| {
             b.iter(|| penumbra::methods::run(black_box(method), black_box(&frame)).expect(method))
         });
     }
+    let mut unpacked = scene.clone();
+    unpacked
+        .options
+        .entry("wedge-blending".into())
+        .or_default()
+        .insert("packing".into(), OptionValue::Str("f32".into()));
+    let unpacked_frame = frame.lit_by(&unpacked);
+    group.bench_function("wedge-blending-f32", |b| {
+        b.iter(|| {
+            penumbra::methods::run("wedge-blending", black_box(&unpacked_frame))
+                .expect("wedge-blending")
+        })
+    });
     group.finish();
 }
 

@@ -29,16 +29,21 @@ enum Cmd {
     Render(RenderArgs),
     /// Print the built-in scenes and the methods, one per line.
     List,
-    /// Run an experiment (Paper II §7): `experiment tile-size SCENE [--out DIR]`.
+    /// Run an experiment: `tile-size SCENE` (Paper II §7, sphere light) or
+    /// `wedge-blending [SCENE]` (Forest et al. 2006: error and time of the overlap
+    /// correction; default scenes cube-of-spheres and forest-spheres).
     Experiment {
-        /// The experiment: `tile-size`.
-        #[arg(value_parser = ["tile-size"])]
+        /// The experiment: `tile-size` or `wedge-blending`.
+        #[arg(value_parser = ["tile-size", "wedge-blending"])]
         name: String,
-        /// Scene file or built-in name (sphere light).
-        scene: String,
-        /// Output directory for the CSV and the SVG plot.
+        /// Scene file or built-in name (required for tile-size).
+        scene: Option<String>,
+        /// Output directory for the CSV files, plots and summary.
         #[arg(long, default_value = "out/experiment")]
         out: PathBuf,
+        /// Image side for wedge-blending (errors at SIZE², times at SIZE² and (2·SIZE)²).
+        #[arg(long, default_value_t = 256)]
+        size: u32,
     },
     /// Check (or with --bless rewrite) the golden outputs under golden/.
     Golden {
@@ -156,12 +161,53 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
             })
         }
         Some(Cmd::Experiment {
-            name: _,
+            name,
             scene,
             out,
+            size,
         }) => {
-            let scene = file::resolve(&scene)?;
-            validate::validate(&scene)?;
+            let scene = scene.map(|s| file::resolve(&s)).transpose()?;
+            if let Some(s) = &scene {
+                validate::validate(s)?;
+            }
+            if name == "wedge-blending" {
+                let scenes = match scene {
+                    Some(s) => vec![s],
+                    None => penumbra::experiment::wedge_blending::SCENES
+                        .iter()
+                        .map(|n| builtin::load(n).ok_or("missing built-in scene"))
+                        .collect::<Result<_, _>>()?,
+                };
+                if let Some(bad) = scenes.iter().find(|s| {
+                    !penumbra::methods::supports_scene("wedge-blending", s) || s.is_multi_light()
+                }) {
+                    return Err(InputError::at(
+                        &bad.source,
+                        "light",
+                        "the wedge-blending experiment needs one rect light",
+                    )
+                    .into());
+                }
+                if !(16..=2048).contains(&size) {
+                    return Err(InputError::at("--size", "size", "expected 16…2048").into());
+                }
+                print!(
+                    "{}",
+                    penumbra::experiment::wedge_blending::run(&scenes, size, &out)?
+                );
+                println!(
+                    "outputs: {0}/wedge_blending_errors.csv, {0}/wedge_blending_times.csv, {0}/summary.md",
+                    out.display()
+                );
+                return Ok(());
+            }
+            let scene = scene.ok_or_else(|| {
+                InputError::at(
+                    "experiment",
+                    "scene",
+                    "tile-size needs a SCENE (sphere light)",
+                )
+            })?;
             print!("{}", penumbra::experiment::tile_size::run(&scene, &out)?);
             println!(
                 "outputs: {0}/tile_size.csv, {0}/tile_size.svg",

@@ -79,12 +79,15 @@ pub fn eye_in_shadow(scene: &Scene, near: f64, lights: &[Vec3]) -> bool {
 /// Whether the open segment p→q crosses any scene triangle (exact f64 test, used for the
 /// z-fail decision and as hard-shadow ground truth in tests).
 pub fn segment_blocked(scene: &Scene, p: DVec3, q: DVec3) -> bool {
+    scene.meshes.iter().any(|m| segment_hits_mesh(m, p, q))
+}
+
+/// Whether the open segment p→q crosses a triangle of `mesh` (exact f64 test).
+pub fn segment_hits_mesh(mesh: &crate::scene::Mesh, p: DVec3, q: DVec3) -> bool {
     let d = q - p;
-    scene.meshes.iter().any(|m| {
-        m.triangles.iter().any(|t| {
-            let [a, b, c] = t.map(|i| m.positions[i as usize].as_dvec3());
-            segment_hits_triangle(p, d, a, b, c)
-        })
+    mesh.triangles.iter().any(|t| {
+        let [a, b, c] = t.map(|i| mesh.positions[i as usize].as_dvec3());
+        segment_hits_triangle(p, d, a, b, c)
     })
 }
 

@@ -8,15 +8,22 @@ use penumbra::frame::{Frame, GpuSettings};
 use penumbra::scene::{builtin, OptionValue};
 use std::path::Path;
 
+/// `[options.wedge-blending]` of one case.
+type Options = &'static [(&'static str, &'static str)];
+
 /// (scene, variant name, options).
-const CASES: &[(&str, &str, &[(&str, &str)])] = &[
+const CASES: &[(&str, &str, Options)] = &[
     ("forest-spheres", "packed", &[]),
     ("forest-spheres", "f32", &[("packing", "f32")]),
     ("cube-of-spheres", "f32", &[("packing", "f32")]),
     ("cube-of-spheres", "centroid", &[("centroid", "on")]),
     ("cube-of-spheres", "adjust-always", &[("adjust", "always")]),
     ("cube-of-spheres", "reverse", &[("order", "reverse")]),
-    ("cube-of-spheres", "flush-denormals", &[("target", "flush-denormals")]),
+    (
+        "cube-of-spheres",
+        "flush-denormals",
+        &[("target", "flush-denormals")],
+    ),
 ];
 
 #[test]

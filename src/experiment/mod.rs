@@ -2,3 +2,4 @@
 //! CSV, plots).
 
 pub mod tile_size;
+pub mod wedge_blending;
