@@ -222,6 +222,23 @@ fn bad_options_and_methods() {
             &["--methods", "hard-sv", "--opt", "hard-sv.bogus=1"],
             &["unknown option"],
         ),
+        (
+            "wedge-blending packing",
+            &["--methods", "wedge-blending", "--opt", "wedge-blending.packing=4bit"],
+            &["wedge-blending.packing", "8bit, f32"],
+        ),
+        (
+            "wedge-blending target without packing",
+            &[
+                "--methods",
+                "wedge-blending",
+                "--opt",
+                "wedge-blending.packing=f32",
+                "--opt",
+                "wedge-blending.target=flush-denormals",
+            ],
+            &["wedge-blending.target", "8bit"],
+        ),
     ];
     for (what, args, keywords) in cases {
         let all: Vec<&str> = [&[scene][..], &small, args].concat();
