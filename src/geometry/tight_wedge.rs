@@ -305,20 +305,8 @@ pub fn wedge_clip_box(scene: &crate::scene::Scene) -> (DVec3, DVec3) {
 }
 
 /// The inner (umbra side) and outer halves of the wedge of silhouette edge `a → b` for a light
-/// with center `c` and the given corners, clipped to the box `[lo, hi]`.
-pub fn wedge_halves(
-    c: DVec3,
-    corners: &[DVec3],
-    a: DVec3,
-    b: DVec3,
-    lo: DVec3,
-    hi: DVec3,
-) -> [ConvexPolyhedron; 2] {
-    wedge_halves_and_planes(c, corners, a, b, lo, hi).0
-}
-
-/// [`wedge_halves`] and the wedge's facet half-spaces ([`wedge_halfspaces`]) they were cut
-/// from.
+/// with center `c` and the given corners, clipped to the box `[lo, hi]`, and the wedge's facet
+/// half-spaces ([`wedge_halfspaces`]) they were cut from.
 pub fn wedge_halves_and_planes(
     c: DVec3,
     corners: &[DVec3],
@@ -415,7 +403,8 @@ mod tests {
         let c = DVec3::new(0.0, 3.0, 0.0);
         let corners = square(c, 0.5);
         let (a, b) = (DVec3::new(-0.5, 1.0, 0.0), DVec3::new(0.5, 1.0, 0.0));
-        let [inner, outer] = wedge_halves(c, &corners, a, b, DVec3::splat(-4.0), DVec3::splat(4.0));
+        let [inner, outer] =
+            wedge_halves_and_planes(c, &corners, a, b, DVec3::splat(-4.0), DVec3::splat(4.0)).0;
         let ic = inner.faces.last().unwrap();
         let oc = outer.faces.last().unwrap();
         assert_eq!(ic[0], oc[0]);

@@ -85,20 +85,25 @@ pub fn read_settings(
         "two-sided" => Submission::TwoSided,
         _ => Submission::TwoPass,
     };
-    let test = match mode {
-        "zpass" => ShadowTest::ZPass,
-        "zfail" => ShadowTest::ZFail,
-        _ if eye_in_shadow(frame.scene, frame.proj.near, lights) => ShadowTest::ZFail,
-        _ => ShadowTest::ZPass,
-    };
     Ok((
         StencilShadowSettings {
-            test,
+            test: shadow_test(mode, frame, lights),
             overflow,
             submission,
         },
         mode,
     ))
+}
+
+/// The counting direction a `mode = auto|zpass|zfail` option asks for: `auto` picks z-fail
+/// when the eye (or any point of the near plane) is in the shadow of one of `lights`.
+pub fn shadow_test(mode: &str, frame: &Frame, lights: &[Vec3]) -> ShadowTest {
+    match mode {
+        "zpass" => ShadowTest::ZPass,
+        "zfail" => ShadowTest::ZFail,
+        _ if eye_in_shadow(frame.scene, frame.proj.near, lights) => ShadowTest::ZFail,
+        _ => ShadowTest::ZPass,
+    }
 }
 
 /// The two-sided stencil state that counts shadow-volume boundaries (module doc): z-pass

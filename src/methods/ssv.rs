@@ -47,7 +47,7 @@
 //! * Final visibility: the resolved V-buffer clamped to [0, 1] (overlapping occluders can
 //!   drive the Green's sum below 0, §5.3 "object overlap artifact"); background pixels are 1.
 
-use super::hard_sv::{stencil_row_major, stencil_shadow, ShadowTest, StencilOverflow};
+use super::hard_sv::{shadow_test, stencil_row_major, stencil_shadow, ShadowTest, StencilOverflow};
 use super::hard_sv::{StencilShadowSettings, Submission};
 use super::options::OptionReader;
 use super::output::{MethodOutput, PassStats, Visibility};
@@ -70,7 +70,7 @@ use crate::light::coverage::{
 use crate::light::coverage_texture::{
     coverage_texture, CoverageFilter, CoverageTexture, CoverageTextureKey, DEFAULT_N, MAX_N, MIN_N,
 };
-use crate::plan::{eye_in_shadow, BufferPlan, MethodPlan};
+use crate::plan::{BufferPlan, MethodPlan};
 use crate::scene::LightShape;
 use glam::DVec3;
 use std::sync::Arc;
@@ -150,13 +150,7 @@ pub fn read_settings(frame: &Frame) -> Result<(SsvSettings, &'static str), Input
             "textured lights need the RGB f32 V-buffer (vbuffer = \"f32\"); f16 and 8bit are grey",
         ));
     }
-    let center = scene.light().center;
-    let test = match mode {
-        "zpass" => ShadowTest::ZPass,
-        "zfail" => ShadowTest::ZFail,
-        _ if eye_in_shadow(scene, frame.proj.near, &[center]) => ShadowTest::ZFail,
-        _ => ShadowTest::ZPass,
-    };
+    let test = shadow_test(mode, frame, &[scene.light().center]);
     let coverage = match coverage {
         "exact" => CoverageMode::Exact,
         _ => CoverageMode::Texture { n, filter },

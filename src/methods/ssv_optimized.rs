@@ -67,7 +67,9 @@ use crate::frame::{setup_all, Frame, BACKGROUND};
 use crate::geometry::loops::silhouette_loops;
 use crate::geometry::shadow_volume::{shadow_volume_triangles, silhouette_quad, Capping};
 use crate::geometry::silhouette::{light_facing, possible_silhouettes};
-use crate::geometry::tight_wedge::{wedge_clip_box, wedge_halves, whole_wedge, ConvexPolyhedron};
+use crate::geometry::tight_wedge::{
+    wedge_clip_box, wedge_halves_and_planes, whole_wedge, ConvexPolyhedron,
+};
 use crate::gpu::buffers::{alloc_tiles, StencilTile};
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
@@ -392,7 +394,7 @@ fn render_group(
     for e in edges {
         match s.split {
             HalfSplit::Stencil => {
-                let [inner, outer] = wedge_halves(c, &corners, e[0], e[1], lo, hi);
+                let [inner, outer] = wedge_halves_and_planes(c, &corners, e[0], e[1], lo, hi).0;
                 for (shape, target) in [(inner, SplitTarget::Add), (outer, SplitTarget::Sub)] {
                     if !shape.is_empty() {
                         jobs.push(HalfJob {

@@ -85,7 +85,7 @@
 pub mod blend;
 pub mod vbuffer;
 
-use super::hard_sv::{volume_stencil_state, ShadowTest, StencilOverflow};
+use super::hard_sv::{shadow_test, volume_stencil_state, ShadowTest, StencilOverflow};
 use super::options::OptionReader;
 use super::output::{MethodOutput, PassStats, RawImage8, Visibility};
 use crate::error::InputError;
@@ -106,7 +106,7 @@ use crate::gpu::tiling::Tiling;
 use crate::gpu::transform::{ClipVertex, WindowPlane};
 use crate::light::coverage::{quad_side, RectLight};
 use crate::light::radial_parts::{edge_in_parts, PART_COUNT};
-use crate::plan::{eye_in_shadow, BufferPlan, MethodPlan};
+use crate::plan::{BufferPlan, MethodPlan};
 use crate::scene::LightShape;
 use blend::{blend_part, BlendCase, InnerAdjust, PartState, Rules};
 use glam::DVec3;
@@ -202,13 +202,7 @@ pub fn options(frame: &Frame) -> Result<(Settings, &'static str), InputError> {
             "wedge-blending supports rect lights (Forest et al. 2006 §4.2)",
         ));
     }
-    let center = scene.light().center;
-    let test = match mode {
-        "zpass" => ShadowTest::ZPass,
-        "zfail" => ShadowTest::ZFail,
-        _ if eye_in_shadow(scene, frame.proj.near, &[center]) => ShadowTest::ZFail,
-        _ => ShadowTest::ZPass,
-    };
+    let test = shadow_test(mode, frame, &[scene.light().center]);
     Ok((
         Settings {
             packing,
@@ -468,12 +462,26 @@ fn tile_pixels(tiling: &Tiling, t: usize, mut visit: impl FnMut(usize, usize)) {
     }
 }
 
-/// Sum per-tile counters.
-fn sum_counters(parts: impl ParallelIterator<Item = Counters>) -> Counters {
-    parts.reduce(Counters::default, |mut a, b| {
-        a += b;
-        a
-    })
+/// Run `pass` on every tile the current silhouette reached (in parallel; the tile's pixels
+/// in order), with the tile index and a counter set each; returns the counters summed.
+fn on_dirty_tiles<P: Send>(
+    tiles: &mut [BlendTile<P>],
+    pass: impl Fn(usize, &mut BlendTile<P>, &mut Counters) + Sync,
+) -> Counters {
+    tiles
+        .par_iter_mut()
+        .enumerate()
+        .map(|(t, tile)| {
+            let mut cnt = Counters::default();
+            if tile.dirty {
+                pass(t, tile, &mut cnt);
+            }
+            cnt
+        })
+        .reduce(Counters::default, |mut a, b| {
+            a += b;
+            a
+        })
 }
 
 fn render_with<S: VBufferStorage>(
@@ -539,11 +547,7 @@ fn render_with<S: VBufferStorage>(
 
         // Initialization: shaded pixels get the hard count in every part.
         let t0 = Instant::now();
-        passes[1].0 += sum_counters(tiles.par_iter_mut().enumerate().map(|(t, tile)| {
-            let mut cnt = Counters::default();
-            if !tile.dirty {
-                return cnt;
-            }
+        passes[1].0 += on_dirty_tiles(&mut tiles, |t, tile, cnt| {
             tile_pixels(tiling, t, |i, _| {
                 cnt.stencil_read_bytes += 1;
                 let count = tile.stencil.values[i] as i8 as i32;
@@ -557,8 +561,7 @@ fn render_with<S: VBufferStorage>(
                     cnt.color_write_bytes += sil_bytes;
                 }
             });
-            cnt
-        }));
+        });
         passes[1].1 += t0.elapsed().as_secs_f64();
 
         // Pass 2: outer halves of every edge, then inner halves.
@@ -707,11 +710,7 @@ fn render_with<S: VBufferStorage>(
 
         // Pass 3: blend into the final vBuffer, then clear the silhouette vBuffer and stencil.
         let t0 = Instant::now();
-        passes[3].0 += sum_counters(tiles.par_iter_mut().enumerate().map(|(t, tile)| {
-            let mut cnt = Counters::default();
-            if !tile.dirty {
-                return cnt;
-            }
+        passes[3].0 += on_dirty_tiles(&mut tiles, |t, tile, cnt| {
             tile_pixels(tiling, t, |i, g| {
                 cnt.color_read_bytes += sil_bytes;
                 let sp = storage.load(&tile.silhouette[i]);
@@ -765,8 +764,7 @@ fn render_with<S: VBufferStorage>(
             cnt.color_write_bytes += pixels * sil_bytes;
             cnt.stencil_write_bytes += pixels;
             tile.dirty = false;
-            cnt
-        }));
+        });
         passes[3].1 += t0.elapsed().as_secs_f64();
     }
 
