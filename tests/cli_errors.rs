@@ -224,7 +224,12 @@ fn bad_options_and_methods() {
         ),
         (
             "wedge-blending packing",
-            &["--methods", "wedge-blending", "--opt", "wedge-blending.packing=4bit"],
+            &[
+                "--methods",
+                "wedge-blending",
+                "--opt",
+                "wedge-blending.packing=4bit",
+            ],
             &["wedge-blending.packing", "8bit, f32"],
         ),
         (

@@ -1,6 +1,7 @@
 //! Rasterizer properties (DESIGN.md "Tests"): a quad split into two triangles covers every
 //! pixel of its interior exactly once — no gaps, no double hits — for random quads, both
-//! diagonals, random tile sizes, including vertices off screen and at sub-pixel positions.
+//! diagonals, random tile sizes, including vertices off screen and at sub-pixel positions; the
+//! single-pixel coverage query agrees with the traversal.
 
 use penumbra::gpu::counters::Counters;
 use penumbra::gpu::raster::{bin, draw, no_tile_culling};
@@ -101,6 +102,24 @@ proptest! {
                 if let Some(inside) = strictly_inside(&q, i, j) {
                     prop_assert_eq!(n == 1, inside, "pixel ({},{}) coverage {} inside {}", i, j, n, inside);
                 }
+            }
+        }
+    }
+
+    /// `RasterTriangle::covers` (the single-pixel query) is exactly the set of samples the
+    /// tile traversal visits.
+    #[test]
+    fn single_pixel_coverage_matches_traversal(q in convex_quad(), w in 0.5f32..3.0) {
+        let v: Vec<ClipVertex> = q.iter().map(|p| ClipVertex([p[0] * w, p[1] * w, 0.0, w])).collect();
+        let tri = [v[0], v[1], v[2]];
+        let counts = hits(&[tri], 8);
+        let mut setup = Vec::new();
+        let mut c = Counters::default();
+        setup_triangle(&tri, 0, CullMode::None, W, H, &mut setup, &mut c);
+        for j in 0..H {
+            for i in 0..W {
+                let covered = setup.iter().filter(|t| t.covers(i, j)).count() as u32;
+                prop_assert_eq!(covered, counts[(j * W + i) as usize], "pixel ({},{})", i, j);
             }
         }
     }

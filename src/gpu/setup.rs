@@ -72,6 +72,16 @@ pub struct RasterTriangle {
 }
 
 impl RasterTriangle {
+    /// Whether the sample of pixel (i, j) is covered: inside the bounding box and on the
+    /// inner side of all three edge functions (fill rule included) — exactly the samples
+    /// [`super::raster::rasterize_in_tile`] visits.
+    pub fn covers(&self, i: u32, j: u32) -> bool {
+        let [x0, y0, x1, y1] = self.bbox;
+        (x0..=x1).contains(&i)
+            && (y0..=y1).contains(&j)
+            && self.edges.iter().all(|e| e.at(i as i64, j as i64) >= 0)
+    }
+
     /// Interpolated window depth at the sample of pixel (i, j): the plane evaluated in f64,
     /// rounded once to f32 (not yet clamped; the depth format clamps).
     #[inline]

@@ -23,12 +23,20 @@
 //!    (its wedge planes other than the quad's, [`bounding_planes`]) tested in viewport space
 //!    against the pixel's footprint (Fig. 7, [`WindowPlane::footprint_outside`]); and the
 //!    **side of the hard quad** the receiver is on — "the wrong side of the shadow-volume
-//!    quadrilateral" of Fig. 8 — as the exact sign `ssv` uses ([`quad_side`]), one test for
-//!    both halves. The face of a half that lies in the quad's plane is therefore drawn without
-//!    the depth test: depth-testing it as well puts a receiver within one depth step of the
-//!    quad in neither half or in both (measured before this rule: half the light lost at such
-//!    pixels of `torus-hole-rect`, where the quad passes through the receiver's depth step).
-//!    A receiver on the quad's plane belongs to neither half (its coverage is 0).
+//!    quadrilateral" of Fig. 8 — one test for both halves (`HardQuad::side`): where the quad
+//!    covers the pixel it is the shadow-volume pass's own depth test of the quad against the
+//!    receiver (the quad in front of the receiver puts it on the other side of the plane from
+//!    the eye), so the half a receiver falls in agrees with its stencil count bit for bit;
+//!    elsewhere the exact sign `ssv` uses ([`quad_side`]) — the coverage is continuous across
+//!    the plane outside the quad. Where the two disagree, the shader evaluates the edge at the
+//!    receiver mirrored across the plane, onto the side the stencil counted. (With the plane's
+//!    sign everywhere, as `ssv` does, a receiver within one depth step of a quad is counted in
+//!    the hard shadow by the stencil and on the lit side by the half-wedges, or the reverse,
+//!    and half the light is added or lost: single pixels off by 0.2–0.5 along hard-shadow
+//!    boundaries on `forest-spheres`.) The face of a
+//!    half that lies in the quad's plane is drawn without the depth test, which would decide
+//!    the same question a second time with the face's own depths. A receiver on the quad's
+//!    plane belongs to neither half (its coverage is 0).
 //!    The shader then projects the edge with the local near
 //!    plane, clips it to the light and to each radial part
 //!    ([`edge_in_parts`]) and, per part the edge reaches, adds (outer) or subtracts (inner)
@@ -404,6 +412,81 @@ struct HalfJob {
     full_screen: bool,
 }
 
+/// The hard shadow quad of one silhouette edge as the shadow-volume pass rasterized it, for
+/// the "wrong side of the shadow-volume quadrilateral" test of Fig. 8 (module doc).
+struct HardQuad {
+    /// Its raster triangles (the same vertices, setup and fill rule as the stencil pass).
+    tris: Vec<RasterTriangle>,
+    /// The side of its plane the eye is on ([`quad_side`]'s sign).
+    eye_side: f64,
+    /// The light center and the edge `a → b`.
+    c: DVec3,
+    edge: [DVec3; 2],
+}
+
+impl HardQuad {
+    fn new(frame: &Frame, a: DVec3, b: DVec3) -> Self {
+        let c = frame.scene.light().center;
+        let mut tris = Vec::new();
+        let mut ignored = Counters::default();
+        for (k, t) in silhouette_quad(&frame.proj, c, a.as_vec3(), b.as_vec3())
+            .iter()
+            .enumerate()
+        {
+            let (w, h) = (frame.tiling.width, frame.tiling.height);
+            setup_triangle(t, k as u32, CullMode::None, w, h, &mut tris, &mut ignored);
+        }
+        let c = c.as_dvec3();
+        HardQuad {
+            tris,
+            eye_side: quad_side(c, frame.scene.camera.eye, b, a),
+            c,
+            edge: [a, b],
+        }
+    }
+
+    /// The side of the quad receiver `p` (seen at pixel (`x`, `y`) with stored depth
+    /// `stored`) is on, `ssv`'s sign ([`quad_side`]: positive on the umbra side), and the point
+    /// the shader evaluates the edge at. Where the quad covers the pixel the side is decided by
+    /// the shadow-volume pass's own depth test — the quad in front of the receiver puts it on
+    /// the other side of the plane from the eye — so that the half a receiver falls in always
+    /// agrees with its stencil count; elsewhere (and with the eye in the plane) by the sign of
+    /// the plane equation in f64. Where the depth test and the plane equation disagree (the
+    /// receiver is within a depth step of the plane), the shader evaluates the edge at the
+    /// receiver mirrored across the plane (moved off it by 10⁻⁹ of its distance from the
+    /// light center if it lies in it), so that the region it adds or subtracts is the one of
+    /// the side the stencil counted: otherwise it would take the region beyond the edge of the
+    /// other side — its complement within the light — and be off by up to the whole light.
+    fn side(&self, x: u32, y: u32, stored: u32, p: DVec3, frame: &Frame) -> (f64, DVec3) {
+        let [a, b] = self.edge;
+        let exact = quad_side(self.c, p, b, a);
+        if self.eye_side == 0.0 {
+            return (exact, p);
+        }
+        let Some(t) = self.tris.iter().find(|t| t.covers(x, y)) else {
+            return (exact, p);
+        };
+        let z = frame.gpu.depth.quantize(t.depth_at(x, y));
+        let side = if DepthFunc::Less.test(z, stored) {
+            -self.eye_side
+        } else {
+            self.eye_side
+        };
+        if side == exact {
+            return (side, p);
+        }
+        // The unit normal pointing to the umbra side (positive quad_side).
+        let n = (b - self.c).cross(a - self.c).normalize();
+        let d = n.dot(p - self.c);
+        let offset = if d == 0.0 {
+            side * 1e-9 * (p - self.c).length()
+        } else {
+            -2.0 * d
+        };
+        (side, p + n * offset)
+    }
+}
+
 /// What a submitted half-wedge triangle is.
 #[derive(Debug, Clone, Copy)]
 struct PrimRole {
@@ -570,8 +653,10 @@ fn render_with<S: VBufferStorage>(
         let mut prims: Vec<[ClipVertex; 3]> = Vec::new();
         let mut roles: Vec<PrimRole> = Vec::new();
         let mut halves = Vec::with_capacity(sil.edges.len());
+        let mut quads = Vec::with_capacity(sil.edges.len());
         for [a, b] in &sil.edges {
             halves.push(wedge_halves_and_planes(c, &corners, *a, *b, lo, hi));
+            quads.push(HardQuad::new(frame, *a, *b));
         }
         for inner in [false, true] {
             for (k, (pair, planes)) in halves.iter().enumerate() {
@@ -673,10 +758,8 @@ fn render_with<S: VBufferStorage>(
                     tile.counters.rejected_outside_planes += 1;
                     return;
                 }
-                let p = rcv.point.as_dvec3();
                 let [a, b] = sil.edges[job.edge];
-                // ssv's sign: positive on the umbra side of the quad (b, a, a∞).
-                let side = quad_side(c, p, b, a);
+                let (side, p) = quads[job.edge].side(f.x, f.y, stored, rcv.point.as_dvec3(), frame);
                 if side == 0.0 || (side > 0.0) != job.inner {
                     tile.counters.rejected_quad_side += 1;
                     return;
