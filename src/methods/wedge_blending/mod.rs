@@ -77,9 +77,9 @@
 //! * **Holes.** A loop around a hole of its mesh (a torus seen from above) has the hard count
 //!   −1 from the center where it is alone. Unpacked, it is added without ε ([`blend`]) and the
 //!   Green sum over the loops is exact; packed, PK4UB clamps it to 0 and the hole stays as
-//!   dark as the rest of the mesh's shadow (`torus-hole-rect`: RMSE 0.237 packed, 0.0074
-//!   unpacked, 0.0076 with `silhouettes = meshes`) — the per-loop silhouettes of the paper
-//!   cannot represent a hole in 8 bits.
+//!   dark as the rest of the mesh's shadow (`torus-hole-rect`: RMSE 0.237 packed, 0.0073
+//!   unpacked, 0.0075 with `silhouettes = meshes`, `ssv` 0.0074) — the per-loop silhouettes
+//!   of the paper cannot represent a hole in 8 bits.
 //! * **Only where the silhouette was drawn.** Per tile, a flag records whether any fragment of
 //!   the silhouette reached it; the initialization, blend and clear passes visit only those
 //!   tiles (a tile-level fast clear: the GPU of the paper would clear and blend the whole
