@@ -105,6 +105,11 @@ pub fn li_visibility(li: i32) -> f32 {
     li.clamp(0, 255) as f32 / 255.0
 }
 
+/// Whether [`li_visibility`] clamps `li` (it lies outside [0, 255]).
+pub fn li_clamped(li: i32) -> bool {
+    !(0..=255).contains(&li)
+}
+
 /// The LI samples of one tile. Values are kept as `i32` but always lie in the format's range.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct LiTile {

@@ -32,6 +32,7 @@ pub fn run(
         outputs.push(run_one(method, &frame.lit_by(&scene))?);
     }
     let visibility = average(outputs.iter().map(|o| &o.visibility));
+    let clamped_pixels = outputs.iter().map(|o| o.stats.clamped_pixels).sum();
     let mut passes = vec![frame.pass.clone()];
     let mut raw_images = Vec::new();
     let mut plans = Vec::new();
@@ -62,10 +63,12 @@ pub fn run(
             "per_light": plans,
         }),
     };
+    let mut stats = super::method_stats(method, frame, start, &plan, passes);
+    stats.clamped_pixels = clamped_pixels;
     Ok(MethodOutput {
         visibility,
         raw_images,
-        stats: super::method_stats(method, frame, start, &plan, passes),
+        stats,
     })
 }
 

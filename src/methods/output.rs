@@ -85,6 +85,10 @@ pub struct MethodStats {
     pub passes: Vec<PassStats>,
     /// Counters summed over all passes.
     pub totals: Counters,
+    /// Pixels whose value the method's final resolve had to clamp into [0, 1] (what it
+    /// computed there was outside); 0 for methods whose result cannot leave [0, 1]. Summed over
+    /// the lights of a scene with several lights.
+    pub clamped_pixels: u64,
 }
 
 /// The result of running one method on one scene.

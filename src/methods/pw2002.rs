@@ -39,7 +39,7 @@ use crate::geometry::penumbra_wedge::{
 };
 use crate::gpu::buffers::alloc_tiles;
 use crate::gpu::depth::{DepthFunc, DepthState};
-use crate::gpu::li_buffer::{li_visibility, LiFormat, LiOverflow, LiTile};
+use crate::gpu::li_buffer::{li_clamped, li_visibility, LiFormat, LiOverflow, LiTile};
 use crate::gpu::raster::{bin, draw, no_tile_culling};
 use crate::gpu::setup::CullMode;
 use crate::plan::{BufferPlan, MethodPlan};
@@ -181,21 +181,24 @@ pub fn li_row_major(frame: &Frame, tiles: &[LiTile]) -> Vec<i32> {
     frame.tiling.to_row_major(&flat)
 }
 
-/// Resolve LI values to visibility (background pixels are lit).
-pub fn resolve(frame: &Frame, li: &[i32]) -> Visibility {
+/// Resolve LI values to visibility (background pixels are lit), and count the receiver pixels
+/// whose LI value the resolve clamps (outside [0, 255]: overlapping shadows of Paper I §7's
+/// approximation, or an LI format's wrap).
+pub fn resolve(frame: &Frame, li: &[i32]) -> (Visibility, u64) {
     let prims = frame.prim_ids();
-    Visibility::Gray(
-        li.iter()
-            .zip(prims)
-            .map(|(v, p)| {
-                if *p == BACKGROUND {
-                    1.0
-                } else {
-                    li_visibility(*v)
-                }
-            })
-            .collect(),
-    )
+    let mut clamped = 0;
+    let v = li
+        .iter()
+        .zip(prims)
+        .map(|(v, p)| {
+            if *p == BACKGROUND {
+                return 1.0;
+            }
+            clamped += li_clamped(*v) as u64;
+            li_visibility(*v)
+        })
+        .collect();
+    (Visibility::Gray(v), clamped)
 }
 
 /// The LI buffer of `pw2002` (tile-major) and its counters.
@@ -313,16 +316,19 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             "gpu": frame.gpu,
         }),
     };
+    let (visibility, clamped) = resolve(frame, &li);
+    let mut stats = super::method_stats(
+        "pw2002",
+        frame,
+        start,
+        &plan,
+        vec![frame.pass.clone(), pass],
+    );
+    stats.clamped_pixels = clamped;
     Ok(MethodOutput {
-        visibility: resolve(frame, &li),
+        visibility,
         raw_images: vec![],
-        stats: super::method_stats(
-            "pw2002",
-            frame,
-            start,
-            &plan,
-            vec![frame.pass.clone(), pass],
-        ),
+        stats,
     })
 }
 

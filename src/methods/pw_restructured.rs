@@ -547,9 +547,12 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     };
     let mut all = vec![frame.pass.clone()];
     all.extend(passes);
+    let (visibility, clamped) = resolve(frame, &li);
+    let mut stats = super::method_stats("pw-restructured", frame, start, &plan, all);
+    stats.clamped_pixels = clamped;
     Ok(MethodOutput {
-        visibility: resolve(frame, &li),
+        visibility,
         raw_images: vec![],
-        stats: super::method_stats("pw-restructured", frame, start, &plan, all),
+        stats,
     })
 }

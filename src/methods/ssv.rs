@@ -209,6 +209,8 @@ impl CoverageSource<'_> {
 pub struct SsvRender {
     /// Visibility per pixel, row-major, clamped to [0, 1]; background 1.
     pub visibility: Visibility,
+    /// Receiver pixels whose resolved V-buffer value (some channel) was outside [0, 1].
+    pub clamped_pixels: u64,
     /// Pass 1 counters.
     pub pass1: Counters,
     /// Pass 2 counters.
@@ -337,6 +339,7 @@ fn render_with<V: VBufferTile>(frame: &Frame, settings: &SsvSettings) -> SsvRend
         .flat_map(|t| (0..tiling.tile_len()).map(move |i| t.resolve(i)))
         .collect();
     let values = tiling.to_row_major(&flat);
+    let mut clamped_pixels = 0;
     let rgb: Vec<[f32; 3]> = values
         .iter()
         .enumerate()
@@ -345,7 +348,9 @@ fn render_with<V: VBufferTile>(frame: &Frame, settings: &SsvSettings) -> SsvRend
                 return [1.0; 3];
             }
             let umbra = stencil.as_ref().map_or(0.0, |s| 1.0 - s[i] as f32);
-            v.map(|x| (x + umbra).clamp(0.0, 1.0))
+            let unclamped = v.map(|x| x + umbra);
+            clamped_pixels += unclamped.iter().any(|x| !(0.0..=1.0).contains(x)) as u64;
+            unclamped.map(|x| x.clamp(0.0, 1.0))
         })
         .collect();
     let visibility = if V::FORMAT == VBufferFormat::RgbF32 {
@@ -355,6 +360,7 @@ fn render_with<V: VBufferTile>(frame: &Frame, settings: &SsvSettings) -> SsvRend
     };
     SsvRender {
         visibility,
+        clamped_pixels,
         pass1,
         pass2,
         wedges: (edges.len(), full_screen),
@@ -461,9 +467,11 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             "gpu": frame.gpu,
         }),
     };
+    let mut stats = super::method_stats("ssv", frame, start, &plan, passes);
+    stats.clamped_pixels = r.clamped_pixels;
     Ok(MethodOutput {
         visibility: r.visibility,
         raw_images: vec![],
-        stats: super::method_stats("ssv", frame, start, &plan, passes),
+        stats,
     })
 }

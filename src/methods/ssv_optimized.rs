@@ -367,8 +367,8 @@ fn silhouettes(frame: &Frame, c: Vec3) -> Result<Vec<Vec<[DVec3; 2]>>, InputErro
 }
 
 /// Render one group (pass 1 quads + the wedges of `edges`) for light piece `light` into a
-/// fresh split V-buffer; returns the resolved, clamped visibility per pixel (row-major) and the
-/// counters.
+/// fresh split V-buffer; returns the resolved, clamped visibility per pixel (row-major), the
+/// counters and per pixel whether the clamp changed the value.
 fn render_group(
     frame: &Frame,
     light: &LightModel,
@@ -376,7 +376,7 @@ fn render_group(
     edges: &[[DVec3; 2]],
     s: &Settings,
     receivers: &[Vec<Option<DVec3>>],
-) -> (Vec<f32>, Counters) {
+) -> (Vec<f32>, Counters, Vec<bool>) {
     let tiling = &frame.tiling;
     let format = s.format;
     let table = SplitTable::get(format);
@@ -556,11 +556,14 @@ fn render_group(
             },
         );
     }
-    let flat: Vec<f32> = tiles
+    let flat: Vec<f64> = tiles
         .iter()
-        .flat_map(|t| (0..t.v.add.len()).map(|i| t.v.resolve(format, i).clamp(0.0, 1.0) as f32))
+        .flat_map(|t| (0..t.v.add.len()).map(|i| t.v.resolve(format, i)))
         .collect();
-    (tiling.to_row_major(&flat), counters)
+    let values = tiling.to_row_major(&flat);
+    let clamped = values.iter().map(|v| !(0.0..=1.0).contains(v)).collect();
+    let vis = values.iter().map(|v| v.clamp(0.0, 1.0) as f32).collect();
+    (vis, counters, clamped)
 }
 
 /// The plane-equation split (§4.4's first approach): the sign of the hard-quad plane equation
@@ -598,13 +601,14 @@ fn receiver_tiles(frame: &Frame) -> Vec<Vec<Option<DVec3>>> {
         .collect()
 }
 
-/// The visibility of one light piece (row-major, clamped) with the settings' overlap mode.
+/// The visibility of one light piece (row-major, clamped) with the settings' overlap mode, the
+/// counters, and per pixel whether a clamp changed a value.
 fn piece_visibility(
     frame: &Frame,
     light: &LightModel,
     s: &Settings,
     receivers: &[Vec<Option<DVec3>>],
-) -> Result<(Vec<f32>, Counters), InputError> {
+) -> Result<(Vec<f32>, Counters, Vec<bool>), InputError> {
     let c = light.center().as_vec3();
     let loops = silhouettes(frame, c)?;
     if !s.overlap {
@@ -620,19 +624,30 @@ fn piece_visibility(
     }
     // §5.1: per loop, coverage c_l = 1 − V_l, combined c = max + ½·min, folded in loop order.
     let mut covered = vec![0.0f32; frame.pixel_count()];
+    let mut clamped = vec![false; frame.pixel_count()];
     let mut counters = Counters::default();
     for l in &loops {
         let quads: Vec<[ClipVertex; 3]> = l
             .iter()
             .flat_map(|e| silhouette_quad(&frame.proj, c, e[0].as_vec3(), e[1].as_vec3()))
             .collect();
-        let (v, cnt) = render_group(frame, light, quads, l, s, receivers);
+        let (v, cnt, cl) = render_group(frame, light, quads, l, s, receivers);
         counters += cnt;
         for (acc, v) in covered.iter_mut().zip(&v) {
             *acc = overlap_combine(*acc, 1.0 - v);
         }
+        for (a, b) in clamped.iter_mut().zip(cl) {
+            *a |= b;
+        }
     }
-    Ok((covered.iter().map(|c| 1.0 - c.min(1.0)).collect(), counters))
+    for (a, c) in clamped.iter_mut().zip(&covered) {
+        *a |= *c > 1.0;
+    }
+    Ok((
+        covered.iter().map(|c| 1.0 - c.min(1.0)).collect(),
+        counters,
+        clamped,
+    ))
 }
 
 /// Paper IV §5.1 eq. 1: `c = max(c_A, c_B) + ½·min(c_A, c_B)`.
@@ -660,12 +675,16 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let pass_start = Instant::now();
     let receivers = receiver_tiles(frame);
     let mut sum = vec![0.0f32; frame.pixel_count()];
+    let mut clamped = vec![false; frame.pixel_count()];
     let mut counters = Counters::default();
     for piece in &pieces {
-        let (v, c) = piece_visibility(frame, piece, &s, &receivers)?;
+        let (v, c, cl) = piece_visibility(frame, piece, &s, &receivers)?;
         counters += c;
         for (acc, v) in sum.iter_mut().zip(&v) {
             *acc += v;
+        }
+        for (a, b) in clamped.iter_mut().zip(cl) {
+            *a |= b;
         }
     }
     let n = pieces.len() as f32;
@@ -706,9 +725,15 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         settings: serde_json::json!({ "resolved": s, "gpu": frame.gpu }),
     };
     let passes = vec![frame.pass.clone(), pass];
+    let mut stats = super::method_stats("ssv-optimized", frame, start, &plan, passes);
+    stats.clamped_pixels = clamped
+        .iter()
+        .zip(prims)
+        .filter(|(c, p)| **c && **p != BACKGROUND)
+        .count() as u64;
     Ok(MethodOutput {
         visibility: Visibility::Gray(vis),
         raw_images: vec![],
-        stats: super::method_stats("ssv-optimized", frame, start, &plan, passes),
+        stats,
     })
 }

@@ -949,12 +949,14 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             "counters": r.counters,
         }),
     };
+    let mut stats = super::method_stats("wedge-blending", frame, start, &plan, passes);
+    stats.clamped_pixels = r.counters.clamped_pixels;
     Ok(MethodOutput {
         visibility: Visibility::Gray(r.visibility),
         raw_images: vec![RawImage8 {
             name: "penumbrae".into(),
             values: r.penumbrae,
         }],
-        stats: super::method_stats("wedge-blending", frame, start, &plan, passes),
+        stats,
     })
 }
