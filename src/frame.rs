@@ -134,10 +134,7 @@ impl<'s> Frame<'s> {
             &bins,
             no_tile_culling,
             |_, tile, tri, f, c| {
-                let (pass, z) = tile.depth.test(&state, &f, c);
-                if pass {
-                    c.depth_passed += 1;
-                    tile.depth.write(f.local, z, c);
+                if tile.depth.test_and_write(&state, &f, c) {
                     tile.prim[f.local] = tri.prim;
                 }
             },
