@@ -121,14 +121,25 @@ impl PolygonOffset {
         units: 0.0,
     };
 
+    /// The offset `o = m·factor + r·units` of a primitive with largest depth slope
+    /// `max_slope` and largest vertex depth `z_max`, stored as `format` (a slope that is not
+    /// finite — a primitive seen edge-on — counts as 0).
+    pub fn amount(self, format: DepthFormat, max_slope: f64, z_max: f32) -> f64 {
+        let m = if max_slope.is_finite() {
+            max_slope
+        } else {
+            0.0
+        };
+        m * self.factor + format.resolvable_difference(z_max) * self.units
+    }
+
     /// The offset window depth of a fragment at interpolated depth `z` of a primitive with
     /// largest depth slope `max_slope` and largest vertex depth `z_max`, stored as `format`.
     pub fn apply(self, format: DepthFormat, z: f32, max_slope: f64, z_max: f32) -> f32 {
         if self == Self::NONE {
             return z;
         }
-        let o = max_slope * self.factor + format.resolvable_difference(z_max) * self.units;
-        (z as f64 + o) as f32
+        (z as f64 + self.amount(format, max_slope, z_max)) as f32
     }
 }
 

@@ -42,11 +42,10 @@ use super::buffers::{alloc_tiles, DepthTile};
 use super::counters::Counters;
 use super::depth::{DepthFormat, DepthFunc, DepthState, PolygonOffset};
 use super::raster::{bin, draw, no_tile_culling, Fragment};
+use super::setup::{setup_all, CullMode};
 use super::texture::{sample_2d, Filter, Wrap};
 use super::tiling::Tiling;
 use super::transform::{viewport, ClipVertex, Projection};
-use crate::frame::setup_all;
-use crate::gpu::setup::CullMode;
 use crate::scene::Scene;
 use glam::{DVec3, Vec3};
 
@@ -252,9 +251,9 @@ impl LightView {
         )
     }
 
-    /// Render the depth of every mesh of `scene` from the light with polygon `offset`
-    /// (module doc, "The shadow map"): the tile-major depth target and the pass counters.
-    pub fn render_depth(&self, scene: &Scene, offset: PolygonOffset) -> (Vec<DepthTile>, Counters) {
+    /// The clip coordinates of every triangle of `scene` in this view, meshes in file order,
+    /// triangles in order (the primitive ids of the scene pass).
+    fn scene_triangles(&self, scene: &Scene) -> Vec<[ClipVertex; 3]> {
         let mut prims = Vec::new();
         for m in &scene.meshes {
             let clip: Vec<ClipVertex> = m
@@ -264,6 +263,35 @@ impl LightView {
                 .collect();
             prims.extend(m.triangles.iter().map(|t| t.map(|i| clip[i as usize])));
         }
+        prims
+    }
+
+    /// Per scene triangle (primitive id order), the largest window-depth slope per texel and
+    /// the largest vertex depth it has in this view, as triangle setup computes them for
+    /// [`PolygonOffset`] — for a depth offset applied when a map is read rather than when it
+    /// is rendered. A triangle setup drops (seen edge-on) gets slope 0 and depth 1.
+    pub fn depth_slopes(&self, scene: &Scene) -> Vec<(f64, f32)> {
+        let (tris, _) = setup_all(&self.scene_triangles(scene), CullMode::None, &self.tiling);
+        let mut out = vec![(0.0, 1.0); scene.meshes.iter().map(|m| m.triangles.len()).sum()];
+        for t in tris.iter().rev() {
+            out[t.prim as usize] = (t.max_depth_slope(), t.z_range[1]);
+        }
+        out
+    }
+
+    /// The shadow-map test (`GL_TEXTURE_COMPARE_MODE` with `GL_LEQUAL`, nearest): whether a
+    /// point at window coordinates `(x, y, z)` of this view is lit by the light center —
+    /// its quantized depth is at most the stored depth of the nearest texel of
+    /// `shadow_map`. The stored value is read from the tile storage (the caller counts it).
+    pub fn lit(&self, shadow_map: &[DepthTile], [x, y, z]: [f32; 3]) -> bool {
+        let stored = self.sample(x, y, Filter::Nearest, |t, l| shadow_map[t].values[l] as f64);
+        self.depth.quantize(z) as f64 <= stored
+    }
+
+    /// Render the depth of every mesh of `scene` from the light with polygon `offset`
+    /// (module doc, "The shadow map"): the tile-major depth target and the pass counters.
+    pub fn render_depth(&self, scene: &Scene, offset: PolygonOffset) -> (Vec<DepthTile>, Counters) {
+        let prims = self.scene_triangles(scene);
         let (tris, mut counters) = setup_all(&prims, CullMode::Back, &self.tiling);
         let bins = bin(&self.tiling, &tris);
         let mut tiles = alloc_tiles(&self.tiling, |_, len| DepthTile::cleared(self.depth, len));

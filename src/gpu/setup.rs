@@ -24,8 +24,10 @@
 use super::clip::{clip_triangle, clip_triangle_barycentric, fully_inside};
 use super::counters::Counters;
 use super::fixed::Fixed8;
+use super::tiling::Tiling;
 use super::transform::{viewport, ClipVertex};
 use crate::limits::{FIXED_ONE, WINDOW_LIMIT};
+use rayon::prelude::*;
 
 /// Which facing to discard before rasterization.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -237,6 +239,56 @@ fn setup_with(
     if made == 0 {
         counters.triangles_dropped += 1;
     }
+}
+
+/// Set up every primitive (in parallel, order kept) and return the raster triangles in
+/// submission order with the setup counters.
+pub fn setup_all(
+    prims: &[[ClipVertex; 3]],
+    cull: CullMode,
+    tiling: &Tiling,
+) -> (Vec<RasterTriangle>, Counters) {
+    setup_all_with(prims, tiling, cull, false)
+}
+
+/// [`setup_all`] with perspective-correct barycentrics ([`setup_triangle_barycentric`]).
+pub fn setup_all_barycentric(
+    prims: &[[ClipVertex; 3]],
+    cull: CullMode,
+    tiling: &Tiling,
+) -> (Vec<RasterTriangle>, Counters) {
+    setup_all_with(prims, tiling, cull, true)
+}
+
+fn setup_all_with(
+    prims: &[[ClipVertex; 3]],
+    tiling: &Tiling,
+    cull: CullMode,
+    barycentric: bool,
+) -> (Vec<RasterTriangle>, Counters) {
+    let state = SetupState {
+        cull,
+        width: tiling.width,
+        height: tiling.height,
+        barycentric,
+    };
+    let parts: Vec<(Vec<RasterTriangle>, Counters)> = prims
+        .par_iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let mut out = Vec::new();
+            let mut c = Counters::default();
+            setup_with(p, k as u32, state, &mut out, &mut c);
+            (out, c)
+        })
+        .collect();
+    let mut tris = Vec::with_capacity(prims.len());
+    let mut counters = Counters::default();
+    for (t, c) in parts {
+        tris.extend(t);
+        counters += c;
+    }
+    (tris, counters)
 }
 
 /// Snapped image-space position (fixed point) and window depth of a clipped vertex, or `None`
