@@ -9,7 +9,7 @@
 use crate::error::InputError;
 use crate::geometry::adjacency::{self, Adjacency};
 use crate::gpu::buffers::{alloc_tiles, DepthTile};
-use crate::gpu::depth::{DepthFormat, DepthFunc, DepthState};
+use crate::gpu::depth::{DepthFormat, DepthState};
 use crate::gpu::raster::{bin, draw, no_tile_culling};
 pub use crate::gpu::setup::setup_all;
 use crate::gpu::setup::CullMode;
@@ -123,10 +123,7 @@ impl<'s> Frame<'s> {
             depth: DepthTile::cleared(gpu.depth, len),
             prim: vec![BACKGROUND; len],
         });
-        let state = DepthState {
-            func: DepthFunc::Less,
-            write: true,
-        };
+        let state = DepthState::LESS_WRITE;
         counters += draw(
             &tiling,
             &mut tiles,

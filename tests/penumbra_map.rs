@@ -13,19 +13,10 @@
 use penumbra::frame::{Frame, GpuSettings, Receiver};
 use penumbra::methods::output::Visibility;
 use penumbra::methods::penumbra_map::{self, PenumbraMapRender, PenumbraMapSettings};
-use penumbra::scene::{builtin, LightShape, OptionValue, Scene};
+use penumbra::scene::{LightShape, OptionValue, Scene};
 
-fn small(name: &str, size: u32) -> Scene {
-    let mut s = builtin::load(name).expect("built-in scene");
-    s.width = size;
-    s.height = size;
-    s
-}
-
-fn with_sphere(mut s: Scene, r: f32) -> Scene {
-    s.lights[0].shape = LightShape::Sphere { radius: r };
-    s
-}
+mod sphere_hard_cases;
+use sphere_hard_cases::{small, with_sphere};
 
 fn set(scene: &mut Scene, method: &str, key: &str, v: OptionValue) {
     scene
@@ -434,7 +425,7 @@ fn stats_account_for_the_passes_and_the_maps() {
     assert!(buffers.contains("shadow-map 48x48") && buffers.contains("penumbra-map colour"));
 }
 
-/// DESIGN.md hard cases that apply to sphere lights, at 32²: finite values in [0, 1] with the
+/// DESIGN.md hard cases that apply to sphere lights ([`sphere_hard_cases`]), at 32²: finite values in [0, 1] with the
 /// intensity I and the screen values checked before any clamp (counted, must be zero), for
 /// the default map and for the float storage formats with the linear falloff (which would let
 /// an out-of-range I through to the visibility), in every depth format.
@@ -443,41 +434,20 @@ fn hard_cases_stay_in_range_before_any_clamp() {
     use penumbra::gpu::color::ColorFormat;
     use penumbra::gpu::depth::DepthFormat;
     use penumbra_map::Falloff;
-    let mut cases = vec![
-        with_sphere(small("single-quad", 32), 1.5),   // no umbra
-        with_sphere(small("eye-in-shadow", 32), 0.3), // eye inside the shadow
-        small("pw-2002", 32),                         // overlapping boxes
-        small("pw-fractal", 32),                      // zigzag silhouettes, high degrees
-        small("pw-columns", 32),                      // contact
-        small("cube-of-spheres-sphere", 32),          // many overlapping penumbrae
-    ];
-    let mut s = penumbra::scene::file::load_scene_file(std::path::Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/scenes/hard/acute-corner-sphere.toml"
-    )))
-    .unwrap();
-    s.width = 32;
-    s.height = 32;
-    cases.push(s);
-    // Edges nearly parallel to the light.
-    let mut s = small("cylinder", 32);
-    s.lights[0].center = glam::Vec3::new(0.35, 3.2, 0.0);
-    cases.push(s);
-    // Far from the origin (depth precision).
-    let mut s = small("cylinder", 32);
-    let off = glam::Vec3::new(1000.0, 0.0, -1000.0);
-    for m in &mut s.meshes {
-        for p in &mut m.positions {
-            *p += off;
+    // Every hard case, the two-light scene light by light (one map per light), and the
+    // heavily overlapping penumbrae of `cube-of-spheres-sphere`.
+    let mut cases = Vec::new();
+    let mut two = None;
+    for scene in sphere_hard_cases::scenes(32) {
+        if scene.is_multi_light() {
+            cases.extend((0..scene.lights.len()).map(|k| scene.with_only_light(k)));
+            two = Some(scene);
+        } else {
+            cases.push(scene);
         }
     }
-    s.lights[0].center += off;
-    s.camera.eye += off.as_dvec3();
-    s.camera.target += off.as_dvec3();
-    cases.push(s);
-    // Each light of the two-light scene.
-    let two = small("two-lights", 32);
-    cases.extend((0..2).map(|k| two.with_only_light(k)));
+    cases.push(small("cube-of-spheres-sphere", 32));
+    let two = two.expect("a multi-light hard case");
     let variants: [(Falloff, ColorFormat, DepthFormat); 4] = [
         (Falloff::Smoothstep, ColorFormat::Unorm8, DepthFormat::D24),
         (Falloff::Linear, ColorFormat::F32, DepthFormat::D24),

@@ -223,7 +223,8 @@ fn push_sheet(g: &mut PenumbraGeometry, light: &ConeLight, a: DVec3, b: DVec3) {
     let along = c_b - c_a;
     let len = along.length();
     let cos = (r_a - r_b) / len;
-    if !(cos.abs() < 1.0) {
+    // Not `cos.abs() < 1` (NaN for coincident centers, or nested circles): no tangent.
+    if cos.is_nan() || cos.abs() >= 1.0 {
         g.skipped_sheets += 1;
         return;
     }

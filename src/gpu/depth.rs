@@ -187,6 +187,14 @@ pub struct DepthState {
     pub write: bool,
 }
 
+impl DepthState {
+    /// LESS with depth writes: the ordinary nearest-surface (or smallest-value) pass.
+    pub const LESS_WRITE: DepthState = DepthState {
+        func: DepthFunc::Less,
+        write: true,
+    };
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -40,7 +40,7 @@
 
 use super::buffers::{alloc_tiles, DepthTile};
 use super::counters::Counters;
-use super::depth::{DepthFormat, DepthFunc, DepthState, PolygonOffset};
+use super::depth::{DepthFormat, DepthState, PolygonOffset};
 use super::raster::{bin, draw, no_tile_culling, Fragment};
 use super::setup::{setup_all, CullMode};
 use super::texture::{sample_2d, Filter, Wrap};
@@ -295,10 +295,7 @@ impl LightView {
         let (tris, mut counters) = setup_all(&prims, CullMode::Back, &self.tiling);
         let bins = bin(&self.tiling, &tris);
         let mut tiles = alloc_tiles(&self.tiling, |_, len| DepthTile::cleared(self.depth, len));
-        let state = DepthState {
-            func: DepthFunc::Less,
-            write: true,
-        };
+        let state = DepthState::LESS_WRITE;
         let format = self.depth;
         counters += draw(
             &self.tiling,

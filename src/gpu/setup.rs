@@ -13,7 +13,7 @@
 //! positions; it is evaluated at each sample in f64 and rounded once to f32
 //! ([`RasterTriangle::depth_at`]). This is the only place interpolated depth is computed.
 //!
-//! Attributes (varyings): a triangle set up with [`setup_triangle_barycentric`] also gets the
+//! Attributes (varyings): a triangle set up with [`setup_all_barycentric`] also gets the
 //! perspective-correct barycentric coordinates of each sample with respect to the submitted
 //! triangle ([`RasterTriangle::barycentric_at`]): 1/w and b_k/w of the three (clipped)
 //! vertices are planes over the snapped positions like the depth ([`ScreenPlane`]), evaluated
@@ -121,7 +121,7 @@ pub struct RasterTriangle {
     /// Smallest and largest vertex window depth (clamped to [0, 1]) — the triangle's depth range
     /// for hierarchical-Z tests.
     pub z_range: [f32; 2],
-    /// Perspective-correct barycentrics, when set up with [`setup_triangle_barycentric`].
+    /// Perspective-correct barycentrics, when set up with [`setup_all_barycentric`].
     perspective: Option<Box<PerspectivePlanes>>,
 }
 
@@ -188,26 +188,6 @@ pub fn setup_triangle(
     setup_with(tri, prim, state, out, counters);
 }
 
-/// [`setup_triangle`] that also sets up perspective-correct barycentrics, so that fragments
-/// can interpolate per-vertex attributes ([`RasterTriangle::interpolate`]).
-pub fn setup_triangle_barycentric(
-    tri: &[ClipVertex; 3],
-    prim: u32,
-    cull: CullMode,
-    width: u32,
-    height: u32,
-    out: &mut Vec<RasterTriangle>,
-    counters: &mut Counters,
-) {
-    let state = SetupState {
-        cull,
-        width,
-        height,
-        barycentric: true,
-    };
-    setup_with(tri, prim, state, out, counters);
-}
-
 const UNIT_BARYCENTRICS: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
 fn setup_with(
@@ -251,7 +231,8 @@ pub fn setup_all(
     setup_all_with(prims, tiling, cull, false)
 }
 
-/// [`setup_all`] with perspective-correct barycentrics ([`setup_triangle_barycentric`]).
+/// [`setup_all`] that also sets up perspective-correct barycentrics, so that fragments can
+/// interpolate per-vertex attributes ([`RasterTriangle::interpolate`]).
 pub fn setup_all_barycentric(
     prims: &[[ClipVertex; 3]],
     cull: CullMode,
@@ -501,9 +482,8 @@ mod tests {
             Vec3::new(0.0, 0.0, 3.4),
         ];
         let tri = world.map(|w| p.clip_point(w));
-        let mut out = Vec::new();
-        let mut c = Counters::default();
-        setup_triangle_barycentric(&tri, 0, CullMode::None, 32, 32, &mut out, &mut c);
+        let tiling = Tiling::new(32, 32, 8).unwrap();
+        let (out, mut c) = setup_all_barycentric(&[tri], CullMode::None, &tiling);
         assert!(out.len() >= 2, "clipped into a fan");
         let mut checked = 0;
         for t in &out {

@@ -92,7 +92,7 @@ use crate::geometry::penumbra_cones::{cones_and_sheets, silhouettes, ConeLight, 
 use crate::gpu::buffers::{alloc_tiles, DepthTile};
 use crate::gpu::color::{ColorFormat, ColorTile};
 use crate::gpu::counters::Counters;
-use crate::gpu::depth::{DepthFormat, DepthFunc, DepthState, PolygonOffset};
+use crate::gpu::depth::{DepthFormat, DepthState, PolygonOffset};
 use crate::gpu::light_view::{LightView, MAX_LIGHT_VIEW_HALF_ANGLE_DEG};
 use crate::gpu::raster::{bin, draw, no_tile_culling, Fragment};
 use crate::gpu::setup::{setup_all_barycentric, CullMode};
@@ -222,17 +222,6 @@ pub struct ProgramStats {
     pub written: u64,
 }
 
-impl AddAssign for ProgramStats {
-    fn add_assign(&mut self, o: Self) {
-        self.fragments += o.fragments;
-        self.discarded_behind_surface += o.discarded_behind_surface;
-        self.discarded_surface_not_beyond_silhouette += o.discarded_surface_not_beyond_silhouette;
-        self.discarded_in_front_of_silhouette += o.discarded_in_front_of_silhouette;
-        self.intensity_out_of_range += o.intensity_out_of_range;
-        self.written += o.written;
-    }
-}
-
 /// What the screen pass found (module doc, pass 3).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
 pub struct ScreenStats {
@@ -248,15 +237,32 @@ pub struct ScreenStats {
     pub out_of_range: u64,
 }
 
-impl AddAssign for ScreenStats {
-    fn add_assign(&mut self, o: Self) {
-        self.receivers += o.receivers;
-        self.umbra += o.umbra;
-        self.penumbra += o.penumbra;
-        self.behind_light += o.behind_light;
-        self.out_of_range += o.out_of_range;
-    }
+/// `AddAssign` as the field-wise sum, for the per-tile and per-row tallies above.
+macro_rules! field_sum {
+    ($t:ty { $($f:ident),* }) => {
+        impl AddAssign for $t {
+            fn add_assign(&mut self, o: Self) {
+                $(self.$f += o.$f;)*
+            }
+        }
+    };
 }
+
+field_sum!(ProgramStats {
+    fragments,
+    discarded_behind_surface,
+    discarded_surface_not_beyond_silhouette,
+    discarded_in_front_of_silhouette,
+    intensity_out_of_range,
+    written
+});
+field_sum!(ScreenStats {
+    receivers,
+    umbra,
+    penumbra,
+    behind_light,
+    out_of_range
+});
 
 /// Per-tile storage of the penumbra map.
 struct PenumbraTile {
@@ -446,10 +452,7 @@ pub fn render_penumbra_map(
         depth: DepthTile::cleared(view.depth, len),
         stats: ProgramStats::default(),
     });
-    let less = DepthState {
-        func: DepthFunc::Less,
-        write: true,
-    };
+    let less = DepthState::LESS_WRITE;
     let format = view.depth;
     counters += draw(
         &view.tiling,
