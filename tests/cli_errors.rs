@@ -228,6 +228,11 @@ fn bad_options_and_methods() {
             &["--methods", "hard-sv", "--opt", "hard-sv.bogus=1"],
             &["unknown option"],
         ),
+        (
+            "penumbra maps need a sphere light",
+            &["--methods", "penumbra-map"],
+            &["method penumbra-map does not support rect lights"],
+        ),
     ];
     for (what, args, keywords) in cases {
         let all: Vec<&str> = [&[scene][..], &small, args].concat();
