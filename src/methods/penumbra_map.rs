@@ -15,23 +15,23 @@
 //!    cast onto full models; here both are the same mesh, and what the method needs is the
 //!    slope-scaled part: the fitted light view is not perpendicular to any floor, so a
 //!    receiver half a texel from the texel center differs in depth by up to the surface's
-//!    depth slope m. Measured at 256² (RMSE vs `raycast`, default otherwise):
-//!    `cube-of-spheres-sphere` / `pw-columns` / `pw-fractal` 0.535 / 0.548 / 0.346 without a
-//!    slope bias, 0.279 / 0.263 / 0.181 with factor 0.5, 0.173 / 0.139 / 0.149 with 1, and
-//!    0.174 / 0.155 / 0.168 with 2 (light leaks grow); the constant part barely matters for
-//!    D24 (up to 1000 units without slope bias still leaves 0.389 / 0.535 / —).
+//!    depth slope m, so half of a tilted lit surface shadows itself without a slope term
+//!    (tested). Measured at 256², RMSE vs `raycast` on `cube-of-spheres-sphere` / `pw-columns`
+//!    / `pw-fractal` / `pw-2002`: 0.535 / 0.548 / 0.346 / 0.577 without slope bias (1000
+//!    units instead: 0.389 / 0.535 / 0.341 / 0.540), 0.278 / 0.262 / 0.181 / 0.299 with
+//!    factor 0.5, 0.173 / 0.138 / 0.149 / 0.185 with 1 (default), 0.174 / 0.155 / 0.168 /
+//!    0.185 with 2 (light leaks grow); 0, 4 or 64 units change nothing visible at D24.
 //!    `bias_stage` chooses where the offset applies: `render` (default) offsets the shadow
 //!    map as it is drawn, so pass 2 reads the offset depths too — near an occluder's own
 //!    silhouette, where its surface is seen edge-on and the slope term is large, the offset
 //!    pushes the surface behind the silhouette, a cone's fragments pass line (4) there and
-//!    darken a few lit texels (counted below); `lookup` keeps the shadow map exact and moves
-//!    the receiver toward the light in the screen pass's test by the offset its own triangle
-//!    has in the light view ([`LightView::depth_slopes`]) — fewer dark specks but more light
-//!    leaks on steep receivers, whose own slope is large. Measured at 256², pixels `raycast`
-//!    sees fully lit (≥ 0.99) that come out below 0.5 / pixels `raycast` sees dark (≤ 0.01)
-//!    that come out above 0.5: `cube-of-spheres-sphere` render 72 / 26, lookup 49 / 45;
-//!    `pw-2002` render 180 / 16, lookup 166 / 888; `pw-fractal` render 197 / 361, lookup
-//!    140 / 815.
+//!    darken a few lit texels; `lookup` keeps the shadow map exact and moves the receiver
+//!    toward the light in the screen pass's test by the offset its own triangle has in the
+//!    light view ([`LightView::depth_slopes`]) — fewer dark specks but more light leaks on
+//!    steep receivers, whose own slope is large. Measured at 256² (pixels `raycast` sees
+//!    fully lit, ≥ 0.99, that come out below 0.5 / pixels `raycast` sees dark, ≤ 0.01, that
+//!    come out above 0.5) on the same four scenes: render 72/26, 283/261, 197/361, 180/16;
+//!    lookup 49/45, 268/322, 140/815, 166/888 (RMSE 0.173, 0.141, 0.173, 0.217).
 //! 2. **Penumbra map** (§3): the silhouette from the light center (possible silhouette edges
 //!    and their loops), a cone per silhouette vertex and an outer sheet per silhouette edge
 //!    ([`crate::geometry::penumbra_cones`]; `cone_segments` triangles per cone), drawn into a
@@ -82,7 +82,13 @@
 //! The paper's limits follow from the construction and are measured in
 //! `tests/penumbra_map.rs`: the penumbra is outer only (inside the hard shadow nothing is lit),
 //! the umbra does not shrink as the light grows (§4.1), shadows harden where occluder and
-//! receiver touch, and the shadow map's resolution shows as aliasing.
+//! receiver touch, and the shadow map's resolution shows as aliasing. Against `raycast` the
+//! method is less accurate than the plain hard shadow (`hard-sv`) on every sphere-light
+//! built-in (256², RMSE: `cube-of-spheres-sphere` 0.173 vs 0.124, `pw-columns` 0.138 vs
+//! 0.072, `pw-fractal` 0.149 vs 0.083): the whole 0 → 1 transition is put in the outer half
+//! of the penumbra, where the true visibility only rises from about 0.5, and I is linear in
+//! depth along the cone, not across the penumbra (halfway across a sheet from a silhouette at
+//! view depth 2 to a receiver at 3, I = 0.4 and I′ = 0.35; `raycast` there is about 0.8).
 
 use super::options::OptionReader;
 use super::output::{MethodOutput, PassStats, Visibility};
