@@ -104,7 +104,6 @@ use crate::gpu::raster::{bin, draw, no_tile_culling, Fragment};
 use crate::gpu::setup::{setup_all_barycentric, CullMode};
 use crate::gpu::texture::Filter;
 use crate::gpu::tiling::Tiling;
-use crate::limits::MAX_IMAGE_SIZE;
 use crate::plan::{BufferPlan, MethodPlan};
 use crate::scene::LightShape;
 use rayon::prelude::*;
@@ -116,6 +115,9 @@ use std::time::Instant;
 pub const DEFAULT_BIAS_UNITS: f64 = 4.0;
 /// The default slope-scaled polygon-offset factor of the shadow map (`slope_bias`).
 pub const DEFAULT_SLOPE_BIAS: f64 = 1.0;
+/// The largest `map_size`: the three map buffers (shadow map, penumbra colour and depth) of
+/// 4096² texels take 200 MB as stored; the paper's maps are 1024².
+pub const MAX_MAP_SIZE: u32 = 4096;
 /// The default number of triangles per cone (`cone_segments`).
 pub const DEFAULT_CONE_SEGMENTS: u32 = 16;
 
@@ -177,8 +179,8 @@ pub fn read_settings(frame: &Frame) -> Result<PenumbraMapSettings, InputError> {
     let mut r = OptionReader::new(scene, "penumbra-map");
     let map_size = r.uint(
         "map_size",
-        scene.width.max(scene.height) as u64,
-        8..=MAX_IMAGE_SIZE as u64,
+        scene.width.max(scene.height).min(MAX_MAP_SIZE) as u64,
+        8..=MAX_MAP_SIZE as u64,
     )? as u32;
     let depth = r.depth_format("depth", frame.gpu.depth)?;
     let units = r.float("bias", DEFAULT_BIAS_UNITS, 0.0..=16_777_215.0)?;
