@@ -9,10 +9,10 @@
 use crate::error::InputError;
 use crate::geometry::adjacency::{self, Adjacency};
 use crate::gpu::buffers::{alloc_tiles, DepthTile};
-use crate::gpu::counters::Counters;
-use crate::gpu::depth::{DepthFormat, DepthFunc, DepthState};
+use crate::gpu::depth::{DepthFormat, DepthState};
 use crate::gpu::raster::{bin, draw, no_tile_culling};
-use crate::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
+pub use crate::gpu::setup::setup_all;
+use crate::gpu::setup::CullMode;
 use crate::gpu::tiling::Tiling;
 use crate::gpu::transform::{ClipVertex, Projection};
 use crate::methods::output::PassStats;
@@ -139,10 +139,7 @@ impl<'s> Frame<'s> {
             depth: DepthTile::cleared(gpu.depth, len),
             prim: vec![BACKGROUND; len],
         });
-        let state = DepthState {
-            func: DepthFunc::Less,
-            write: true,
-        };
+        let state = DepthState::LESS_WRITE;
         counters += draw(
             &tiling,
             &mut tiles,
@@ -150,10 +147,7 @@ impl<'s> Frame<'s> {
             &bins,
             no_tile_culling,
             |_, tile, tri, f, c| {
-                let (pass, z) = tile.depth.test(&state, &f, c);
-                if pass {
-                    c.depth_passed += 1;
-                    tile.depth.write(f.local, z, c);
+                if tile.depth.test_and_write(&state, &f, c) {
                     tile.prim[f.local] = tri.prim;
                 }
             },
@@ -337,40 +331,6 @@ fn check_camera_outside_geometry(scene: &Scene, near: f64) -> Result<(), InputEr
         }
     }
     Ok(())
-}
-
-/// Set up every primitive (in parallel, order kept) and return the raster triangles in
-/// submission order with the setup counters.
-pub fn setup_all(
-    prims: &[[ClipVertex; 3]],
-    cull: CullMode,
-    tiling: &Tiling,
-) -> (Vec<RasterTriangle>, Counters) {
-    let parts: Vec<(Vec<RasterTriangle>, Counters)> = prims
-        .par_iter()
-        .enumerate()
-        .map(|(k, p)| {
-            let mut out = Vec::new();
-            let mut c = Counters::default();
-            setup_triangle(
-                p,
-                k as u32,
-                cull,
-                tiling.width,
-                tiling.height,
-                &mut out,
-                &mut c,
-            );
-            (out, c)
-        })
-        .collect();
-    let mut tris = Vec::with_capacity(prims.len());
-    let mut counters = Counters::default();
-    for (t, c) in parts {
-        tris.extend(t);
-        counters += c;
-    }
-    (tris, counters)
 }
 
 #[cfg(test)]

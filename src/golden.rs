@@ -495,6 +495,7 @@ mod tests {
                 plan: serde_json::Value::Null,
                 passes: vec![],
                 totals: Counters::default(),
+                clamped_pixels: 0,
             },
         }
     }

@@ -17,6 +17,8 @@ pub const MAX_IMAGE_SIZE: u32 = 16384;
 /// Guard band: clip-space x and y are clipped to |x| ≤ GUARD_BAND·w, so that primitives
 /// reaching infinity (w = 0) become finite without moving any edge that crosses the viewport.
 pub const GUARD_BAND: f64 = 4.0;
+/// Largest D16 value, 2^16 − 1.
+pub const D16_MAX: u32 = (1 << 16) - 1;
 /// Largest D24 value, 2^24 − 1.
 pub const D24_MAX: u32 = (1 << 24) - 1;
 /// Largest |window coordinate| in pixels a vertex may have after clipping: 2^20. The guard

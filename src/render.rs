@@ -26,7 +26,8 @@ pub struct MethodRun {
     pub error: Option<ErrorStats>,
 }
 
-/// Read `[options.gpu]`: `tile_size` (power of two 2…256, default 8) and `depth` (`d24` | `d32f`).
+/// Read `[options.gpu]`: `tile_size` (power of two 2…256, default 8) and `depth`
+/// (`d16` | `d24` | `d32f`, default `d24`).
 pub fn gpu_settings(scene: &Scene) -> Result<GpuSettings, InputError> {
     let mut r = OptionReader::new(scene, "gpu");
     let tile_size = r.uint(
@@ -41,10 +42,7 @@ pub fn gpu_settings(scene: &Scene) -> Result<GpuSettings, InputError> {
             format!("{tile_size} is not a power of two"),
         ));
     }
-    let depth = match r.choice("depth", &["d24", "d32f"], "d24")? {
-        "d24" => DepthFormat::D24,
-        _ => DepthFormat::D32F,
-    };
+    let depth = r.depth_format("depth", DepthFormat::D24)?;
     r.finish()?;
     Ok(GpuSettings { tile_size, depth })
 }

@@ -95,7 +95,15 @@ const BAD_FILES: &[(&str, &[&str])] = &[
         "camera-inside-mesh.toml",
         &["camera inside geometry", "near plane"],
     ),
+    (
+        "penumbra-map-frustum.toml",
+        &["one light frustum cannot cover the scene"],
+    ),
 ];
+
+/// Files whose problem is in their own method list or in a method that list names, which
+/// `--methods` would replace: they run with their own list.
+const OWN_METHODS: &[&str] = &["unknown-method.toml", "penumbra-map-frustum.toml"];
 
 #[test]
 fn every_bad_scene_file_is_rejected() {
@@ -112,9 +120,7 @@ fn every_bad_scene_file_is_rejected() {
 
     for (name, keywords) in BAD_FILES {
         let path = format!("scenes/bad/{name}");
-        // unknown-method.toml's problem is its own method list, which `--methods` would
-        // replace (an override is not an error), so that file runs with its own list.
-        let args: Vec<&str> = if *name == "unknown-method.toml" {
+        let args: Vec<&str> = if OWN_METHODS.contains(name) {
             vec![path.as_str(), "--width", "32", "--height", "32"]
         } else {
             [&[path.as_str()], SMALL].concat()
@@ -243,6 +249,11 @@ fn bad_options_and_methods() {
                 "wedge-blending.target=flush-denormals",
             ],
             &["wedge-blending.target", "8bit"],
+        ),
+        (
+            "penumbra maps need a sphere light",
+            &["--methods", "penumbra-map"],
+            &["method penumbra-map does not support rect lights"],
         ),
     ];
     for (what, args, keywords) in cases {

@@ -5,16 +5,12 @@ use penumbra::frame::{Frame, GpuSettings};
 use penumbra::gpu::transform::ClipVertex;
 use penumbra::methods::pw2002::{self, WedgeSettings};
 use penumbra::methods::pw_restructured::{self, Culling, Passes, RestructuredSettings, WedgeTest};
-use penumbra::scene::{builtin, Scene};
+use penumbra::scene::Scene;
 use std::cmp::Ordering;
 use std::collections::BTreeMap;
 
-fn small(name: &str, size: u32) -> Scene {
-    let mut s = builtin::load(name).expect("built-in scene");
-    s.width = size;
-    s.height = size;
-    s
-}
+mod sphere_hard_cases;
+use sphere_hard_cases::{small, with_sphere};
 
 fn wedge_settings(frame: &Frame) -> WedgeSettings {
     let mut r = penumbra::methods::options::OptionReader::new(frame.scene, "pw2002");
@@ -152,11 +148,6 @@ fn mean_abs(a: &[f32], b: &[f32]) -> f64 {
         / a.len() as f64
 }
 
-fn with_sphere(mut s: Scene, r: f32) -> Scene {
-    s.lights[0].shape = LightShape::Sphere { radius: r };
-    s
-}
-
 #[test]
 fn zfail_is_right_in_eye_in_shadow_and_zpass_is_not() {
     let scene = with_sphere(small("eye-in-shadow", 40), 0.3);
@@ -224,50 +215,9 @@ fn overflow_first_wrong_pixel_is_pinned() {
     assert_eq!(stacked_li(10, Li12, Saturate), -2048);
 }
 
-/// Hard cases of DESIGN.md that apply to spheres: a light so large there is no umbra, an
-/// occluder touching the receiver, silhouette edges nearly parallel to the light direction,
-/// acute corners, eye in shadow, geometry far from the origin.
-fn hard_cases() -> Vec<Scene> {
-    let mut v = vec![
-        with_sphere(small("single-quad", 32), 1.5),   // no umbra
-        with_sphere(small("eye-in-shadow", 32), 0.3), // eye inside shadow
-        small("pw-2002", 32),                         // overlapping boxes
-        small("pw-fractal", 32),                      // zigzag silhouettes, high vertex degrees
-        small("pw-columns", 32),                      // contact: columns stand on the floor
-        small("two-lights", 32),                      // two lights in one LI buffer
-    ];
-    // Acute silhouette corners (Fig. 7 corner wedges) under a small sphere light.
-    let mut s = penumbra::scene::file::load_scene_file(std::path::Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/scenes/hard/acute-corner-sphere.toml"
-    )))
-    .unwrap();
-    s.width = 32;
-    s.height = 32;
-    v.push(s);
-    // Edges nearly parallel to the light: the cylinder's vertical edges under a light almost
-    // straight above its rim.
-    let mut s = small("cylinder", 32);
-    s.lights[0].center = glam::Vec3::new(0.35, 3.2, 0.0);
-    v.push(s);
-    // Far from the origin (depth precision).
-    let mut s = small("cylinder", 32);
-    let off = glam::Vec3::new(1000.0, 0.0, -1000.0);
-    for m in &mut s.meshes {
-        for p in &mut m.positions {
-            *p += off;
-        }
-    }
-    s.lights[0].center += off;
-    s.camera.eye += off.as_dvec3();
-    s.camera.target += off.as_dvec3();
-    v.push(s);
-    v
-}
-
 #[test]
 fn hard_cases_give_finite_visibility_in_range() {
-    for scene in hard_cases() {
+    for scene in sphere_hard_cases::scenes(32) {
         let frame = Frame::render(&scene, GpuSettings::default()).unwrap();
         for m in ["pw2002", "pw-restructured"] {
             let v = gray(&penumbra::methods::run(m, &frame).unwrap().visibility);

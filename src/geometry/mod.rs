@@ -1,8 +1,10 @@
 //! Geometry preparation: mesh adjacency, possible silhouettes from a light point, silhouette
-//! loops (Paper V), hard shadow volumes with caps.
+//! loops (Paper V), hard shadow volumes with caps, penumbra wedges, and the cones and sheets
+//! of penumbra maps.
 
 pub mod adjacency;
 pub mod loops;
+pub mod penumbra_cones;
 pub mod penumbra_wedge;
 pub mod shadow_volume;
 pub mod silhouette;

@@ -76,6 +76,21 @@ impl DepthTile {
         (state.func.test(z, stored), z)
     }
 
+    /// The depth test of fragment `f` followed, when it passes and `state.write` is set, by the
+    /// write of its quantized depth (all counted, `depth_passed` included). Returns whether it
+    /// passed.
+    #[inline]
+    pub fn test_and_write(&mut self, state: &DepthState, f: &Fragment, c: &mut Counters) -> bool {
+        let (pass, z) = self.test(state, f, c);
+        if pass {
+            c.depth_passed += 1;
+            if state.write {
+                self.write(f.local, z, c);
+            }
+        }
+        pass
+    }
+
     /// Hierarchical-Z rejection for a LESS test against this tile: true when every sample of
     /// the triangle is at or behind every stored sample (triangle zmin ≥ tile zmax), i.e. no
     /// fragment of it can pass. Reads the tile's zmax (not counted as depth traffic: on-chip).

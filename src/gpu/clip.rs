@@ -12,9 +12,45 @@
 //! therefore get bit-identical new vertices on it. The clipped polygon is fanned from its first
 //! vertex. Vertices that end with w ≤ 0 (only the degenerate direction x = y = 0, z = w = 0
 //! can) cause the polygon to be dropped.
+//!
+//! Attributes: [`clip_triangle_barycentric`] also carries each output vertex's barycentric
+//! coordinates with respect to the submitted triangle (linear in clip space, so a new vertex
+//! gets the f64 interpolation of its edge's barycentrics with the same parameter, not
+//! rounded); setup turns them into perspective-correct barycentrics per sample
+//! ([`super::setup`]).
 
 use super::transform::ClipVertex;
 use crate::limits::GUARD_BAND;
+
+/// A vertex the clipper can cut edges at: its clip-space position and whatever it carries.
+pub trait ClipPoint: Copy {
+    /// The clip-space position.
+    fn clip(&self) -> ClipVertex;
+    /// The point at parameter `t` from `inside` toward `outside` whose position is `at`.
+    fn between(inside: &Self, outside: &Self, t: f64, at: ClipVertex) -> Self;
+}
+
+impl ClipPoint for ClipVertex {
+    fn clip(&self) -> ClipVertex {
+        *self
+    }
+    fn between(_: &Self, _: &Self, _: f64, at: ClipVertex) -> Self {
+        at
+    }
+}
+
+/// A clip vertex with its barycentric coordinates in the submitted triangle.
+pub type BarycentricVertex = (ClipVertex, [f64; 3]);
+
+impl ClipPoint for BarycentricVertex {
+    fn clip(&self) -> ClipVertex {
+        self.0
+    }
+    fn between(inside: &Self, outside: &Self, t: f64, at: ClipVertex) -> Self {
+        let (a, b) = (inside.1, outside.1);
+        (at, std::array::from_fn(|k| a[k] + t * (b[k] - a[k])))
+    }
+}
 
 /// Signed distances of a vertex to the six clip planes (inside ≥ 0).
 #[inline]
@@ -44,14 +80,23 @@ pub fn fully_inside(tri: &[ClipVertex; 3]) -> bool {
 
 /// Clip a triangle; returns the clipped convex polygon (0, or 3 to 9 vertices), in order.
 pub fn clip_triangle(tri: &[ClipVertex; 3]) -> Vec<ClipVertex> {
-    let mut poly: Vec<ClipVertex> = tri.to_vec();
+    clip_polygon(tri.to_vec())
+}
+
+/// [`clip_triangle`] with each output vertex's barycentric coordinates in `tri` (module doc).
+pub fn clip_triangle_barycentric(tri: &[ClipVertex; 3]) -> Vec<BarycentricVertex> {
+    let unit = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    clip_polygon((0..3).map(|k| (tri[k], unit[k])).collect())
+}
+
+fn clip_polygon<V: ClipPoint>(mut poly: Vec<V>) -> Vec<V> {
     for plane in 0..6 {
         if poly.is_empty() {
             break;
         }
         let d: Vec<f64> = poly
             .iter()
-            .map(|v| plane_distance(plane, &to_f64(*v)))
+            .map(|v| plane_distance(plane, &to_f64(v.clip())))
             .collect();
         if d.iter().all(|&x| x >= 0.0) {
             continue;
@@ -66,15 +111,15 @@ pub fn clip_triangle(tri: &[ClipVertex; 3]) -> Vec<ClipVertex> {
             }
             if (da >= 0.0) != (db >= 0.0) {
                 out.push(if da >= 0.0 {
-                    intersect(a, da, b, db)
+                    intersect(&a, da, &b, db)
                 } else {
-                    intersect(b, db, a, da)
+                    intersect(&b, db, &a, da)
                 });
             }
         }
         poly = out;
     }
-    if poly.len() < 3 || poly.iter().any(|v| v.0[3] <= 0.0) {
+    if poly.len() < 3 || poly.iter().any(|v| v.clip().0[3] <= 0.0) {
         return Vec::new();
     }
     poly
@@ -82,11 +127,12 @@ pub fn clip_triangle(tri: &[ClipVertex; 3]) -> Vec<ClipVertex> {
 
 /// The point where the edge from `inside` (distance `di` ≥ 0) to `outside` (`do_` < 0) crosses
 /// the plane, computed from the inside vertex so shared edges clip identically.
-fn intersect(inside: ClipVertex, di: f64, outside: ClipVertex, do_: f64) -> ClipVertex {
+fn intersect<V: ClipPoint>(inside: &V, di: f64, outside: &V, do_: f64) -> V {
     let t = di / (di - do_);
-    let a = to_f64(inside);
-    let b = to_f64(outside);
-    ClipVertex(std::array::from_fn(|k| (a[k] + t * (b[k] - a[k])) as f32))
+    let a = to_f64(inside.clip());
+    let b = to_f64(outside.clip());
+    let at = ClipVertex(std::array::from_fn(|k| (a[k] + t * (b[k] - a[k])) as f32));
+    V::between(inside, outside, t, at)
 }
 
 #[cfg(test)]
@@ -127,6 +173,27 @@ mod tests {
             ClipVertex([0.0, 0.5, -2.0, 1.0]),
         ];
         assert!(clip_triangle(&t).is_empty());
+    }
+
+    #[test]
+    fn barycentrics_follow_the_clipped_vertices() {
+        // One vertex behind the near plane: two new vertices on its edges.
+        let t = [
+            ClipVertex([0.0, 0.0, 0.0, 1.0]),
+            ClipVertex([0.5, 0.0, -3.0, 1.0]),
+            ClipVertex([0.0, 0.5, 0.0, 1.0]),
+        ];
+        let plain = clip_triangle(&t);
+        let with = clip_triangle_barycentric(&t);
+        assert_eq!(plain, with.iter().map(|v| v.0).collect::<Vec<_>>());
+        for (v, b) in &with {
+            assert!((b.iter().sum::<f64>() - 1.0).abs() < 1e-15);
+            // The barycentric combination of the input reproduces the position (to f32).
+            for k in 0..4 {
+                let x: f64 = (0..3).map(|i| b[i] * t[i].0[k] as f64).sum();
+                assert!((x - v.0[k] as f64).abs() < 1e-6, "{v:?} {b:?}");
+            }
+        }
     }
 
     #[test]

@@ -12,12 +12,22 @@
 //! Depth: the window depths z_w (f32) of the three vertices define a plane over the snapped
 //! positions; it is evaluated at each sample in f64 and rounded once to f32
 //! ([`RasterTriangle::depth_at`]). This is the only place interpolated depth is computed.
+//!
+//! Attributes (varyings): a triangle set up with [`setup_all_barycentric`] also gets the
+//! perspective-correct barycentric coordinates of each sample with respect to the submitted
+//! triangle ([`RasterTriangle::barycentric_at`]): 1/w and b_k/w of the three (clipped)
+//! vertices are planes over the snapped positions like the depth ([`ScreenPlane`]), evaluated
+//! in f64 at the sample, and `b_k = (b_k/w) / (1/w)`. An attribute is then
+//! `Σ b_k · a_k` ([`RasterTriangle::interpolate`]), in f64 and not rounded — the fragment
+//! programs of this crate compute in f64. Triangles set up without them pay nothing.
 
-use super::clip::{clip_triangle, fully_inside};
+use super::clip::{clip_triangle, clip_triangle_barycentric, fully_inside};
 use super::counters::Counters;
 use super::fixed::Fixed8;
+use super::tiling::Tiling;
 use super::transform::{viewport, ClipVertex};
 use crate::limits::{FIXED_ONE, WINDOW_LIMIT};
+use rayon::prelude::*;
 
 /// Which facing to discard before rasterization.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -51,6 +61,50 @@ impl EdgeFunction {
     }
 }
 
+/// A value that is affine over the image: `v(i, j) = v0 + sx·(i − x0) + sy·(j − y0)` at the
+/// sample of pixel (i, j), defined by its values at three snapped vertex positions.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScreenPlane {
+    /// Origin x, y (pixels, image space) and the value there.
+    origin: [f64; 3],
+    /// Slopes per pixel in x and y.
+    slope: [f64; 2],
+}
+
+impl ScreenPlane {
+    /// The plane through `(x_k, y_k, v_k)` for the three vertices (positions in pixels).
+    pub fn through(p: [(f64, f64); 3], v: [f64; 3]) -> Self {
+        let [(x0, y0), (x1, y1), (x2, y2)] = p;
+        let det = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0);
+        let dvdx = ((v[1] - v[0]) * (y2 - y0) - (v[2] - v[0]) * (y1 - y0)) / det;
+        let dvdy = ((x1 - x0) * (v[2] - v[0]) - (x2 - x0) * (v[1] - v[0])) / det;
+        Self {
+            origin: [x0, y0, v[0]],
+            slope: [dvdx, dvdy],
+        }
+    }
+
+    /// The value at the sample of pixel (i, j), in f64.
+    #[inline]
+    pub fn at(&self, i: u32, j: u32) -> f64 {
+        let dx = i as f64 - self.origin[0];
+        let dy = j as f64 - self.origin[1];
+        self.origin[2] + self.slope[0] * dx + self.slope[1] * dy
+    }
+
+    /// The largest absolute slope per pixel, max(|∂v/∂x|, |∂v/∂y|).
+    pub fn max_slope(&self) -> f64 {
+        self.slope[0].abs().max(self.slope[1].abs())
+    }
+}
+
+/// The planes of 1/w and b_k/w of a raster triangle (module doc, "Attributes").
+#[derive(Debug, Clone, PartialEq)]
+pub struct PerspectivePlanes {
+    inv_w: ScreenPlane,
+    b_over_w: [ScreenPlane; 3],
+}
+
 /// A triangle ready for traversal: everything that does not depend on the pixel.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RasterTriangle {
@@ -62,13 +116,13 @@ pub struct RasterTriangle {
     pub edges: [EdgeFunction; 3],
     /// Inclusive pixel bounding box, clamped to the image: x0, y0, x1, y1.
     pub bbox: [u32; 4],
-    /// Depth plane origin (pixels, image space) and value: x, y, z.
-    z_origin: [f64; 3],
-    /// Depth plane slopes per pixel in x and y.
-    z_slope: [f64; 2],
+    /// The window-depth plane.
+    depth: ScreenPlane,
     /// Smallest and largest vertex window depth (clamped to [0, 1]) — the triangle's depth range
     /// for hierarchical-Z tests.
     pub z_range: [f32; 2],
+    /// Perspective-correct barycentrics, when set up with [`setup_all_barycentric`].
+    perspective: Option<Box<PerspectivePlanes>>,
 }
 
 impl RasterTriangle {
@@ -86,10 +140,42 @@ impl RasterTriangle {
     /// rounded once to f32 (not yet clamped; the depth format clamps).
     #[inline]
     pub fn depth_at(&self, i: u32, j: u32) -> f32 {
-        let dx = i as f64 - self.z_origin[0];
-        let dy = j as f64 - self.z_origin[1];
-        (self.z_origin[2] + self.z_slope[0] * dx + self.z_slope[1] * dy) as f32
+        self.depth.at(i, j) as f32
     }
+
+    /// The largest window-depth slope per pixel, max(|∂z/∂x|, |∂z/∂y|) (the `m` of
+    /// [`super::depth::PolygonOffset`]).
+    pub fn max_depth_slope(&self) -> f64 {
+        self.depth.max_slope()
+    }
+
+    /// The perspective-correct barycentric coordinates of the sample of pixel (i, j) with
+    /// respect to the submitted triangle's vertices (module doc, "Attributes"); `None` for a
+    /// triangle set up without them ([`setup_triangle`]).
+    #[inline]
+    pub fn barycentric_at(&self, i: u32, j: u32) -> Option<[f64; 3]> {
+        let p = self.perspective.as_deref()?;
+        let q = p.inv_w.at(i, j);
+        Some(p.b_over_w.map(|b| b.at(i, j) / q))
+    }
+
+    /// The perspective-correct interpolation of the per-vertex `values` (in the submitted
+    /// vertex order) at the sample of pixel (i, j): `Σ b_k · values[k]` in f64; `None` for a
+    /// triangle set up without barycentrics.
+    #[inline]
+    pub fn interpolate(&self, i: u32, j: u32, values: [f64; 3]) -> Option<f64> {
+        let b = self.barycentric_at(i, j)?;
+        Some(b[0] * values[0] + b[1] * values[1] + b[2] * values[2])
+    }
+}
+
+/// The target and state of triangle setup.
+#[derive(Debug, Clone, Copy)]
+struct SetupState {
+    cull: CullMode,
+    width: u32,
+    height: u32,
+    barycentric: bool,
 }
 
 /// Clip, project, snap and set up one triangle of clip-space vertices; pushes 0 or more
@@ -103,21 +189,39 @@ pub fn setup_triangle(
     out: &mut Vec<RasterTriangle>,
     counters: &mut Counters,
 ) {
+    let state = SetupState {
+        cull,
+        width,
+        height,
+        barycentric: false,
+    };
+    setup_with(tri, prim, state, out, counters);
+}
+
+const UNIT_BARYCENTRICS: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
+fn setup_with(
+    tri: &[ClipVertex; 3],
+    prim: u32,
+    state: SetupState,
+    out: &mut Vec<RasterTriangle>,
+    counters: &mut Counters,
+) {
     counters.triangles_submitted += 1;
     let before = out.len();
     if fully_inside(tri) {
-        setup_clipped(tri, prim, cull, width, height, out);
+        let v = [0, 1, 2].map(|k| (tri[k], UNIT_BARYCENTRICS[k]));
+        setup_clipped(&v, prim, state, out);
+    } else if state.barycentric {
+        let poly = clip_triangle_barycentric(tri);
+        for k in 1..poly.len().saturating_sub(1) {
+            setup_clipped(&[poly[0], poly[k], poly[k + 1]], prim, state, out);
+        }
     } else {
         let poly = clip_triangle(tri);
         for k in 1..poly.len().saturating_sub(1) {
-            setup_clipped(
-                &[poly[0], poly[k], poly[k + 1]],
-                prim,
-                cull,
-                width,
-                height,
-                out,
-            );
+            let v = [poly[0], poly[k], poly[k + 1]];
+            setup_clipped(&v.map(|c| (c, [0.0; 3])), prim, state, out);
         }
     }
     let made = (out.len() - before) as u64;
@@ -125,6 +229,57 @@ pub fn setup_triangle(
     if made == 0 {
         counters.triangles_dropped += 1;
     }
+}
+
+/// Set up every primitive (in parallel, order kept) and return the raster triangles in
+/// submission order with the setup counters.
+pub fn setup_all(
+    prims: &[[ClipVertex; 3]],
+    cull: CullMode,
+    tiling: &Tiling,
+) -> (Vec<RasterTriangle>, Counters) {
+    setup_all_with(prims, tiling, cull, false)
+}
+
+/// [`setup_all`] that also sets up perspective-correct barycentrics, so that fragments can
+/// interpolate per-vertex attributes ([`RasterTriangle::interpolate`]).
+pub fn setup_all_barycentric(
+    prims: &[[ClipVertex; 3]],
+    cull: CullMode,
+    tiling: &Tiling,
+) -> (Vec<RasterTriangle>, Counters) {
+    setup_all_with(prims, tiling, cull, true)
+}
+
+fn setup_all_with(
+    prims: &[[ClipVertex; 3]],
+    tiling: &Tiling,
+    cull: CullMode,
+    barycentric: bool,
+) -> (Vec<RasterTriangle>, Counters) {
+    let state = SetupState {
+        cull,
+        width: tiling.width,
+        height: tiling.height,
+        barycentric,
+    };
+    let parts: Vec<(Vec<RasterTriangle>, Counters)> = prims
+        .par_iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let mut out = Vec::new();
+            let mut c = Counters::default();
+            setup_with(p, k as u32, state, &mut out, &mut c);
+            (out, c)
+        })
+        .collect();
+    let mut tris = Vec::with_capacity(prims.len());
+    let mut counters = Counters::default();
+    for (t, c) in parts {
+        tris.extend(t);
+        counters += c;
+    }
+    (tris, counters)
 }
 
 /// Snapped image-space position (fixed point) and window depth of a clipped vertex, or `None`
@@ -143,18 +298,25 @@ fn window_vertex(v: ClipVertex, width: u32, height: u32) -> Option<(i64, i64, f3
     Some((x.0, y.0, zw))
 }
 
+/// Set up one clipped triangle whose vertices carry their barycentrics in the submitted
+/// triangle (ignored unless `state.barycentric`).
 fn setup_clipped(
-    tri: &[ClipVertex; 3],
+    tri: &[(ClipVertex, [f64; 3]); 3],
     prim: u32,
-    cull: CullMode,
-    width: u32,
-    height: u32,
+    state: SetupState,
     out: &mut Vec<RasterTriangle>,
 ) {
-    let [Some(a), Some(b), Some(c)] = tri.map(|c| window_vertex(c, width, height)) else {
+    let SetupState {
+        cull,
+        width,
+        height,
+        barycentric,
+    } = state;
+    let [Some(a), Some(b), Some(c)] = tri.map(|c| window_vertex(c.0, width, height)) else {
         return;
     };
     let mut v = [a, b, c];
+    let mut carried = *tri;
     // Image-space signed area ×2 (y down). Counter-clockwise in GL (y up) = negative here.
     let area = (v[1].0 - v[0].0) * (v[2].1 - v[0].1) - (v[1].1 - v[0].1) * (v[2].0 - v[0].0);
     if area == 0 {
@@ -168,6 +330,7 @@ fn setup_clipped(
     }
     if area < 0 {
         v.swap(1, 2); // make the image-space area positive: interior where every E > 0
+        carried.swap(1, 2);
     }
     let edges = [(0, 1), (1, 2), (2, 0)].map(|(p, q)| edge_function(v[p], v[q]));
 
@@ -183,29 +346,27 @@ fn setup_clipped(
         return;
     }
 
-    let px = |p: (i64, i64, f32)| {
-        (
-            p.0 as f64 / FIXED_ONE as f64,
-            p.1 as f64 / FIXED_ONE as f64,
-            p.2 as f64,
-        )
-    };
-    let (x0f, y0f, z0) = px(v[0]);
-    let (x1f, y1f, z1) = px(v[1]);
-    let (x2f, y2f, z2) = px(v[2]);
-    let det = (x1f - x0f) * (y2f - y0f) - (x2f - x0f) * (y1f - y0f);
-    let dzdx = ((z1 - z0) * (y2f - y0f) - (z2 - z0) * (y1f - y0f)) / det;
-    let dzdy = ((x1f - x0f) * (z2 - z0) - (x2f - x0f) * (z1 - z0)) / det;
+    let pos = v.map(|p| (p.0 as f64 / FIXED_ONE as f64, p.1 as f64 / FIXED_ONE as f64));
+    let depth = ScreenPlane::through(pos, v.map(|p| p.2 as f64));
     let zs = [v[0].2, v[1].2, v[2].2].map(|z| z.clamp(0.0, 1.0));
+    let perspective = barycentric.then(|| {
+        let inv_w = carried.map(|c| 1.0 / c.0 .0[3] as f64);
+        Box::new(PerspectivePlanes {
+            inv_w: ScreenPlane::through(pos, inv_w),
+            b_over_w: std::array::from_fn(|k| {
+                ScreenPlane::through(pos, std::array::from_fn(|i| carried[i].1[k] * inv_w[i]))
+            }),
+        })
+    });
 
     out.push(RasterTriangle {
         prim,
         front_facing,
         edges,
         bbox: [x0 as u32, y0 as u32, x1 as u32, y1 as u32],
-        z_origin: [x0f, y0f, z0],
-        z_slope: [dzdx, dzdy],
+        depth,
         z_range: [zs[0].min(zs[1]).min(zs[2]), zs[0].max(zs[1]).max(zs[2])],
+        perspective,
     });
 }
 
@@ -307,6 +468,62 @@ mod tests {
         // and `top` (image above): belongs to the triangle for which it is a bottom edge: `top`.
         assert!(covered(&out[2], 0, 3));
         assert!(!covered(&out[0], 0, 3));
+    }
+
+    #[test]
+    fn perspective_barycentrics_reproduce_world_positions() {
+        use crate::gpu::transform::Projection;
+        use crate::scene::Camera;
+        use glam::{DVec3, Vec3};
+        // A triangle receding in depth, one vertex behind the near plane (clipped), seen by
+        // a perspective camera: at every covered sample, the barycentric combination of the
+        // world vertices lies on the eye ray through the sample.
+        let cam = Camera {
+            eye: DVec3::new(0.0, 1.0, 3.0),
+            target: DVec3::ZERO,
+            up: DVec3::Y,
+            vfov_deg: 60.0,
+            near: Some(0.5),
+        };
+        let p = Projection::new(&cam, 32, 32, 0.5);
+        let world = [
+            Vec3::new(-2.0, 0.0, 0.0),
+            Vec3::new(2.0, 0.0, 0.5),
+            Vec3::new(0.0, 0.0, 3.4),
+        ];
+        let tri = world.map(|w| p.clip_point(w));
+        let tiling = Tiling::new(32, 32, 8).unwrap();
+        let (out, mut c) = setup_all_barycentric(&[tri], CullMode::None, &tiling);
+        assert!(out.len() >= 2, "clipped into a fan");
+        let mut checked = 0;
+        for t in &out {
+            for j in t.bbox[1]..=t.bbox[3] {
+                for i in t.bbox[0]..=t.bbox[2] {
+                    if !covered(t, i, j) {
+                        continue;
+                    }
+                    let b = t.barycentric_at(i, j).unwrap();
+                    assert!((b.iter().sum::<f64>() - 1.0).abs() < 1e-9);
+                    let x: DVec3 = (0..3).map(|k| world[k].as_dvec3() * b[k]).sum();
+                    let ray = (p.unproject(i, j, 0.5) - cam.eye).normalize();
+                    let along = (x - cam.eye).dot(ray);
+                    let off = (x - cam.eye) - ray * along;
+                    // Vertices are snapped to 1/256 pixel: allow that much of a pixel's
+                    // footprint at the point's distance.
+                    let pixel = 2.0 * (30f64).to_radians().tan() * along / 32.0;
+                    assert!(off.length() < pixel / 256.0, "({i}, {j}): {off:?}");
+                    let y = t.interpolate(i, j, [1.0, 2.0, 3.0]).unwrap();
+                    assert!((y - (b[0] + 2.0 * b[1] + 3.0 * b[2])).abs() < 1e-15);
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked > 50, "{checked}");
+        // Without barycentrics: none.
+        let mut plain = Vec::new();
+        setup_triangle(&tri, 0, CullMode::None, 32, 32, &mut plain, &mut c);
+        assert_eq!(plain[0].barycentric_at(5, 5), None);
+        assert_eq!(plain[0].depth_at(5, 5), out[0].depth_at(5, 5));
     }
 
     #[test]

@@ -5,6 +5,10 @@
 //!   `P = [[f/a,0,0,0],[0,f,0,0],[0,0,-1,-2n],[0,0,-1,0]]`, f = 1/tan(vfov/2), a = W/H.
 //!   A point extruded to infinity (w = 0) gets z_clip = w_clip, i.e. window depth exactly 1
 //!   (D24 0xFFFFFF).
+//! * Render targets seen from a light ([`super::light_view`]) use a finite frustum instead,
+//!   OpenGL's `glFrustum(l, r, b, t, n, f)` ([`Projection::frustum`]); window depth maps back
+//!   to view depth (the distance along the view axis) by one rule for both
+//!   ([`Projection::view_depth`]).
 //! * Clip coordinates are computed as (P·V)·X in f64 and rounded once to f32 ([`ClipVertex`]).
 //! * Viewport: `x_w = (x/w + 1)·W/2` and `y_gl = (y/w + 1)·H/2` in f32, OpenGL's y pointing up;
 //!   image row j is GL row H−1−j (the flip is done exactly in fixed point, see [`super::fixed`]).
@@ -43,6 +47,8 @@ pub struct Projection {
     pub height: u32,
     /// Near-plane distance actually used.
     pub near: f64,
+    /// Far-plane distance: `f64::INFINITY` for the infinite-far projection.
+    pub far: f64,
     /// P·V.
     pub view_proj: DMat4,
     /// (P·V)⁻¹, for un-projecting depth-buffer points.
@@ -71,13 +77,70 @@ impl Projection {
             DVec4::new(0.0, 0.0, -1.0, -1.0),
             DVec4::new(0.0, 0.0, -2.0 * near, 0.0),
         );
+        Self::from_matrices(width, height, near, f64::INFINITY, proj, view)
+    }
+
+    /// A finite perspective frustum for a `width`×`height` target, as `gluLookAt(eye,
+    /// eye + forward, up)` followed by `glFrustum(l, r, b, t, near, far)` with the window
+    /// `[l, r] × [b, t]` given as tangents at unit distance (`extent = [l, r, b, t]`, so the
+    /// near-plane window is `extent · near`):
+    /// `P = [[2n/(r−l),0,(r+l)/(r−l),0],[0,2n/(t−b),(t+b)/(t−b),0],[0,0,−(f+n)/(f−n),−2fn/(f−n)],[0,0,−1,0]]`.
+    pub fn frustum(
+        eye: DVec3,
+        forward: DVec3,
+        up: DVec3,
+        extent: [f64; 4],
+        near: f64,
+        far: f64,
+        size: [u32; 2],
+    ) -> Self {
+        let view = DMat4::look_at_rh(eye, eye + forward, up);
+        let [l, r, b, t] = extent.map(|e| e * near);
+        let (n, f) = (near, far);
+        let proj = DMat4::from_cols(
+            DVec4::new(2.0 * n / (r - l), 0.0, 0.0, 0.0),
+            DVec4::new(0.0, 2.0 * n / (t - b), 0.0, 0.0),
+            DVec4::new(
+                (r + l) / (r - l),
+                (t + b) / (t - b),
+                -(f + n) / (f - n),
+                -1.0,
+            ),
+            DVec4::new(0.0, 0.0, -2.0 * f * n / (f - n), 0.0),
+        );
+        Self::from_matrices(size[0], size[1], near, far, proj, view)
+    }
+
+    fn from_matrices(
+        width: u32,
+        height: u32,
+        near: f64,
+        far: f64,
+        proj: DMat4,
+        view: DMat4,
+    ) -> Self {
         let view_proj = proj * view;
         Self {
             width,
             height,
             near,
+            far,
             view_proj,
             inv_view_proj: view_proj.inverse(),
+        }
+    }
+
+    /// The view depth (distance along the view axis, > 0 in front) that window depth `z_w`
+    /// stands for, in f64 — the inverse of the projection's depth mapping: `n / (1 − z_w)`
+    /// for the infinite far plane, `f·n / (f − z_w·(f − n))` for a finite frustum (Wyman &
+    /// Hansen's `ConvertToWorldSpace`). Monotone in `z_w` (every step is a correctly rounded
+    /// monotone operation), so window-depth order and view-depth order agree.
+    pub fn view_depth(&self, z_w: f64) -> f64 {
+        let (n, f) = (self.near, self.far);
+        if f.is_finite() {
+            f * n / (f - z_w * (f - n))
+        } else {
+            n / (1.0 - z_w)
         }
     }
 
@@ -224,6 +287,35 @@ mod tests {
         let v = p.clip_point(Vec3::new(0.0, 0.0, 4.5));
         let w = viewport(v, 64, 32);
         assert_eq!(w, [32.0, 16.0, 0.0]);
+    }
+
+    #[test]
+    fn frustum_maps_near_and_far_and_view_depth_inverts_it() {
+        // Looking down −z from the origin, window [−1, 1] × [−0.5, 0.5] at unit distance.
+        let p = Projection::frustum(
+            DVec3::ZERO,
+            DVec3::new(0.0, 0.0, -1.0),
+            DVec3::Y,
+            [-1.0, 1.0, -0.5, 0.5],
+            2.0,
+            10.0,
+            [64, 32],
+        );
+        let near = viewport(p.clip_point(Vec3::new(0.0, 0.0, -2.0)), 64, 32);
+        let far = viewport(p.clip_point(Vec3::new(0.0, 0.0, -10.0)), 64, 32);
+        assert_eq!(near[2], 0.0);
+        assert!((far[2] - 1.0).abs() < 1e-6, "{far:?}");
+        // The corner of the window at distance 5 maps to the corner of the viewport.
+        let corner = viewport(p.clip_point(Vec3::new(5.0, 2.5, -5.0)), 64, 32);
+        assert!((corner[0] - 64.0).abs() < 1e-4 && (corner[1] - 32.0).abs() < 1e-4);
+        for d in [2.0, 3.0, 7.5, 10.0] {
+            let z = p.window_depth(DVec3::new(0.3, -0.1, -d)).unwrap();
+            assert!((p.view_depth(z) - d).abs() < 1e-12 * d, "{d}");
+        }
+        // The infinite projection: the same rule with f = ∞.
+        let q = Projection::new(&cam(), 64, 64, 0.5);
+        let z = q.window_depth(DVec3::new(0.0, 0.0, 1.0)).unwrap();
+        assert!((q.view_depth(z) - 4.0).abs() < 1e-12);
     }
 
     #[test]

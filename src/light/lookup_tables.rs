@@ -35,6 +35,7 @@
 //!   exact.
 
 use crate::gpu::split_blend::SplitFormat;
+use crate::gpu::texture::{sample_2d, Wrap};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 use std::sync::OnceLock;
 
@@ -45,14 +46,8 @@ pub const AREA_TABLE_SIZE: usize = 256;
 /// Entries of the split table (Paper IV §6).
 pub const SPLIT_TABLE_SIZE: usize = 1024;
 
-/// How a table is filtered.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-pub enum TableFilter {
-    /// The texel whose center is nearest.
-    Nearest,
-    /// Bilinear interpolation of the four nearest texel centers.
-    Bilinear,
-}
+/// How a table is filtered (the GPU's texture filters, [`crate::gpu::texture::Filter`]).
+pub type TableFilter = crate::gpu::texture::Filter;
 
 /// A single-channel 2D texture of unsigned normalized texels (8 or 16 bits), wrapped
 /// (GL_REPEAT) in both coordinates, texel centers at +0.5.
@@ -78,28 +73,16 @@ impl UnormTexture2D {
         ((1u32 << self.bits) - 1) as f64
     }
 
-    fn texel(&self, i: i64, j: i64) -> f64 {
-        let i = i.rem_euclid(self.width as i64) as usize;
-        let j = j.rem_euclid(self.height as i64) as usize;
-        self.texels[j * self.width + i] as f64 / self.max()
+    fn texel(&self, i: u32, j: u32) -> f64 {
+        self.texels[j as usize * self.width + i as usize] as f64 / self.max()
     }
 
-    /// Sample at texture coordinates (s, t) (1.0 = one full width/height).
+    /// Sample at texture coordinates (s, t) (1.0 = one full width/height), wrapped
+    /// ([`crate::gpu::texture::sample_2d`]).
     pub fn sample(&self, s: f64, t: f64, filter: TableFilter) -> f64 {
-        let x = s * self.width as f64;
-        let y = t * self.height as f64;
-        match filter {
-            TableFilter::Nearest => self.texel(x.floor() as i64, y.floor() as i64),
-            TableFilter::Bilinear => {
-                let (x, y) = (x - 0.5, y - 0.5);
-                let (i, j) = (x.floor(), y.floor());
-                let (fx, fy) = (x - i, y - j);
-                let (i, j) = (i as i64, j as i64);
-                let top = self.texel(i, j) * (1.0 - fx) + self.texel(i + 1, j) * fx;
-                let bottom = self.texel(i, j + 1) * (1.0 - fx) + self.texel(i + 1, j + 1) * fx;
-                top * (1.0 - fy) + bottom * fy
-            }
-        }
+        let size = [self.width as u32, self.height as u32];
+        let (x, y) = (s * self.width as f64, t * self.height as f64);
+        sample_2d(x, y, size, Wrap::Repeat, filter, |i, j| self.texel(i, j))
     }
 }
 

@@ -8,6 +8,7 @@ pub mod light_average;
 pub mod nsample;
 pub mod options;
 pub mod output;
+pub mod penumbra_map;
 pub mod pw2002;
 pub mod pw_restructured;
 pub mod raycast;
@@ -33,6 +34,7 @@ pub const ALL: &[&str] = &[
     "ssv-optimized",
     "ssv",
     "wedge-blending",
+    "penumbra-map",
 ];
 
 /// The reference every other method's error is measured against.
@@ -70,8 +72,11 @@ pub fn supports(method: &str, shape: &LightShape) -> bool {
             let _ = shape;
             true
         }
-        // Penumbra wedges are built for spherical lights only (Paper I §4).
-        "pw2002" | "pw-restructured" => matches!(shape, LightShape::Sphere { .. }),
+        // Penumbra wedges are built for spherical lights only (Paper I §4); penumbra maps
+        // use spherical lights (Wyman & Hansen §4).
+        "pw2002" | "pw-restructured" | "penumbra-map" => {
+            matches!(shape, LightShape::Sphere { .. })
+        }
         // Paper IV §4.2: the rectangular and the spherical shader.
         "ssv-optimized" => matches!(shape, LightShape::Rect { .. } | LightShape::Sphere { .. }),
         // Paper III §3.2.2, §3.3: rectangular and textured rectangular lights; §5.3: spheres.
@@ -147,6 +152,7 @@ fn run_one_light(method: &str, frame: &Frame) -> Result<MethodOutput, InputError
         "pw2002" => pw2002::run(frame),
         "pw-restructured" => pw_restructured::run(frame),
         "wedge-blending" => wedge_blending::run(frame),
+        "penumbra-map" => penumbra_map::run(frame),
         _ => Err(InputError::at(
             &frame.scene.source,
             "methods",
@@ -261,6 +267,7 @@ fn check_options_one_light(method: &str, frame: &Frame) -> Result<(), InputError
         "ssv" => ssv::read_settings(frame).map(drop),
         "ssv-optimized" => ssv_optimized::options(frame).map(drop),
         "wedge-blending" => wedge_blending::options(frame).map(drop),
+        "penumbra-map" => penumbra_map::read_settings(frame).map(drop),
         _ => Err(InputError::at(
             &frame.scene.source,
             "methods",

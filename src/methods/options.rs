@@ -3,6 +3,7 @@
 //! `options.METHOD.KEY`.
 
 use crate::error::InputError;
+use crate::gpu::depth::DepthFormat;
 use crate::scene::{OptionValue, Scene};
 use std::collections::BTreeMap;
 
@@ -74,6 +75,38 @@ impl OptionReader {
                 ),
             )),
         }
+    }
+
+    /// A number option (an integer or a float) in `range`.
+    pub fn float(
+        &mut self,
+        key: &str,
+        default: f64,
+        range: std::ops::RangeInclusive<f64>,
+    ) -> Result<f64, InputError> {
+        match self.table.remove(key) {
+            None => Ok(default),
+            Some(OptionValue::Float(x)) if range.contains(&x) => Ok(x),
+            Some(OptionValue::Int(i)) if range.contains(&(i as f64)) => Ok(i as f64),
+            Some(v) => Err(self.err(
+                key,
+                format!(
+                    "expected a number in {}..={}, got {v}",
+                    range.start(),
+                    range.end()
+                ),
+            )),
+        }
+    }
+
+    /// A depth format option: one of [`DepthFormat::OPTION_NAMES`].
+    pub fn depth_format(
+        &mut self,
+        key: &str,
+        default: DepthFormat,
+    ) -> Result<DepthFormat, InputError> {
+        let name = self.choice(key, &DepthFormat::OPTION_NAMES, default.option_name())?;
+        Ok(DepthFormat::from_option(name).unwrap_or(default))
     }
 
     /// Error for the first key nobody asked for.

@@ -530,6 +530,7 @@ mod tests {
                 plan: serde_json::json!({"passes": ["scene-depth"]}),
                 passes: vec![],
                 totals: Counters::default(),
+                clamped_pixels: 0,
             },
         }
     }

@@ -1,0 +1,713 @@
+//! `penumbra-map`: penumbra maps (Wyman & Hansen, "Penumbra Maps: Approximate Soft Shadows in
+//! Real-Time", EGSR 2003), the one image-space method: a shadow map for the umbra and a second
+//! map holding the penumbra intensity on the surfaces the shadow map sees.
+//!
+//! Three passes on the emulated GPU, all through the same fixed-point rasterizer, fill rule
+//! and depth rules as every other pass ([`crate::gpu::light_view`]):
+//!
+//! 1. **Shadow map** (§3 "the first pass renders a standard shadow map from the viewpoint of a
+//!    point light source at the approximate center of the light"): the scene from the light
+//!    center into a `map_size`² depth target (`depth`, default the frame's format, D24), back
+//!    faces culled. The depth bias is a polygon offset ([`PolygonOffset`],
+//!    `glPolygonOffset(slope_bias, bias)`): `bias` in units of the format's resolvable
+//!    difference (one D24 or D16 step, default 4) and `slope_bias`, the slope-scaled factor
+//!    (default 1). The paper's "larger bias" (§5) compensates for shadows of simplified models
+//!    cast onto full models; here both are the same mesh, and what the method needs is the
+//!    slope-scaled part: the fitted light view is not perpendicular to any floor, so a
+//!    receiver half a texel from the texel center differs in depth by up to the surface's
+//!    depth slope m, so half of a tilted lit surface shadows itself without a slope term
+//!    (tested). Measured at 256², RMSE vs `raycast` on `cube-of-spheres-sphere` / `pw-columns`
+//!    / `pw-fractal` / `pw-2002`: 0.535 / 0.548 / 0.346 / 0.577 without slope bias (1000
+//!    units instead: 0.389 / 0.535 / 0.341 / 0.540), 0.278 / 0.262 / 0.181 / 0.299 with
+//!    factor 0.5, 0.173 / 0.138 / 0.149 / 0.185 with 1 (default), 0.174 / 0.155 / 0.168 /
+//!    0.185 with 2 (light leaks grow); 0, 4 or 64 units change nothing visible at D24.
+//!    `bias_stage` chooses where the offset applies: `render` (default) offsets the shadow
+//!    map as it is drawn, so pass 2 reads the offset depths too — near an occluder's own
+//!    silhouette, where its surface is seen edge-on and the slope term is large, the offset
+//!    pushes the surface behind the silhouette, a cone's fragments pass line (4) there and
+//!    darken a few lit texels; `lookup` keeps the shadow map exact and moves the receiver
+//!    toward the light in the screen pass's test by the offset its own triangle has in the
+//!    light view ([`LightView::depth_slopes`]) — fewer dark specks but more light leaks on
+//!    steep receivers, whose own slope is large. Measured at 256² (pixels `raycast` sees
+//!    fully lit, ≥ 0.99, that come out below 0.5 / pixels `raycast` sees dark, ≤ 0.01, that
+//!    come out above 0.5) on the same four scenes: render 72/26, 283/261, 197/361, 180/16;
+//!    lookup 49/45, 268/322, 140/815, 166/888 (RMSE 0.173, 0.141, 0.173, 0.217).
+//! 2. **Penumbra map** (§3): the silhouette from the light center (possible silhouette edges
+//!    and their loops), a cone per silhouette vertex and an outer sheet per silhouette edge
+//!    ([`crate::geometry::penumbra_cones`]; `cone_segments` triangles per cone), drawn into a
+//!    map with a colour channel (`storage = unorm8|f16|f32`, [`ColorFormat`]; unorm8 as a
+//!    p-buffer of 2003 held it) cleared to white and a depth channel (the light view's format)
+//!    cleared to 1.0, both facings, in the order of
+//!    [`crate::geometry::penumbra_cones::cones_and_sheets`]. The fragment program, line by
+//!    line as the paper's pseudocode:
+//!    * (1)–(3) `Z_P` = the shadow map at the fragment's own window coordinates (same
+//!      resolution and matrices, so the same texel), `Z_F` = the fragment's interpolated
+//!      window depth (f32);
+//!    * (4) discard if `Z_F > Z_P` (the cone or sheet lies behind the surface);
+//!    * (5)–(6) `Z_P′`, `Z_F′`: both converted to view depths by the projection's one rule
+//!      ([`crate::gpu::transform::Projection::view_depth`]);
+//!    * `Z_v`: constant on cones; on sheets interpolated perspective-correctly by the
+//!      rasterizer ([`crate::gpu::setup::RasterTriangle::interpolate`]);
+//!    * (7) `I = (Z_F′ − Z_v)/(Z_P′ − Z_v)`; (8) `I′ = 3I² − 2I³` (`falloff = smoothstep`,
+//!      default, the Bernstein interpolant of §3) or `I′ = I` (`falloff = linear`);
+//!    * (9)–(10) `I′` to the colour channel and to the depth channel, depth test LESS with
+//!      writes: where cones and sheets overlap, the darkest wins (§3, Fig. 6).
+//!
+//!    Choices where the pseudocode divides by zero or leaves [0, 1] (each counted in
+//!    [`ProgramStats`], asserted in the tests): a fragment is also discarded when
+//!    `Z_P′ ≤ Z_v` — the surface is not beyond the silhouette vertex, so it is not in that
+//!    vertex's penumbra (at a cone's tip on the occluder the paper's I is 0/0) — and when
+//!    `Z_F′ < Z_v` — the fragment lies in front of its silhouette point, which only rounding
+//!    can produce (at the sheet's silhouette edge, where the interpolated `Z_v` and the
+//!    rasterized depth meet). After these, `0 ≤ Z_F′ − Z_v ≤ Z_P′ − Z_v` with a positive
+//!    denominator, so `I` is in [0, 1] by construction; the count of `I` outside [0, 1]
+//!    (before any falloff or storage clamp) is kept to prove it. The program computes in f64.
+//! 3. **Screen** (§3 "for each pixel rendered from the camera's viewpoint, a comparison with the
+//!    depth in the shadow map determines if the pixel is completely shadowed. If not fully
+//!    shadowed, a lookup into the penumbra map gives an approximation of the light"): the
+//!    paper's third pass is a forward pass whose fragment program gets the light-space
+//!    position interpolated from the vertices, i.e. the point of the visible triangle at the
+//!    pixel center ([`Frame::primary_ray_receivers`]; the depth-buffer point would add the
+//!    camera's depth quantization, hundreds of light-map depth steps, to every comparison).
+//!    Its window position in the light view ([`LightView::window`], f32), the shadow-map test
+//!    at the nearest texel (`quantize(z) > stored` → umbra, visibility 0; the comparison is
+//!    always nearest: the umbra is the hard shadow) and otherwise the penumbra map sampled
+//!    with `filter` (`nearest`, default, as the paper, or `bilinear`), clamped to the edge.
+//!    Values outside [0, 1] before the final clamp are counted ([`ScreenStats`]).
+//!
+//! Lights: spheres only (the paper's, §4); every other shape is rejected by the registry.
+//! Several lights: one shadow map and one penumbra map per light (§3, last paragraph), run once
+//! per light and averaged ([`super::light_average`]).
+//!
+//! The paper's limits follow from the construction and are measured in
+//! `tests/penumbra_map.rs`: the penumbra is outer only (inside the hard shadow nothing is lit),
+//! the umbra does not shrink as the light grows (§4.1), shadows harden where occluder and
+//! receiver touch, and the shadow map's resolution shows as aliasing. Against `raycast` the
+//! method is less accurate than the plain hard shadow (`hard-sv`) on every sphere-light
+//! built-in (256², RMSE: `cube-of-spheres-sphere` 0.173 vs 0.124, `pw-columns` 0.138 vs
+//! 0.072, `pw-fractal` 0.149 vs 0.083): the whole 0 → 1 transition is put in the outer half
+//! of the penumbra, where the true visibility only rises from about 0.5, and I is linear in
+//! depth along the cone, not across the penumbra (halfway across a sheet from a silhouette at
+//! view depth 2 to a receiver at 3, I = 0.4 and I′ = 0.35; `raycast` there is about 0.8).
+
+use super::options::OptionReader;
+use super::output::{MethodOutput, PassStats, Visibility};
+use crate::error::InputError;
+use crate::frame::Frame;
+use crate::geometry::penumbra_cones::{cones_and_sheets, silhouettes, ConeLight, PenumbraGeometry};
+use crate::gpu::buffers::{alloc_tiles, DepthTile};
+use crate::gpu::color::{ColorFormat, ColorTile};
+use crate::gpu::counters::Counters;
+use crate::gpu::depth::{DepthFormat, DepthState, PolygonOffset};
+use crate::gpu::light_view::{LightView, MAX_LIGHT_VIEW_HALF_ANGLE_DEG};
+use crate::gpu::raster::{bin, draw, no_tile_culling, Fragment};
+use crate::gpu::setup::{setup_all_barycentric, CullMode};
+use crate::gpu::texture::Filter;
+use crate::gpu::tiling::Tiling;
+use crate::plan::{BufferPlan, MethodPlan};
+use crate::scene::LightShape;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::ops::AddAssign;
+use std::time::Instant;
+
+/// The default polygon-offset units of the shadow map (`bias`): resolvable-difference steps.
+pub const DEFAULT_BIAS_UNITS: f64 = 4.0;
+/// The default slope-scaled polygon-offset factor of the shadow map (`slope_bias`).
+pub const DEFAULT_SLOPE_BIAS: f64 = 1.0;
+/// The largest `map_size`: the three map buffers (shadow map, penumbra colour and depth) of
+/// 4096² texels take 200 MB as stored; the paper's maps are 1024².
+pub const MAX_MAP_SIZE: u32 = 4096;
+/// The default number of triangles per cone (`cone_segments`).
+pub const DEFAULT_CONE_SEGMENTS: u32 = 16;
+
+/// How the penumbra intensity falls off across the penumbra (§3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Falloff {
+    /// `I′ = 3I² − 2I³` (Parker et al.'s approximation of the spherical light's falloff).
+    Smoothstep,
+    /// `I′ = I`.
+    Linear,
+}
+
+impl Falloff {
+    /// `I′` of `I`.
+    pub fn apply(self, i: f64) -> f64 {
+        match self {
+            Falloff::Smoothstep => 3.0 * i * i - 2.0 * i * i * i,
+            Falloff::Linear => i,
+        }
+    }
+}
+
+/// Where the shadow-map bias is applied (module doc, pass 1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum BiasStage {
+    /// In the screen pass's shadow-map test: the receiver's depth is moved toward the light
+    /// by the offset its own triangle would get from `glPolygonOffset` in the light view.
+    /// The shadow map holds the surfaces' depths, so pass 2 sees them unbiased.
+    Lookup,
+    /// `glPolygonOffset` while rendering the shadow map: both the test and pass 2 read the
+    /// offset depths.
+    Render,
+}
+
+/// The settings of one `penumbra-map` render (module doc).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PenumbraMapSettings {
+    /// Edge of the shadow and penumbra maps in texels.
+    pub map_size: u32,
+    /// Depth format of the shadow map and of the penumbra map's depth channel.
+    pub depth: DepthFormat,
+    /// The shadow-map bias: `bias` (units) and `slope_bias` (factor).
+    pub offset: PolygonOffset,
+    /// Where the bias is applied.
+    pub bias_stage: BiasStage,
+    /// Triangles per cone.
+    pub cone_segments: u32,
+    /// Intensity falloff.
+    pub falloff: Falloff,
+    /// Storage format of the penumbra map's colour channel.
+    pub storage: ColorFormat,
+    /// Filter of the penumbra-map lookup in the screen pass.
+    pub filter: Filter,
+}
+
+/// Read and check `[options.penumbra-map]` (module doc) for `frame`.
+pub fn read_settings(frame: &Frame) -> Result<PenumbraMapSettings, InputError> {
+    let scene = frame.scene;
+    let mut r = OptionReader::new(scene, "penumbra-map");
+    let map_size = r.uint(
+        "map_size",
+        scene.width.max(scene.height).min(MAX_MAP_SIZE) as u64,
+        8..=MAX_MAP_SIZE as u64,
+    )? as u32;
+    let depth = r.depth_format("depth", frame.gpu.depth)?;
+    let units = r.float("bias", DEFAULT_BIAS_UNITS, 0.0..=16_777_215.0)?;
+    let factor = r.float("slope_bias", DEFAULT_SLOPE_BIAS, 0.0..=1000.0)?;
+    let bias_stage = match r.choice("bias_stage", &["render", "lookup"], "render")? {
+        "lookup" => BiasStage::Lookup,
+        _ => BiasStage::Render,
+    };
+    let cone_segments = r.uint("cone_segments", DEFAULT_CONE_SEGMENTS as u64, 3..=1024)? as u32;
+    let falloff = match r.choice("falloff", &["smoothstep", "linear"], "smoothstep")? {
+        "linear" => Falloff::Linear,
+        _ => Falloff::Smoothstep,
+    };
+    let storage = r.choice("storage", &ColorFormat::OPTION_NAMES, "unorm8")?;
+    let storage = ColorFormat::from_option(storage).unwrap_or(ColorFormat::Unorm8);
+    let filter = match r.choice("filter", &["nearest", "bilinear"], "nearest")? {
+        "bilinear" => Filter::Bilinear,
+        _ => Filter::Nearest,
+    };
+    r.finish()?;
+    Ok(PenumbraMapSettings {
+        map_size,
+        depth,
+        offset: PolygonOffset { factor, units },
+        bias_stage,
+        cone_segments,
+        falloff,
+        storage,
+        filter,
+    })
+}
+
+/// What the penumbra-map fragment program did (module doc, pass 2).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct ProgramStats {
+    /// Fragments that ran the program.
+    pub fragments: u64,
+    /// Discarded by line (4): `Z_F > Z_P`.
+    pub discarded_behind_surface: u64,
+    /// Discarded because `Z_P′ ≤ Z_v` (the surface is not beyond the silhouette point).
+    pub discarded_surface_not_beyond_silhouette: u64,
+    /// Discarded because `Z_F′ < Z_v` (the fragment is in front of its silhouette point).
+    pub discarded_in_front_of_silhouette: u64,
+    /// Fragments whose `I` was not a number in [0, 1] (before the falloff and the storage).
+    pub intensity_out_of_range: u64,
+    /// Fragments that passed the LESS test and were written.
+    pub written: u64,
+}
+
+/// What the screen pass found (module doc, pass 3).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct ScreenStats {
+    /// Receiver pixels shaded.
+    pub receivers: u64,
+    /// Pixels in the umbra (failed the shadow-map test).
+    pub umbra: u64,
+    /// Pixels outside the umbra with a penumbra-map value below 1.
+    pub penumbra: u64,
+    /// Receivers not in front of the light (w ≤ 0 in the light view): lit, no lookup.
+    pub behind_light: u64,
+    /// Values outside [0, 1] (or not a number) before the final clamp.
+    pub out_of_range: u64,
+}
+
+/// `AddAssign` as the field-wise sum, for the per-tile and per-row tallies above.
+macro_rules! field_sum {
+    ($t:ty { $($f:ident),* }) => {
+        impl AddAssign for $t {
+            fn add_assign(&mut self, o: Self) {
+                $(self.$f += o.$f;)*
+            }
+        }
+    };
+}
+
+field_sum!(ProgramStats {
+    fragments,
+    discarded_behind_surface,
+    discarded_surface_not_beyond_silhouette,
+    discarded_in_front_of_silhouette,
+    intensity_out_of_range,
+    written
+});
+field_sum!(ScreenStats {
+    receivers,
+    umbra,
+    penumbra,
+    behind_light,
+    out_of_range
+});
+
+/// Per-tile storage of the penumbra map.
+struct PenumbraTile {
+    color: ColorTile,
+    depth: DepthTile,
+    stats: ProgramStats,
+}
+
+/// The result of the three passes.
+#[derive(Debug, Clone)]
+pub struct PenumbraMapRender {
+    /// Visibility per pixel, row-major, clamped to [0, 1]; background 1.
+    pub visibility: Visibility,
+    /// The light view the maps were rendered in.
+    pub view: LightView,
+    /// The shadow map, tile-major in `view.tiling`.
+    pub shadow_map: Vec<DepthTile>,
+    /// The penumbra map's colour channel, tile-major in `view.tiling`.
+    pub penumbra_map: Vec<ColorTile>,
+    /// The cones and sheets.
+    pub geometry: PenumbraGeometry,
+    /// Silhouette edges, loops and the largest vertex degree over all meshes.
+    pub silhouette: (usize, usize, u32),
+    /// What the fragment program did.
+    pub program: ProgramStats,
+    /// What the screen pass found.
+    pub screen: ScreenStats,
+    /// The passes after the scene pass: shadow map, silhouettes, penumbra map, screen.
+    pub passes: Vec<PassStats>,
+}
+
+fn pass(name: &str, start: Instant, counters: Counters) -> PassStats {
+    PassStats {
+        name: name.into(),
+        wall_seconds: start.elapsed().as_secs_f64(),
+        runs: 1,
+        counters,
+    }
+}
+
+/// Render `penumbra-map` with `s` on `frame` (one sphere light).
+pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRender, InputError> {
+    let scene = frame.scene;
+    let light = scene.light();
+    let LightShape::Sphere { radius } = light.shape else {
+        return Err(InputError::at(
+            &scene.source,
+            scene.light_object(0, "light"),
+            "penumbra maps need a sphere light",
+        ));
+    };
+    let tiling = Tiling::new(s.map_size, s.map_size, frame.tiling.tile)
+        .map_err(|e| InputError::at(&scene.source, "options.penumbra-map.map_size", e))?;
+    let view = LightView::fit(scene, light.center, tiling, s.depth).map_err(|u| {
+        let m = &scene.meshes[u.mesh];
+        InputError::at(
+            &scene.source,
+            scene.light_object(0, "light"),
+            format!(
+                "one light frustum cannot cover the scene: vertex {} ({}, {}, {}) of meshes[{}] \
+                 ({}) is {:.1}° from the light's view axis (limit {MAX_LIGHT_VIEW_HALF_ANGLE_DEG}°); \
+                 penumbra maps need every receiver in front of the light center",
+                u.vertex, u.position.x, u.position.y, u.position.z, u.mesh, m.name, u.angle_deg
+            ),
+        )
+    })?;
+
+    // Pass 1: the shadow map.
+    let t = Instant::now();
+    let render_offset = match s.bias_stage {
+        BiasStage::Render => s.offset,
+        BiasStage::Lookup => PolygonOffset::NONE,
+    };
+    let (shadow_map, c1) = view.render_depth(scene, render_offset);
+    let pass1 = pass("shadow-map", t, c1);
+
+    // The silhouette from the light center (CPU; the paper's 30 %).
+    let t = Instant::now();
+    let meshes: Vec<_> = scene.meshes.iter().zip(&frame.adjacency).collect();
+    let sils = silhouettes(&meshes, light.center).map_err(|(i, e)| {
+        InputError::at(
+            &scene.source,
+            format!("meshes[{i}] ({})", scene.meshes[i].name),
+            e,
+        )
+    })?;
+    let pass_sil = pass("silhouettes", t, Counters::default());
+
+    // Pass 2: cones and sheets into the penumbra map.
+    let t = Instant::now();
+    let mesh_refs: Vec<_> = scene.meshes.iter().collect();
+    let geometry = cones_and_sheets(
+        &mesh_refs,
+        &sils,
+        &cone_light(&view, radius),
+        s.cone_segments,
+    );
+    let (color, program, c2) = render_penumbra_map(&view, &shadow_map, &geometry, s);
+    let pass2 = pass("penumbra-map", t, c2);
+
+    // Pass 3: the screen.
+    let t = Instant::now();
+    let (visibility, screen, c3) = screen_pass(frame, &view, &shadow_map, &color, s);
+    let pass3 = pass("screen", t, c3);
+
+    let silhouette = (
+        sils.iter().map(|m| m.edges.len()).sum(),
+        sils.iter().map(|m| m.loops.len()).sum(),
+        sils.iter().map(|m| m.max_vertex_degree).max().unwrap_or(0),
+    );
+    Ok(PenumbraMapRender {
+        visibility,
+        view,
+        shadow_map,
+        penumbra_map: color,
+        geometry,
+        silhouette,
+        program,
+        screen,
+        passes: vec![pass1, pass_sil, pass2, pass3],
+    })
+}
+
+/// Why the penumbra-map fragment program discards a fragment (module doc, pass 2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Discard {
+    /// Line (4): `Z_F > Z_P`, the cone or sheet lies behind the surface.
+    BehindSurface,
+    /// `Z_P′ ≤ Z_v`: the surface is not beyond the silhouette point.
+    SurfaceNotBeyondSilhouette,
+    /// `Z_F′ < Z_v`: the fragment lies in front of its silhouette point (rounding only).
+    InFrontOfSilhouette,
+}
+
+/// Lines (3)–(7) of the penumbra-map fragment program (module doc, pass 2): the intensity
+/// `I` of a fragment at interpolated window depth `z_f` over a shadow-map surface at window
+/// depth `z_p`, for the silhouette point at view depth `z_v`, depths converted by `proj`.
+pub fn penumbra_intensity(
+    z_f: f32,
+    z_p: f64,
+    z_v: f64,
+    proj: &crate::gpu::transform::Projection,
+) -> Result<f64, Discard> {
+    let z_f = z_f as f64;
+    if z_f > z_p {
+        return Err(Discard::BehindSurface);
+    }
+    let (z_p, z_f) = (proj.view_depth(z_p), proj.view_depth(z_f));
+    if z_p <= z_v {
+        return Err(Discard::SurfaceNotBeyondSilhouette);
+    }
+    if z_f < z_v {
+        return Err(Discard::InFrontOfSilhouette);
+    }
+    Ok((z_f - z_v) / (z_p - z_v))
+}
+
+/// The light of radius `radius` as the cones and sheets see it from `view`: its center, the
+/// view axis and the far plane.
+pub fn cone_light(view: &LightView, radius: f32) -> ConeLight {
+    ConeLight {
+        center: view.center,
+        axis: view.axis,
+        far: view.proj.far,
+        radius: radius as f64,
+    }
+}
+
+/// Pass 2 (module doc): draw the cones and sheets of `geometry` over `shadow_map` (both in
+/// `view`) into a penumbra map; returns its colour tiles, the program's stats and the pass
+/// counters.
+pub fn render_penumbra_map(
+    view: &LightView,
+    shadow_map: &[DepthTile],
+    geometry: &PenumbraGeometry,
+    s: &PenumbraMapSettings,
+) -> (Vec<ColorTile>, ProgramStats, Counters) {
+    let prims: Vec<_> = geometry
+        .triangles
+        .iter()
+        .map(|t| t.corners.map(|p| view.clip_point(p)))
+        .collect();
+    let (tris, mut counters) = setup_all_barycentric(&prims, CullMode::None, &view.tiling);
+    let bins = bin(&view.tiling, &tris);
+    let mut tiles = alloc_tiles(&view.tiling, |_, len| PenumbraTile {
+        color: ColorTile::cleared(s.storage, 1.0, len),
+        depth: DepthTile::cleared(view.depth, len),
+        stats: ProgramStats::default(),
+    });
+    let less = DepthState::LESS_WRITE;
+    let format = view.depth;
+    counters += draw(
+        &view.tiling,
+        &mut tiles,
+        &tris,
+        &bins,
+        no_tile_culling,
+        |t, tile, tri, f, c| {
+            let PenumbraTile {
+                color,
+                depth,
+                stats: st,
+            } = tile;
+            c.fragments_shaded += 1;
+            st.fragments += 1;
+            let z_p = shadow_map[t].read(f.local, c);
+            let z_v = tri
+                .interpolate(f.x, f.y, geometry.triangles[tri.prim as usize].z_v)
+                .expect("penumbra triangles are set up with barycentrics");
+            let i = match penumbra_intensity(f.z, format.to_window(z_p), z_v, &view.proj) {
+                Ok(i) => i,
+                Err(Discard::BehindSurface) => {
+                    st.discarded_behind_surface += 1;
+                    return;
+                }
+                Err(Discard::SurfaceNotBeyondSilhouette) => {
+                    st.discarded_surface_not_beyond_silhouette += 1;
+                    return;
+                }
+                Err(Discard::InFrontOfSilhouette) => {
+                    st.discarded_in_front_of_silhouette += 1;
+                    return;
+                }
+            };
+            if !(0.0..=1.0).contains(&i) {
+                st.intensity_out_of_range += 1;
+            }
+            let i = s.falloff.apply(i);
+            // (9)–(10): colour and depth, LESS: the darkest wins.
+            let out = Fragment { z: i as f32, ..f };
+            if depth.test_and_write(&less, &out, c) {
+                color.write(f.local, i, c);
+                st.written += 1;
+            }
+        },
+    );
+    let mut program = ProgramStats::default();
+    let mut color = Vec::with_capacity(tiles.len());
+    for t in tiles {
+        program += t.stats;
+        color.push(t.color);
+    }
+    (color, program, counters)
+}
+
+/// Pass 3 (module doc): visibility per pixel, the screen stats, the counters.
+fn screen_pass(
+    frame: &Frame,
+    view: &LightView,
+    shadow_map: &[DepthTile],
+    penumbra_map: &[ColorTile],
+    s: &PenumbraMapSettings,
+) -> (Visibility, ScreenStats, Counters) {
+    let receivers = frame.primary_ray_receivers();
+    let prims = frame.prim_ids();
+    let slopes = match s.bias_stage {
+        BiasStage::Lookup => view.depth_slopes(frame.scene),
+        BiasStage::Render => Vec::new(),
+    };
+    let width = frame.scene.width as usize;
+    let depth_bytes = view.depth.bytes();
+    let taps = match s.filter {
+        Filter::Nearest => 1,
+        Filter::Bilinear => 4,
+    };
+    let rows: Vec<(Vec<f32>, ScreenStats, Counters)> = receivers
+        .par_chunks(width)
+        .zip(prims.par_chunks(width))
+        .map(|(row, row_prims)| {
+            let mut st = ScreenStats::default();
+            let mut c = Counters::default();
+            let values = row
+                .iter()
+                .zip(row_prims)
+                .map(|(r, prim)| {
+                    let Some(r) = r else {
+                        return 1.0;
+                    };
+                    st.receivers += 1;
+                    c.fragments_shaded += 1;
+                    let Some([x, y, z]) = view.window(r.point) else {
+                        st.behind_light += 1;
+                        return 1.0;
+                    };
+                    c.depth_read_bytes += depth_bytes;
+                    let z = match slopes.get(*prim as usize) {
+                        Some(&(m, z_max)) => {
+                            (z as f64 - s.offset.amount(view.depth, m, z_max)) as f32
+                        }
+                        None => z,
+                    };
+                    if !view.lit(shadow_map, [x, y, z]) {
+                        st.umbra += 1;
+                        return 0.0;
+                    }
+                    c.color_read_bytes += taps * s.storage.bytes();
+                    let v = view.sample(x, y, s.filter, |t, l| penumbra_map[t].value(l) as f64);
+                    if !(0.0..=1.0).contains(&v) {
+                        st.out_of_range += 1;
+                    }
+                    st.penumbra += (v < 1.0) as u64;
+                    v.clamp(0.0, 1.0) as f32
+                })
+                .collect();
+            (values, st, c)
+        })
+        .collect();
+    let mut values = Vec::with_capacity(receivers.len());
+    let mut stats = ScreenStats::default();
+    let mut counters = Counters::default();
+    for (v, st, c) in rows {
+        values.extend(v);
+        stats += st;
+        counters += c;
+    }
+    (Visibility::Gray(values), stats, counters)
+}
+
+/// Run `penumbra-map` on a rendered frame (one light: [`super::run`] averages several).
+pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
+    let start = Instant::now();
+    let s = read_settings(frame)?;
+    let r = render(frame, &s)?;
+    let mut passes = vec![frame.pass.clone()];
+    passes.extend(r.passes.iter().cloned());
+    let n = s.map_size;
+    let plan = MethodPlan {
+        method: "penumbra-map".into(),
+        passes: passes.iter().map(|p| p.name.clone()).collect(),
+        buffers: vec![
+            BufferPlan::depth(&frame.gpu),
+            BufferPlan {
+                name: format!("shadow-map {n}x{n}"),
+                format: format!("{:?}", s.depth),
+                bytes_per_sample: s.depth.bytes() as u32,
+            },
+            BufferPlan {
+                name: format!("penumbra-map colour {n}x{n}"),
+                format: format!("{:?}", s.storage),
+                bytes_per_sample: s.storage.bytes() as u32,
+            },
+            BufferPlan {
+                name: format!("penumbra-map depth {n}x{n}"),
+                format: format!("{:?}", s.depth),
+                bytes_per_sample: s.depth.bytes() as u32,
+            },
+        ],
+        settings: serde_json::json!({
+            "settings": s,
+            "light_view": {
+                "axis": r.view.axis.to_array(),
+                "near": r.view.proj.near,
+                "far": r.view.proj.far,
+            },
+            "silhouette_edges": r.silhouette.0,
+            "silhouette_loops": r.silhouette.1,
+            "max_silhouette_vertex_degree": r.silhouette.2,
+            "cones": r.geometry.cones,
+            "sheets": r.geometry.sheets,
+            "skipped_sheets": r.geometry.skipped_sheets,
+            "max_sheet_twist_deg": r.geometry.max_sheet_twist_deg,
+            "penumbra_triangles": r.geometry.triangles.len(),
+            "program": r.program,
+            "screen": r.screen,
+            "gpu": frame.gpu,
+        }),
+    };
+    Ok(MethodOutput {
+        visibility: r.visibility,
+        raw_images: vec![],
+        stats: super::method_stats("penumbra-map", frame, start, &plan, passes),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::transform::Projection;
+    use glam::DVec3;
+
+    fn proj() -> Projection {
+        Projection::frustum(
+            DVec3::ZERO,
+            DVec3::NEG_Z,
+            DVec3::Y,
+            [-1.0, 1.0, -1.0, 1.0],
+            1.0,
+            10.0,
+            [64, 64],
+        )
+    }
+
+    /// The window depth of view depth `d` (f64, the projection's own mapping).
+    fn window(p: &Projection, d: f64) -> f64 {
+        p.window_depth(DVec3::new(0.0, 0.0, -d)).unwrap()
+    }
+
+    #[test]
+    fn intensity_is_the_depth_ratio_of_equation_1() {
+        let p = proj();
+        // Silhouette at 2, fragment at 3, surface at 6: I = (3 − 2)/(6 − 2).
+        let i = penumbra_intensity(window(&p, 3.0) as f32, window(&p, 6.0), 2.0, &p).unwrap();
+        assert!((i - 0.25).abs() < 1e-6, "{i}");
+        // Line (4): the fragment behind the surface.
+        assert_eq!(
+            penumbra_intensity(window(&p, 7.0) as f32, window(&p, 6.0), 2.0, &p),
+            Err(Discard::BehindSurface)
+        );
+    }
+
+    #[test]
+    fn degenerate_denominators_and_rounding_are_discarded_not_divided() {
+        let p = proj();
+        let z = window(&p, 2.0);
+        let tip = p.view_depth(z as f32 as f64);
+        // The cone's tip on the occluder itself: Z_F′ = Z_P′ = Z_v, the paper's I is 0/0.
+        assert_eq!(
+            penumbra_intensity(z as f32, z as f32 as f64, tip, &p),
+            Err(Discard::SurfaceNotBeyondSilhouette)
+        );
+        // A fragment rounded in front of its silhouette point over a surface beyond it.
+        assert_eq!(
+            penumbra_intensity(z as f32, window(&p, 5.0), tip * (1.0 + 1e-9), &p),
+            Err(Discard::InFrontOfSilhouette)
+        );
+        // At the silhouette point over a surface beyond it: I = 0, the darkest.
+        assert_eq!(
+            penumbra_intensity(z as f32, window(&p, 5.0), tip, &p),
+            Ok(0.0)
+        );
+    }
+
+    #[test]
+    fn smoothstep_is_the_bernstein_interpolant() {
+        for (i, e) in [(0.0, 0.0), (0.5, 0.5), (1.0, 1.0), (0.25, 0.15625)] {
+            assert_eq!(Falloff::Smoothstep.apply(i), e);
+            assert_eq!(Falloff::Linear.apply(i), i);
+        }
+    }
+}
