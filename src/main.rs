@@ -78,18 +78,6 @@ struct RenderArgs {
     opts: Vec<String>,
 }
 
-fn parse_opt_value(v: &str) -> OptionValue {
-    if let Ok(b) = v.parse::<bool>() {
-        OptionValue::Bool(b)
-    } else if let Ok(i) = v.parse::<i64>() {
-        OptionValue::Int(i)
-    } else if let Ok(f) = v.parse::<f64>() {
-        OptionValue::Float(f)
-    } else {
-        OptionValue::Str(v.to_string())
-    }
-}
-
 fn apply_overrides(scene: &mut Scene, a: &RenderArgs) -> Result<(), InputError> {
     if let Some(m) = &a.methods {
         scene.methods = Some(m.clone());
@@ -111,7 +99,7 @@ fn apply_overrides(scene: &mut Scene, a: &RenderArgs) -> Result<(), InputError> 
             .options
             .entry(method.to_string())
             .or_default()
-            .insert(key.to_string(), parse_opt_value(value));
+            .insert(key.to_string(), OptionValue::parse_cli(value));
     }
     validate::validate(scene)
 }

@@ -1,5 +1,6 @@
-//! Golden outputs: every built-in foundation scene with every method, rendered at 64×64 and
-//! compared bit for bit with `golden/` (see `penumbra::golden`). Re-bless with
+//! Golden outputs: every case of the catalog (`penumbra::golden::cases`: every method on the
+//! foundation scenes and the knobs), rendered small and compared bit for bit with `golden/`,
+//! counters included (see `penumbra::golden`). Re-bless with
 //! `cargo run --release -- golden --bless` (or `PENUMBRA_BLESS=1 cargo test --test golden`)
 //! only when a change of output is intended.
 
@@ -16,26 +17,24 @@ fn goldens_match() {
 
 #[test]
 fn goldens_do_not_depend_on_thread_count() {
-    let case = &penumbra::golden::cases()[0];
-    let one = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .unwrap();
-    let many = rayon::ThreadPoolBuilder::new()
-        .num_threads(3)
-        .build()
-        .unwrap();
-    let a = one.install(|| penumbra::golden::render_case(case)).unwrap();
-    let b = many
-        .install(|| penumbra::golden::render_case(case))
-        .unwrap();
-    for (x, y) in a.iter().zip(&b) {
-        assert_eq!(x.method, y.method);
+    let base = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let group = &penumbra::golden::cases::groups()[0];
+    let render = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| penumbra::golden::cases::render_group(base, group))
+            .unwrap()
+    };
+    let (a, b) = (render(1), render(3));
+    for ((case, x), (_, y)) in a.iter().zip(&b) {
         assert_eq!(
-            x.output.visibility, y.output.visibility,
+            x.visibility, y.visibility,
             "{} differs between 1 and 3 threads",
-            x.method
+            case.method
         );
-        assert_eq!(x.output.raw_images, y.output.raw_images);
+        assert_eq!(x.raw_images, y.raw_images);
+        assert_eq!(x.stats.totals, y.stats.totals);
     }
 }

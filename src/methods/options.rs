@@ -29,31 +29,31 @@ impl OptionReader {
         InputError::at(&self.source, format!("options.{}.{key}", self.method), msg)
     }
 
-    /// A string option restricted to `allowed`.
+    /// An option restricted to `allowed` values, written as a string or, where a value reads as
+    /// a number or bool (`li = 12`, `--opt pw2002.li=8`), as that number or bool.
     pub fn choice(
         &mut self,
         key: &str,
         allowed: &[&'static str],
         default: &'static str,
     ) -> Result<&'static str, InputError> {
-        match self.table.remove(key) {
-            None => Ok(default),
-            Some(OptionValue::Str(s)) => {
-                allowed.iter().find(|a| **a == s).copied().ok_or_else(|| {
-                    self.err(
-                        key,
-                        format!(
-                            "unknown value {s:?}; expected one of {}",
-                            allowed.join(", ")
-                        ),
-                    )
-                })
-            }
-            Some(v) => Err(self.err(
-                key,
-                format!("expected one of {}, got {v}", allowed.join(", ")),
-            )),
-        }
+        let Some(v) = self.table.remove(key) else {
+            return Ok(default);
+        };
+        let written = match &v {
+            OptionValue::Str(s) => s.clone(),
+            other => other.to_string(),
+        };
+        allowed
+            .iter()
+            .find(|a| **a == written)
+            .copied()
+            .ok_or_else(|| {
+                self.err(
+                    key,
+                    format!("unknown value {v}; expected one of {}", allowed.join(", ")),
+                )
+            })
     }
 
     /// An integer option in `range`.

@@ -125,6 +125,22 @@ pub enum OptionValue {
     Str(String),
 }
 
+impl OptionValue {
+    /// A value written on the command line (`--opt METHOD.KEY=VALUE`): a bool, else an
+    /// integer, else a float, else a string.
+    pub fn parse_cli(v: &str) -> OptionValue {
+        if let Ok(b) = v.parse::<bool>() {
+            OptionValue::Bool(b)
+        } else if let Ok(i) = v.parse::<i64>() {
+            OptionValue::Int(i)
+        } else if let Ok(f) = v.parse::<f64>() {
+            OptionValue::Float(f)
+        } else {
+            OptionValue::Str(v.to_string())
+        }
+    }
+}
+
 impl std::fmt::Display for OptionValue {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {

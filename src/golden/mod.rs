@@ -6,7 +6,12 @@
 //! ```text
 //! golden/<scene>/<method>/visibility.pfm     the visibility buffer, exact f32 bits
 //! golden/<scene>/<method>/<raw>.png          each raw 8-bit buffer, e.g. hard-sv's stencil.png
+//! golden/<scene>/<method>/counters.json      every integer counter of stats.json: totals,
+//!                                            per pass (name, runs, counters), clamped_pixels
 //! ```
+//!
+//! `<method>` is the method name, or `<method>-<variant>` for a render with other options
+//! ([`cases`] holds the catalog of pinned renders).
 //!
 //! Files are compared on their **decoded values** — f32 bits of the PFM, u8 values of the
 //! PNG — never on the compressed bytes, so a different PNG encoder version cannot fail a test
@@ -34,11 +39,37 @@ use crate::output::{
 };
 use std::path::{Path, PathBuf};
 
+pub mod cases;
+
+pub use cases::{run_cases, GoldenCase, GOLDEN_SIZE};
+
 /// The environment variable that turns [`check`] into [`bless`]: set it to `1`.
 pub const BLESS_ENV: &str = "PENUMBRA_BLESS";
 
 /// The file name of the visibility golden.
 pub const VISIBILITY_FILE: &str = "visibility.pfm";
+
+/// The file name of the counters golden.
+pub const COUNTERS_FILE: &str = "counters.json";
+
+/// The integer counters of a method's stats that a golden pins (times excluded), as pretty
+/// JSON: `clamped_pixels`, `totals`, and per pass its name, runs and counters.
+pub fn counters_json(out: &MethodOutput) -> Vec<u8> {
+    let passes: Vec<serde_json::Value> = out
+        .stats
+        .passes
+        .iter()
+        .map(|p| serde_json::json!({ "name": p.name, "runs": p.runs, "counters": p.counters }))
+        .collect();
+    let v = serde_json::json!({
+        "clamped_pixels": out.stats.clamped_pixels,
+        "totals": out.stats.totals,
+        "passes": passes,
+    });
+    let mut text = serde_json::to_string_pretty(&v).unwrap_or_default();
+    text.push('\n');
+    text.into_bytes()
+}
 
 /// Where the goldens of one scene and method live: `root/scene/method`.
 pub fn golden_dir(root: &Path, scene: &str, method: &str) -> PathBuf {
@@ -87,10 +118,13 @@ fn golden_files(
             out.visibility.len()
         ));
     }
-    let mut files = vec![(
-        VISIBILITY_FILE.to_string(),
-        encode_pfm(&out.visibility, width, height),
-    )];
+    let mut files = vec![
+        (
+            VISIBILITY_FILE.to_string(),
+            encode_pfm(&out.visibility, width, height),
+        ),
+        (COUNTERS_FILE.to_string(), counters_json(out)),
+    ];
     for raw in &out.raw_images {
         let name = raw_image_file_name(raw).map_err(|e| format!("golden: {e}"))?;
         if files.iter().any(|(f, _)| *f == name) {
@@ -103,7 +137,8 @@ fn golden_files(
     Ok(files)
 }
 
-/// Golden-like files already in `dir` (`*.pfm`, `*.png`), sorted; empty if `dir` is missing.
+/// Golden-like files already in `dir` (`*.pfm`, `*.png`, `*.json`), sorted; empty if `dir` is
+/// missing.
 fn existing_golden_files(dir: &Path) -> Result<Vec<String>, String> {
     let rd = match std::fs::read_dir(dir) {
         Ok(rd) => rd,
@@ -114,7 +149,8 @@ fn existing_golden_files(dir: &Path) -> Result<Vec<String>, String> {
     for entry in rd {
         let entry = entry.map_err(|e| format!("golden: reading {}: {e}", dir.display()))?;
         let name = entry.file_name().to_string_lossy().into_owned();
-        if !name.starts_with('.') && (name.ends_with(".pfm") || name.ends_with(".png")) {
+        let golden_like = [".pfm", ".png", ".json"].iter().any(|x| name.ends_with(x));
+        if !name.starts_with('.') && golden_like {
             names.push(name);
         }
     }
@@ -124,7 +160,8 @@ fn existing_golden_files(dir: &Path) -> Result<Vec<String>, String> {
 
 /// Rewrites the goldens of `scene`/`method` under `root` from `out` and returns the paths
 /// written. The size is taken from `out.stats.width`/`height` (and must match the buffers).
-/// Golden files of that method that `out` no longer produces (`*.pfm`, `*.png`) are removed.
+/// Golden files of that method that `out` no longer produces (`*.pfm`, `*.png`, `*.json`) are
+/// removed.
 pub fn bless(
     root: &Path,
     scene: &str,
@@ -233,6 +270,8 @@ fn check_against(
         };
         let result = if name == VISIBILITY_FILE {
             compare_visibility(&expected, &out.visibility, width, height)
+        } else if name == COUNTERS_FILE {
+            compare_counters(&expected, bytes)
         } else {
             let raw = out
                 .raw_images
@@ -244,16 +283,15 @@ fn check_against(
         match result {
             Ok(()) => {}
             Err(mismatch) => {
-                let (actual_name, panel_name) = if name == VISIBILITY_FILE {
-                    (
+                let (actual_name, panel_name) = match name.as_str() {
+                    VISIBILITY_FILE => (
                         "actual.pfm".to_string(),
                         "expected_diff_actual.png".to_string(),
-                    )
-                } else {
-                    (
+                    ),
+                    _ => (
                         format!("actual_{name}"),
                         format!("expected_diff_actual_{name}"),
-                    )
+                    ),
                 };
                 let mut msg = format!(
                     "golden mismatch {what} {name}: {}\n  expected: {}\n  actual:   {}",
@@ -455,6 +493,61 @@ fn compare_raw(
     })
 }
 
+/// Compares the counters JSON: equal values, or the first differing counter by its path.
+fn compare_counters(expected_bytes: &[u8], actual_bytes: &[u8]) -> Result<(), Mismatch> {
+    let parse = |b: &[u8]| serde_json::from_slice::<serde_json::Value>(b);
+    let (expected, actual) = match (parse(expected_bytes), parse(actual_bytes)) {
+        (Ok(e), Ok(a)) => (e, a),
+        (Err(e), _) | (_, Err(e)) => {
+            return Err(Mismatch {
+                summary: format!("unreadable counters JSON: {e}"),
+                panels: None,
+            })
+        }
+    };
+    match first_difference(&expected, &actual, String::new()) {
+        None => Ok(()),
+        Some((path, e, a)) => Err(Mismatch {
+            summary: format!("counter {path}: expected {e}, actual {a}"),
+            panels: None,
+        }),
+    }
+}
+
+/// The first place where two JSON values differ: (path, expected, actual).
+fn first_difference(
+    e: &serde_json::Value,
+    a: &serde_json::Value,
+    path: String,
+) -> Option<(String, String, String)> {
+    use serde_json::Value;
+    match (e, a) {
+        (Value::Object(eo), Value::Object(ao)) => {
+            let mut keys: Vec<&String> = eo.keys().chain(ao.keys()).collect();
+            keys.sort();
+            keys.dedup();
+            keys.into_iter().find_map(|k| {
+                let p = format!("{path}.{k}");
+                match (eo.get(k), ao.get(k)) {
+                    (Some(x), Some(y)) => first_difference(x, y, p),
+                    (x, y) => Some((p, fmt_json(x), fmt_json(y))),
+                }
+            })
+        }
+        (Value::Array(ea), Value::Array(aa)) if ea.len() == aa.len() => ea
+            .iter()
+            .zip(aa)
+            .enumerate()
+            .find_map(|(i, (x, y))| first_difference(x, y, format!("{path}[{i}]"))),
+        _ if e == a => None,
+        _ => Some((path, e.to_string(), a.to_string())),
+    }
+}
+
+fn fmt_json(v: Option<&serde_json::Value>) -> String {
+    v.map_or("(missing)".to_string(), |v| v.to_string())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -650,95 +743,5 @@ mod tests {
         assert!(check_against(&root, &fails, "s", "", 3, 2, &out).is_err());
         assert!(check_against(&root, &fails, "s", "m", 4, 2, &out).is_err());
         assert!(!base.exists());
-    }
-}
-
-/// One pinned golden render: a built-in scene at a small size with a list of methods.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct GoldenCase {
-    /// Built-in scene name (also the golden sub-directory).
-    pub scene: &'static str,
-    /// Width and height in pixels (goldens are small so the suite stays fast).
-    pub size: u32,
-    /// Methods pinned for this scene.
-    pub methods: &'static [&'static str],
-}
-
-/// Golden image size (DESIGN.md "Goldens are rendered small").
-pub const GOLDEN_SIZE: u32 = 64;
-
-/// Every golden case: each built-in scene of the foundation and the two-light scene, with
-/// every method that exists (those that do not support a scene's lights are skipped by
-/// [`render_case`]).
-pub fn cases() -> Vec<GoldenCase> {
-    [
-        "cube-of-spheres",
-        "single-quad",
-        "cylinder",
-        "eye-in-shadow",
-        "two-lights",
-    ]
-    .into_iter()
-    .map(|scene| GoldenCase {
-        scene,
-        size: GOLDEN_SIZE,
-        methods: crate::methods::ALL,
-    })
-    .collect()
-}
-
-/// Render one golden case: the built-in scene at the case's size with the case's methods.
-pub fn render_case(case: &GoldenCase) -> Result<Vec<crate::render::MethodRun>, String> {
-    let mut scene = crate::scene::builtin::load(case.scene)
-        .ok_or_else(|| format!("no built-in scene {}", case.scene))?;
-    scene.width = case.size;
-    scene.height = case.size;
-    // Pin every listed method that supports the scene's light shape.
-    let methods = case
-        .methods
-        .iter()
-        .filter(|m| crate::methods::supports_scene(m, &scene))
-        .map(|m| m.to_string())
-        .collect();
-    scene.methods = Some(methods);
-    crate::render::render_scene(&scene).map_err(|e| e.to_string())
-}
-
-/// Check (or with `bless`, rewrite) every golden case under `root`. Returns a report, one line
-/// per (scene, method); fails with every mismatch listed.
-pub fn run_cases(root: &Path, bless_all: bool) -> Result<String, String> {
-    let mut report = String::new();
-    let mut failures = Vec::new();
-    for case in cases() {
-        for run in render_case(&case)? {
-            let result = if bless_all {
-                bless(root, case.scene, &run.method, &run.output).map(|_| ())
-            } else {
-                check(
-                    root,
-                    case.scene,
-                    &run.method,
-                    case.size,
-                    case.size,
-                    &run.output,
-                )
-            };
-            match result {
-                Ok(()) => {
-                    report += &format!(
-                        "{} {}/{}\n",
-                        if bless_all { "blessed" } else { "ok" },
-                        case.scene,
-                        run.method
-                    )
-                }
-                Err(e) => failures.push(format!("{}/{}: {e}", case.scene, run.method)),
-            }
-        }
-    }
-    if failures.is_empty() {
-        Ok(report)
-    } else {
-        Err(failures.join("\n"))
     }
 }
