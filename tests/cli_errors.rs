@@ -144,12 +144,18 @@ fn bad_input_leaves_an_existing_out_dir_untouched() {
         o,
     ]);
     assert_eq!(output.status.code(), Some(2));
-    let entries: Vec<_> = std::fs::read_dir(&out)
-        .unwrap()
-        .map(|e| e.unwrap().file_name())
-        .collect();
-    assert_eq!(entries, ["keep.txt"]);
+    assert_eq!(entries(&out), ["keep.txt"]);
     std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// The names in directory `dir`, sorted.
+fn entries(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
 }
 
 #[test]
@@ -539,20 +545,12 @@ fn output_write_errors_name_the_path_and_leave_nothing() {
     let out = fresh_out("blocked");
     std::fs::create_dir_all(&out).unwrap();
     std::fs::write(out.join("hard-sv"), "in the way").unwrap();
-    let output = penumbra(&[
-        "render",
-        "single-quad",
-        "--width",
-        "32",
-        "--height",
-        "32",
-        "--methods",
-        "raycast,hard-sv",
-        "--opt",
-        "raycast.samples=4",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let mut args: Vec<&str> = "render single-quad --width 32 --height 32 \
+                               --methods raycast,hard-sv --opt raycast.samples=4 --out"
+        .split_whitespace()
+        .collect();
+    args.push(out.to_str().unwrap());
+    let output = penumbra(&args);
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert_eq!(output.status.code(), Some(1), "{stderr}");
     assert_eq!(
@@ -562,11 +560,7 @@ fn output_write_errors_name_the_path_and_leave_nothing() {
             out.join("hard-sv").display()
         )
     );
-    let entries: Vec<_> = std::fs::read_dir(&out)
-        .unwrap()
-        .map(|e| e.unwrap().file_name())
-        .collect();
-    assert_eq!(entries, ["hard-sv"]);
+    assert_eq!(entries(&out), ["hard-sv"]);
     std::fs::remove_dir_all(&out).unwrap();
 }
 

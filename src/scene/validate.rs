@@ -143,16 +143,10 @@ impl LightRegion {
     /// Whether the region around `c` shares a point with the triangle `tri`.
     fn meets(&self, c: DVec3, tri: [DVec3; 3]) -> bool {
         let [a, b, p] = tri;
-        let normal = match self {
-            LightRegion::Ball(r) => return closest_point_on_triangle(c, a, b, p).distance(c) <= *r,
-            LightRegion::Disk(_, n) => *n,
-            LightRegion::Rect(u, v) => u.cross(*v),
-        };
-        let section = plane_section(c, normal, tri);
         match self {
-            LightRegion::Ball(_) => unreachable!("returned above"),
-            LightRegion::Disk(r, _) => {
-                let closest = match section.as_slice() {
+            LightRegion::Ball(r) => closest_point_on_triangle(c, a, b, p).distance(c) <= *r,
+            LightRegion::Disk(r, n) => {
+                let closest = match plane_section(c, *n, tri).as_slice() {
                     [] => return false,
                     [q] => *q,
                     [q0, q1] => closest_point_on_segment(c, *q0, *q1),
@@ -162,9 +156,10 @@ impl LightRegion {
             }
             LightRegion::Rect(u, v) => {
                 // Coordinates (s, t) with x − c = s·u + t·v + k·normal; the light is |s|, |t| ≤ 1.
+                let normal = u.cross(*v);
                 let (du, dv) = (v.cross(normal), normal.cross(*u));
                 let (su, tv) = (u.dot(du), v.dot(dv));
-                let st: Vec<[f64; 2]> = section
+                let st: Vec<[f64; 2]> = plane_section(c, normal, tri)
                     .iter()
                     .map(|q| [(*q - c).dot(du) / su, (*q - c).dot(dv) / tv])
                     .collect();
@@ -844,58 +839,50 @@ mod tests {
                 "{m}"
             );
         };
-        s.lights[0] = Light {
-            center: Vec3::new(0.0, 1.9, 0.0),
-            shape: LightShape::Sphere { radius: 0.5 },
+        let light = |c: [f32; 3], shape: LightShape| Light {
+            center: Vec3::from_array(c),
+            shape,
         };
-        overlaps(&s, "meshes[1] (ball)");
-        s.lights[0].shape = LightShape::Sphere { radius: 0.35 };
-        validate(&s).unwrap();
-        // A rectangle whose centre is clear of the ball but whose corner cuts into it.
-        s.lights[0] = Light {
-            center: Vec3::new(0.7, 1.2, 0.0),
-            shape: LightShape::Rect {
-                u: Vec3::X * 0.4,
-                v: Vec3::Z * 0.4,
-            },
-        };
-        overlaps(&s, "meshes[1] (ball)");
-        s.lights[0].center.x = 1.0;
-        validate(&s).unwrap();
-        // A vertical rectangle reaching down through the floor.
-        s.lights[0] = Light {
-            center: Vec3::new(2.0, 0.3, 2.0),
-            shape: LightShape::Rect {
-                u: Vec3::X * 0.2,
-                v: Vec3::Y * 0.5,
-            },
-        };
-        overlaps(&s, "meshes[0] (floor)");
-        s.lights[0].center.y = 0.6;
-        validate(&s).unwrap();
-        // A disk lying in the plane of the floor's top face, its centre just beyond the edge.
-        s.lights[0] = Light {
-            center: Vec3::new(3.2, 0.0, 0.0),
-            shape: LightShape::Disk {
-                radius: 0.5,
-                normal: Vec3::Y,
-            },
-        };
-        overlaps(&s, "meshes[0] (floor)");
-        s.lights[0].shape = LightShape::Disk {
-            radius: 0.1,
-            normal: Vec3::Y,
-        };
-        validate(&s).unwrap();
-        // A tilted disk dipping into the ball.
-        s.lights[0] = Light {
-            center: Vec3::new(0.0, 1.7, 0.0),
-            shape: LightShape::Disk {
-                radius: 0.6,
-                normal: Vec3::new(1.0, 1.0, 0.0),
-            },
-        };
-        overlaps(&s, "meshes[1] (ball)");
+        let rect = |u: Vec3, v: Vec3| LightShape::Rect { u, v };
+        let disk = |radius: f32, normal: Vec3| LightShape::Disk { radius, normal };
+        // (a light touching the mesh, the same light moved or shrunk clear of it, the mesh)
+        let cases = [
+            (
+                light([0.0, 1.9, 0.0], LightShape::Sphere { radius: 0.5 }),
+                light([0.0, 1.9, 0.0], LightShape::Sphere { radius: 0.35 }),
+                "meshes[1] (ball)",
+            ),
+            // A rectangle whose centre is clear of the ball but whose corner cuts into it.
+            (
+                light([0.7, 1.2, 0.0], rect(Vec3::X * 0.4, Vec3::Z * 0.4)),
+                light([1.0, 1.2, 0.0], rect(Vec3::X * 0.4, Vec3::Z * 0.4)),
+                "meshes[1] (ball)",
+            ),
+            // A vertical rectangle reaching down through the floor.
+            (
+                light([2.0, 0.3, 2.0], rect(Vec3::X * 0.2, Vec3::Y * 0.5)),
+                light([2.0, 0.6, 2.0], rect(Vec3::X * 0.2, Vec3::Y * 0.5)),
+                "meshes[0] (floor)",
+            ),
+            // A disk in the plane of the floor's top face, its centre just beyond the edge.
+            (
+                light([3.2, 0.0, 0.0], disk(0.5, Vec3::Y)),
+                light([3.2, 0.0, 0.0], disk(0.1, Vec3::Y)),
+                "meshes[0] (floor)",
+            ),
+            // A tilted disk dipping into the ball.
+            (
+                light([0.0, 1.7, 0.0], disk(0.6, Vec3::new(1.0, 1.0, 0.0))),
+                light([0.0, 1.7, 0.0], disk(0.1, Vec3::new(1.0, 1.0, 0.0))),
+                "meshes[1] (ball)",
+            ),
+        ];
+        for (touching, clear, mesh) in cases {
+            s.lights[0] = touching;
+            overlaps(&s, mesh);
+            s.lights[0] = clear;
+            validate(&s).unwrap();
+        }
     }
 
     #[test]
