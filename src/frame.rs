@@ -310,27 +310,39 @@ impl<'s> Frame<'s> {
 /// *volumes*, not inside occluders), so the scene is rejected naming the mesh, the point and
 /// the near distance ([`crate::plan::near_plane_points`], the same ray-parity test as for
 /// lights, [`crate::scene::validate::point_touches`]).
+///
+/// The message reports the most telling contact: the eye before the near plane, and a point
+/// inside a mesh before a point on a surface (a near plane reaching into a mesh also has
+/// points on its surface, which come first in grid order).
 fn check_camera_outside_geometry(scene: &Scene, near: f64) -> Result<(), InputError> {
-    for p in crate::plan::near_plane_points(scene, near) {
-        for (i, mesh) in scene.meshes.iter().enumerate() {
-            if let Some(why) = crate::scene::validate::point_touches(mesh, p.as_vec3()) {
-                let what = if p == scene.camera.eye {
-                    "the eye".to_string()
-                } else {
-                    format!("the near plane (near = {near})")
-                };
-                return Err(InputError::at(
-                    &scene.source,
-                    "camera",
-                    format!(
-                        "camera inside geometry: {what} at ({}, {}, {}) is {why} meshes[{i}] ({})",
-                        p.x, p.y, p.z, mesh.name
-                    ),
-                ));
-            }
-        }
-    }
-    Ok(())
+    let points = crate::plan::near_plane_points(scene, near);
+    let contacts = points.iter().enumerate().flat_map(|(k, p)| {
+        scene
+            .meshes
+            .iter()
+            .enumerate()
+            .filter_map(move |(i, mesh)| {
+                crate::scene::validate::point_touches(mesh, p.as_vec3()).map(|why| (k, *p, i, why))
+            })
+    });
+    // Rank: the eye (k = 0) first, then "inside" before "on the surface of".
+    let worst = contacts.min_by_key(|&(k, _, _, why)| (k != 0, why != "inside", k));
+    let Some((k, p, i, why)) = worst else {
+        return Ok(());
+    };
+    let what = if k == 0 {
+        "the eye".to_string()
+    } else {
+        format!("the near plane (near = {near})")
+    };
+    Err(InputError::at(
+        &scene.source,
+        "camera",
+        format!(
+            "camera inside geometry: {what} at ({}, {}, {}) is {why} meshes[{i}] ({})",
+            p.x, p.y, p.z, scene.meshes[i].name
+        ),
+    ))
 }
 
 #[cfg(test)]
@@ -362,5 +374,41 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("the near plane (near = 0.1)"), "{e}");
+    }
+
+    /// A near plane reaching into a tetrahedron, edge-on to one of its faces: its grid column
+    /// on the face's plane comes before the columns inside, yet the report is "inside".
+    #[test]
+    fn camera_inside_is_reported_as_inside() {
+        use crate::scene::Mesh;
+        let mut s = builtin::load("single-quad").unwrap();
+        s.width = 16;
+        s.height = 16;
+        // Faces x = 1, y = 1.2, z = 0 and x + y + z = 3.2.
+        s.meshes.push(Mesh {
+            name: "tet".into(),
+            positions: vec![
+                Vec3::new(1.0, 1.2, 0.0),
+                Vec3::new(2.0, 1.2, 0.0),
+                Vec3::new(1.0, 2.2, 0.0),
+                Vec3::new(1.0, 1.2, 1.0),
+            ],
+            triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+            color: [0.5; 3],
+        });
+        crate::scene::validate::validate(&s).unwrap();
+        // Outside the tetrahedron, looking along its face x = 1 toward −z; the near plane's
+        // columns run from x < 1 (outside) over x = 1 (on the face) to x > 1 (inside).
+        s.camera.eye = DVec3::new(1.0, 1.5, 1.5);
+        s.camera.target = DVec3::new(1.0, 1.5, 0.0);
+        s.camera.up = DVec3::Y;
+        s.camera.near = Some(1.0);
+        let e = Frame::render(&s, GpuSettings::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("the near plane (near = 1)") && e.contains("is inside meshes[2] (tet)"),
+            "{e}"
+        );
     }
 }

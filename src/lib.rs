@@ -18,6 +18,7 @@ pub mod golden;
 pub mod gpu;
 pub mod light;
 pub mod limits;
+pub mod memory;
 pub mod methods;
 pub mod metrics;
 pub mod output;

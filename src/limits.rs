@@ -28,3 +28,13 @@ pub const WINDOW_LIMIT: f32 = 1_048_576.0;
 /// Largest number of lights in a scene: Paper I §7 scales light intensities by 255/n, so
 /// with more than 255 lights a fully visible light would add less than one LI unit.
 pub const MAX_LIGHTS: usize = 255;
+/// Largest input file (scene file, OBJ, texture) in bytes, 512 MiB: every input is read whole
+/// into memory, so a bound keeps a mistaken path (a disk image, say) from exhausting memory.
+pub const MAX_INPUT_FILE_BYTES: u64 = 512 << 20;
+/// Largest `--threads`: far above any core count the renders scale to, far below the
+/// thousands of threads that exhaust a machine's process limits.
+pub const MAX_THREADS: usize = 1024;
+/// Smallest accepted `camera.vfov_deg`, 0.1°: at [`MAX_IMAGE_SIZE`] rows a pixel then still
+/// spans about two f32 steps (2⁻²⁴ relative) of the distance it is seen at; narrower views
+/// put several pixels into one representable coordinate and the methods stop agreeing.
+pub const MIN_VFOV_DEG: f64 = 0.1;

@@ -5,6 +5,8 @@
 
 use clap::{Parser, Subcommand};
 use penumbra::error::InputError;
+use penumbra::limits::MAX_THREADS;
+use penumbra::memory;
 use penumbra::scene::{builtin, file, validate, OptionValue, Scene};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -18,7 +20,7 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     cmd: Option<Cmd>,
-    /// Worker threads (default: all cores). Results are bit-identical for any count.
+    /// Worker threads, 1 to 1024 (default: all cores). Results are bit-identical for any count.
     #[arg(long, global = true)]
     threads: Option<usize>,
 }
@@ -76,6 +78,10 @@ struct RenderArgs {
     /// A method option, METHOD.KEY=VALUE (repeatable), e.g. nsample.n=256 or gpu.tile_size=16.
     #[arg(long = "opt")]
     opts: Vec<String>,
+    /// Refuse a render whose estimated memory exceeds this many bytes (suffix K, M, G, T:
+    /// powers of 1024). Default: half of the machine's memory.
+    #[arg(long)]
+    max_memory: Option<String>,
 }
 
 fn apply_overrides(scene: &mut Scene, a: &RenderArgs) -> Result<(), InputError> {
@@ -107,6 +113,23 @@ fn apply_overrides(scene: &mut Scene, a: &RenderArgs) -> Result<(), InputError> 
 fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let mut scene = file::resolve(&a.scene)?;
     apply_overrides(&mut scene, a)?;
+    let (limit, origin) = match &a.max_memory {
+        Some(text) => (
+            Some(
+                memory::parse_size(text)
+                    .map_err(|m| InputError::at("--max-memory", text.as_str(), m))?,
+            ),
+            "--max-memory",
+        ),
+        None => (
+            memory::default_limit(),
+            "the default, half of the machine's memory; set it with --max-memory",
+        ),
+    };
+    memory::check_fits(&scene, &penumbra::methods::selected(&scene)?, limit, origin)?;
+    if let Some(w) = validate::f32_rounding_warning(&scene) {
+        eprintln!("penumbra: {w}");
+    }
     let runs = penumbra::render::render_scene(&scene)?;
     penumbra::render::write_runs(&a.out, &scene, &runs)?;
     print!("{}", penumbra::render::table(&scene, &runs));
@@ -116,9 +139,14 @@ fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
 
 fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(n) = cli.threads {
+        let bad = |why: String| InputError::at("--threads", n.to_string(), why);
+        if !(1..=MAX_THREADS).contains(&n) {
+            return Err(bad(format!("expected 1..={MAX_THREADS} worker threads")).into());
+        }
         rayon::ThreadPoolBuilder::new()
-            .num_threads(n.max(1))
-            .build_global()?;
+            .num_threads(n)
+            .build_global()
+            .map_err(|e| bad(format!("cannot start {n} worker threads: {e}")))?;
     }
     match cli.cmd {
         // The default scene, then its sphere-light twin so that the sphere-only methods
@@ -132,6 +160,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
                 height: None,
                 out: "out".into(),
                 opts: vec![],
+                max_memory: None,
             })?;
             let twin = builtin::load("cube-of-spheres-sphere").ok_or("missing built-in twin")?;
             let methods = penumbra::methods::ALL
@@ -146,6 +175,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
                 height: None,
                 out: "out/cube-of-spheres-sphere".into(),
                 opts: vec![],
+                max_memory: None,
             })
         }
         Some(Cmd::Experiment {

@@ -118,19 +118,14 @@ pub fn render_scene(scene: &Scene) -> Result<Vec<MethodRun>, InputError> {
     Ok(runs)
 }
 
-/// Write every run's files under `dir/METHOD/`.
+/// Write every run's files under `dir/METHOD/`, all or nothing: the method folders appear
+/// only once every method's files were written ([`crate::output::write_method_dirs`]).
 pub fn write_runs(dir: &Path, scene: &Scene, runs: &[MethodRun]) -> std::io::Result<()> {
-    for r in runs {
-        crate::output::write_method_outputs(
-            dir,
-            &r.method,
-            &r.output,
-            &r.shaded,
-            scene.width,
-            scene.height,
-        )?;
-    }
-    Ok(())
+    let names: Vec<&str> = runs.iter().map(|r| r.method.as_str()).collect();
+    crate::output::write_method_dirs(dir, &names, |i| {
+        let r = &runs[i];
+        crate::output::encode_method_outputs(&r.output, &r.shaded, scene.width, scene.height)
+    })
 }
 
 /// The table the default run prints: time and error vs the reference per method.

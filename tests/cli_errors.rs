@@ -99,6 +99,8 @@ const BAD_FILES: &[(&str, &[&str])] = &[
         "penumbra-map-frustum.toml",
         &["one light frustum cannot cover the scene"],
     ),
+    ("light-overlaps-mesh.toml", &["light intersects geometry"]),
+    ("top-level-array.json", &["not an array"]),
 ];
 
 /// Files whose problem is in their own method list or in a method that list names, which
@@ -148,12 +150,18 @@ fn bad_input_leaves_an_existing_out_dir_untouched() {
         o,
     ]);
     assert_eq!(output.status.code(), Some(2));
-    let entries: Vec<_> = std::fs::read_dir(&out)
-        .unwrap()
-        .map(|e| e.unwrap().file_name())
-        .collect();
-    assert_eq!(entries, ["keep.txt"]);
+    assert_eq!(entries(&out), ["keep.txt"]);
     std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// The names in directory `dir`, sorted.
+fn entries(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
 }
 
 #[test]
@@ -227,6 +235,33 @@ fn bad_options_and_methods() {
             "hard-sv option",
             &["--methods", "hard-sv", "--opt", "hard-sv.bogus=1"],
             &["unknown option"],
+        ),
+        (
+            "unknown key of a method that cannot render the light",
+            &["--methods", "hard-sv", "--opt", "pw2002.bogus=1"],
+            &["options.pw2002.bogus", "does not support rect lights"],
+        ),
+        (
+            "known key of a method that cannot render the light",
+            &["--methods", "hard-sv", "--opt", "pw2002.li=8"],
+            &["options.pw2002.li", "does not support rect lights"],
+        ),
+        (
+            "ssv filter with exact coverage",
+            &["--methods", "ssv", "--opt", "ssv.filter=bilinear"],
+            &["options.ssv.filter", "coverage = \"texture\""],
+        ),
+        (
+            "ssv texture-n with exact coverage",
+            &[
+                "--methods",
+                "ssv",
+                "--opt",
+                "ssv.coverage=exact",
+                "--opt",
+                "ssv.texture-n=16",
+            ],
+            &["options.ssv.texture-n", "coverage = \"texture\""],
         ),
         (
             "wedge-blending packing",
@@ -395,4 +430,181 @@ fn list_prints_scenes_and_methods_one_per_line() {
     for m in penumbra::methods::ALL {
         assert!(lines.contains(m), "list lacks method {m}: {stdout}");
     }
+}
+
+/// A fresh directory holding `scene.toml` whose mesh is `obj` (relative to it) under a point
+/// light; returns the directory and the scene path.
+fn scene_with_obj(tag: &str, obj: &str) -> (PathBuf, PathBuf) {
+    let dir = fresh_out(tag);
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("scene.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            "[camera]\neye = [0, 2, 5]\ntarget = [0, 0, 0]\nup = [0, 1, 0]\nvfov_deg = 45\n\
+             [light]\ntype = \"point\"\ncenter = [0, 4, 0]\n[[meshes]]\nobj = \"{obj}\"\n"
+        ),
+    )
+    .unwrap();
+    (dir, scene)
+}
+
+/// An OBJ that is a device, a symlink to one, or a FIFO is refused before it is opened (one
+/// rule for every input file): it would never end, or block forever.
+#[cfg(unix)]
+#[test]
+fn special_files_as_inputs_are_refused() {
+    let (dir, scene) = scene_with_obj("devzero", "zero.obj");
+    std::os::unix::fs::symlink("/dev/zero", dir.join("zero.obj")).unwrap();
+    let run = render("devzero", &[&[scene.to_str().unwrap()], SMALL].concat());
+    assert_bad_input(
+        "/dev/zero OBJ",
+        &run,
+        "zero.obj",
+        &["is a character device"],
+    );
+
+    let (dir2, scene2) = scene_with_obj("fifo", "pipe.obj");
+    let made = Command::new("mkfifo")
+        .arg(dir2.join("pipe.obj"))
+        .status()
+        .expect("mkfifo");
+    assert!(made.success());
+    let run = render("fifo", &[&[scene2.to_str().unwrap()], SMALL].concat());
+    assert_bad_input("FIFO OBJ", &run, "pipe.obj", &["is a FIFO"]);
+
+    let run = render("dir-scene", &[&["scenes/bad"], SMALL].concat());
+    assert_bad_input(
+        "directory as scene",
+        &run,
+        "scenes/bad",
+        &["is a directory"],
+    );
+    for d in [dir, dir2] {
+        std::fs::remove_dir_all(d).unwrap();
+    }
+}
+
+/// A very long path in a scene file is shortened in the message, which says so.
+#[test]
+fn long_paths_are_shortened() {
+    let long = format!("{}.obj", "d/".repeat(500_000));
+    let (dir, scene) = scene_with_obj("long", &long);
+    let run = render("long", &[&[scene.to_str().unwrap()], SMALL].concat());
+    assert_bad_input("long path", &run, "scene.toml", &["characters, shortened]"]);
+    assert!(run.0.stderr.len() < 4000, "{} bytes", run.0.stderr.len());
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn thread_count_is_bounded() {
+    for n in ["0", "20000"] {
+        let (output, out) = render("threads", &["single-quad", "--threads", n]);
+        assert_bad_input(
+            "--threads",
+            &(output, out),
+            &format!("--threads: {n}"),
+            &["expected 1..=1024 worker threads"],
+        );
+    }
+}
+
+/// An image too large for the memory limit is refused before anything is allocated, naming
+/// the size, the estimate and the limit.
+#[test]
+fn memory_limit_refuses_large_images() {
+    let big = [
+        "single-quad",
+        "--width",
+        "4096",
+        "--height",
+        "4096",
+        "--methods",
+        "hard-sv",
+        "--max-memory",
+        "1G",
+    ];
+    let run = render("memory", &big);
+    assert_bad_input(
+        "memory limit",
+        &run,
+        "single-quad",
+        &[
+            "4096×4096 with hard-sv needs an estimated 1728.0 MiB, more than the memory limit \
+           of 1024.0 MiB (--max-memory)",
+        ],
+    );
+    let run = render("memory-arg", &["single-quad", "--max-memory", "lots"]);
+    assert_bad_input(
+        "bad --max-memory",
+        &run,
+        "--max-memory",
+        &["expected bytes"],
+    );
+    let (output, out) = render(
+        "memory-ok",
+        &[&["single-quad", "--max-memory", "200M"], SMALL].concat(),
+    );
+    assert_eq!(output.status.code(), Some(0), "{output:?}");
+    std::fs::remove_dir_all(out).unwrap();
+}
+
+/// A file where a method's folder should be: the error names it, and no method's output of
+/// this run is left behind (the outputs are staged and moved into place together).
+#[test]
+fn output_write_errors_name_the_path_and_leave_nothing() {
+    let out = fresh_out("blocked");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("hard-sv"), "in the way").unwrap();
+    let mut args: Vec<&str> = "render single-quad --width 32 --height 32 \
+                               --methods raycast,hard-sv --opt raycast.samples=4 --out"
+        .split_whitespace()
+        .collect();
+    args.push(out.to_str().unwrap());
+    let output = penumbra(&args);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert_eq!(
+        stderr.trim_end(),
+        format!(
+            "penumbra: {}: cannot write outputs: exists and is not a directory",
+            out.join("hard-sv").display()
+        )
+    );
+    assert_eq!(entries(&out), ["hard-sv"]);
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// Coordinates far from the origin render, with one warning line on stderr naming the
+/// rounding and the scene's size.
+#[test]
+fn far_coordinates_warn_on_stderr() {
+    let dir = fresh_out("far");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("far.toml");
+    let models = root().join("scenes/models");
+    std::fs::write(
+        &scene,
+        format!(
+            "[camera]\neye = [40000, 2.5, 4]\ntarget = [40000, 0.4, 0]\nup = [0, 1, 0]\n\
+             vfov_deg = 45\n[light]\ntype = \"point\"\ncenter = [40000.5, 3.5, 0.3]\n\
+             [[meshes]]\nobj = \"{0}/cube.obj\"\n\
+             transform = [6,0,0,0, 0,0.1,0,0, 0,0,6,0, 40000,-0.05,0,1]\n\
+             [[meshes]]\nobj = \"{0}/tetra.obj\"\n\
+             transform = [1,0,0,0, 0,1,0,0, 0,0,1,0, 40000,0.6,0,1]\n",
+            models.display()
+        ),
+    )
+    .unwrap();
+    let (output, out) = render("far-out", &[&[scene.to_str().unwrap()], SMALL].concat());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(0), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("far.toml: warning: coordinates up to 40003 are stored as f32")
+            && stderr.contains("warned above 1e-4"),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(out).unwrap();
+    std::fs::remove_dir_all(dir).unwrap();
 }

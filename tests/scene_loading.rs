@@ -171,3 +171,39 @@ fn unknown_extension() {
         .to_string();
     assert_contains(&err, &["cube.obj: unknown scene file extension"]);
 }
+
+#[test]
+fn light_overlapping_a_mesh() {
+    assert_contains(
+        &bad("light-overlaps-mesh.toml"),
+        &[
+            "light-overlaps-mesh.toml: light: light intersects geometry: the sphere light around \
+             (0, 1.7, 0) overlaps meshes[1] (",
+            "tetra.obj): its triangle ",
+        ],
+    );
+}
+
+#[test]
+fn top_level_json_array() {
+    assert_contains(
+        &bad("top-level-array.json"),
+        &[
+            "top-level-array.json: the top level must be a JSON object ({...}) holding the \
+           scene, not an array",
+        ],
+    );
+}
+
+#[test]
+fn a_directory_is_not_a_scene_file() {
+    let dir = scenes_dir().join("bad");
+    let err = resolve(dir.to_str().unwrap()).unwrap_err().to_string();
+    assert_eq!(
+        err,
+        format!(
+            "{}: cannot read scene file: is a directory, not a file",
+            dir.display()
+        )
+    );
+}

@@ -239,12 +239,24 @@ fn raycast_options(scene: &Scene) -> Result<(raycast::RaycastSettings, &'static 
 }
 
 /// Parse and check `method`'s options without running it, so that a bad option is reported
-/// even for a method this run does not render. Methods that do not support the scene's light
-/// shapes are not checked (their options cannot be interpreted for these lights); a method
-/// that runs once per light is checked for each light.
+/// even for a method this run does not render. Options of a method that cannot render the
+/// scene's lights are an error (they could never act); a method that runs once per light is
+/// checked for each light.
 pub fn check_options(method: &str, frame: &Frame) -> Result<(), InputError> {
-    if !supports_scene(method, frame.scene) {
-        return Ok(());
+    if let Some(why) = unsupported_light(method, frame.scene) {
+        let key = frame
+            .scene
+            .options
+            .get(method)
+            .and_then(|t| t.keys().next());
+        return match key {
+            None => Ok(()),
+            Some(key) => Err(InputError::at(
+                &frame.scene.source,
+                format!("options.{method}.{key}"),
+                format!("{why}, so options for it cannot act on this scene"),
+            )),
+        };
     }
     if frame.scene.is_multi_light() && !RENDERS_SEVERAL_LIGHTS.contains(&method) {
         for k in 0..frame.scene.lights.len() {

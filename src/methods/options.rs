@@ -25,6 +25,11 @@ impl OptionReader {
         }
     }
 
+    /// Whether the table sets `key` (and it has not been read yet).
+    pub fn has(&self, key: &str) -> bool {
+        self.table.contains_key(key)
+    }
+
     fn err(&self, key: &str, msg: String) -> InputError {
         InputError::at(&self.source, format!("options.{}.{key}", self.method), msg)
     }

@@ -106,6 +106,10 @@ pub fn read_settings(frame: &Frame) -> Result<(SsvSettings, &'static str), Input
     let scene = frame.scene;
     let textured = matches!(scene.light().shape, LightShape::TexturedRect { .. });
     let mut r = OptionReader::new(scene, "ssv");
+    let texture_keys: Vec<&str> = ["texture-n", "filter"]
+        .into_iter()
+        .filter(|k| r.has(k))
+        .collect();
     let mode = r.choice("mode", &["auto", "zpass", "zfail"], "auto")?;
     let coverage = r.choice(
         "coverage",
@@ -142,6 +146,13 @@ pub fn read_settings(frame: &Frame) -> Result<(SsvSettings, &'static str), Input
             "coverage",
             "sphere lights need coverage = \"exact\" (Paper III §5.3: no coverage texture for \
              spheres; the 4D texture of §3.3 is defined over a rectangle)",
+        ));
+    }
+    if let (Some(key), "exact") = (texture_keys.first(), coverage) {
+        return Err(bad(
+            key,
+            "only used with coverage = \"texture\"; coverage is \"exact\" (the default for \
+             rectangle and sphere lights), which has no coverage texture to size or filter",
         ));
     }
     if textured && vbuffer != VBufferFormat::RgbF32 {

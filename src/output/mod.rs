@@ -11,10 +11,11 @@
 //! | `<name>.png` | each [`RawImage8`] (e.g. `hard-sv`'s `stencil.png`), 8-bit grayscale, values as stored |
 //! | `stats.json` | [`MethodStats`](crate::methods::output::MethodStats) as pretty-printed JSON |
 //!
-//! **No partial output** (DESIGN.md "Bad input"): every file is encoded in memory first, so
-//! an encoding error writes nothing; then each file is written to a hidden temporary name in
-//! the destination directory and all are renamed into place only once every write succeeded
-//! (see [`write_files_all_or_nothing`]).
+//! **No partial output** (DESIGN.md "Bad input"): a run's method folders are written into a
+//! hidden staging folder inside the output directory and moved into place only once every
+//! method's files were encoded and written ([`write_method_dirs`]); single files are written
+//! to a hidden temporary name and renamed ([`write_files_all_or_nothing`]). Every I/O error
+//! names the path it happened at.
 //!
 //! All images are row-major with row 0 at the top, like [`Visibility`].
 
@@ -310,36 +311,163 @@ pub fn read_pfm(bytes: &[u8]) -> Result<(u32, u32, Visibility), String> {
     Ok((width, height, vis))
 }
 
+/// The I/O error `e` of `doing` at `path`, with the path (shortened if very long,
+/// [`crate::error::shortened`]) in its message: `PATH: doing: cause`.
+pub fn error_at(path: &Path, doing: &str, e: io::Error) -> io::Error {
+    let shown = path.display().to_string();
+    io::Error::new(
+        e.kind(),
+        format!("{}: {doing}: {e}", crate::error::shortened(&shown)),
+    )
+}
+
+/// Writes `bytes` to a new file at `path` and syncs it; errors name the path.
+fn write_new_file(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let mut f = std::fs::File::create(path).map_err(|e| error_at(path, "cannot create", e))?;
+    io::Write::write_all(&mut f, bytes).map_err(|e| error_at(path, "cannot write", e))?;
+    f.sync_all().map_err(|e| error_at(path, "cannot write", e))
+}
+
+/// `dir` created with its missing parents; returns the outermost directory this created (to
+/// remove on failure), `None` if `dir` existed.
+fn create_dirs(dir: &Path) -> io::Result<Option<PathBuf>> {
+    let mut outermost = None;
+    let mut p = Some(dir);
+    while let Some(d) = p.filter(|d| !d.as_os_str().is_empty() && !d.exists()) {
+        outermost = Some(d.to_path_buf());
+        p = d.parent();
+    }
+    std::fs::create_dir_all(dir).map_err(|e| error_at(dir, "cannot create directory", e))?;
+    Ok(outermost)
+}
+
 /// Writes `files` (name, bytes) into `dir` with no partial output: `dir` is created if
 /// needed, every file is first written to a hidden temporary name in `dir`
 /// (`.NAME.tmp-PID`) and synced, and only when all writes succeeded are they renamed to their
 /// final names (a rename within one directory replaces the target atomically). On an error
-/// before the renames, the temporary files are removed and no final file is touched.
+/// before the renames, the temporary files (and the directories this created) are removed and
+/// no final file is touched. Errors name the path.
 pub fn write_files_all_or_nothing(dir: &Path, files: &[(String, Vec<u8>)]) -> io::Result<()> {
-    std::fs::create_dir_all(dir)?;
+    let created = create_dirs(dir)?;
     let pid = std::process::id();
     let mut temps: Vec<(PathBuf, PathBuf)> = Vec::with_capacity(files.len());
-    let result = (|| -> io::Result<()> {
-        for (name, bytes) in files {
-            let fin = dir.join(name);
-            let tmp = dir.join(format!(".{name}.tmp-{pid}"));
-            temps.push((tmp.clone(), fin));
-            let mut f = std::fs::File::create(&tmp)?;
-            io::Write::write_all(&mut f, bytes)?;
-            f.sync_all()?;
-        }
-        Ok(())
-    })();
+    let result = files.iter().try_for_each(|(name, bytes)| {
+        let tmp = dir.join(format!(".{name}.tmp-{pid}"));
+        temps.push((tmp.clone(), dir.join(name)));
+        write_new_file(&tmp, bytes)
+    });
     if let Err(e) = result {
         for (tmp, _) in &temps {
             let _ = std::fs::remove_file(tmp);
         }
+        if let Some(d) = created {
+            let _ = std::fs::remove_dir_all(d);
+        }
         return Err(e);
     }
     for (tmp, fin) in &temps {
-        std::fs::rename(tmp, fin)?;
+        std::fs::rename(tmp, fin).map_err(|e| error_at(fin, "cannot move into place", e))?;
     }
     Ok(())
+}
+
+/// Writes one folder per method, `dir/NAME/` for each of `names`, all or nothing: every
+/// target must be absent or a directory (checked first); the folders are written into a
+/// hidden staging folder `dir/.penumbra-staging-PID/` with the files `encode(i)` returns for
+/// method `i`, and only when every method's files were encoded and written are they moved into
+/// place, each replacing the folder of the same name as a whole. On any error nothing of this
+/// run is left: the staging folder, and `dir` itself if this call created it, are removed,
+/// and the folders already moved are moved back. Every error names its path.
+pub fn write_method_dirs(
+    dir: &Path,
+    names: &[&str],
+    encode: impl Fn(usize) -> io::Result<Vec<(String, Vec<u8>)>>,
+) -> io::Result<()> {
+    for name in names {
+        if name.is_empty() || name.contains(['/', '\\']) || name.starts_with('.') {
+            return Err(invalid(format!(
+                "method name {name:?} is not a plain directory name"
+            )));
+        }
+    }
+    for target in std::iter::once(dir.to_path_buf()).chain(names.iter().map(|n| dir.join(n))) {
+        match std::fs::symlink_metadata(&target) {
+            Ok(m) if !m.is_dir() => {
+                return Err(error_at(
+                    &target,
+                    "cannot write outputs",
+                    io::Error::new(
+                        io::ErrorKind::AlreadyExists,
+                        "exists and is not a directory",
+                    ),
+                ))
+            }
+            _ => {}
+        }
+    }
+    let created = create_dirs(dir)?;
+    let staging = dir.join(format!(".penumbra-staging-{}", std::process::id()));
+    let cleanup = |staging: &Path| {
+        let _ = std::fs::remove_dir_all(staging);
+        if let Some(d) = &created {
+            let _ = std::fs::remove_dir_all(d);
+        }
+    };
+    let staged = (|| -> io::Result<()> {
+        std::fs::create_dir(&staging)
+            .map_err(|e| error_at(&staging, "cannot create directory", e))?;
+        for (i, name) in names.iter().enumerate() {
+            let files = encode(i)?;
+            let method_dir = staging.join(name);
+            std::fs::create_dir(&method_dir)
+                .map_err(|e| error_at(&method_dir, "cannot create directory", e))?;
+            for (file, bytes) in &files {
+                write_new_file(&method_dir.join(file), bytes)?;
+            }
+        }
+        Ok(())
+    })();
+    if let Err(e) = staged {
+        cleanup(&staging);
+        return Err(e);
+    }
+    // Move into place: an existing folder is first moved aside into the staging folder.
+    let mut moved: Vec<(PathBuf, PathBuf, Option<PathBuf>)> = Vec::new();
+    for name in names {
+        let (new, target) = (staging.join(name), dir.join(name));
+        let aside = staging.join(format!(".old-{name}"));
+        let result = (|| -> io::Result<Option<PathBuf>> {
+            let old = if target.exists() {
+                std::fs::rename(&target, &aside)
+                    .map_err(|e| error_at(&target, "cannot replace", e))?;
+                Some(aside.clone())
+            } else {
+                None
+            };
+            if let Err(e) = std::fs::rename(&new, &target) {
+                if let Some(o) = &old {
+                    let _ = std::fs::rename(o, &target);
+                }
+                return Err(error_at(&target, "cannot move into place", e));
+            }
+            Ok(old)
+        })();
+        match result {
+            Ok(old) => moved.push((new, target, old)),
+            Err(e) => {
+                for (new, target, old) in moved.iter().rev() {
+                    let _ = std::fs::rename(target, new);
+                    if let Some(o) = old {
+                        let _ = std::fs::rename(o, target);
+                    }
+                }
+                cleanup(&staging);
+                return Err(e);
+            }
+        }
+    }
+    std::fs::remove_dir_all(&staging)
+        .map_err(|e| error_at(&staging, "outputs written, but cannot remove", e))
 }
 
 /// Encodes every output file of one method in memory: `(file name, bytes)` in a fixed order
@@ -418,8 +546,7 @@ pub fn raw_image_file_name(raw: &RawImage8) -> io::Result<String> {
 /// from `shaded` (linear RGB, `width·height` pixels, row 0 at the top), `visibility.png`,
 /// `visibility.exr`, `visibility.pfm`, one `<name>.png` per raw image, and `stats.json`.
 ///
-/// Everything is encoded before anything is written, and files appear under their final
-/// names only once all were written ([`write_files_all_or_nothing`]).
+/// The folder appears only once every file was encoded and written ([`write_method_dirs`]).
 pub fn write_method_outputs(
     dir: &Path,
     method: &str,
@@ -428,13 +555,9 @@ pub fn write_method_outputs(
     width: u32,
     height: u32,
 ) -> io::Result<()> {
-    if method.is_empty() || method.contains(['/', '\\']) || method.starts_with('.') {
-        return Err(invalid(format!(
-            "method name {method:?} is not a plain directory name"
-        )));
-    }
-    let files = encode_method_outputs(out, shaded, width, height)?;
-    write_files_all_or_nothing(&dir.join(method), &files)
+    write_method_dirs(dir, &[method], |_| {
+        encode_method_outputs(out, shaded, width, height)
+    })
 }
 
 /// Width in pixels of the separator between the panels of [`write_side_by_side_png`].
@@ -720,6 +843,56 @@ mod tests {
         out2.raw_images[0].name = "visibility".into();
         assert!(write_method_outputs(&dir, "hard-sv", &out2, &[[0.0; 3]; 6], 3, 2).is_err());
         assert!(!dir.exists());
+    }
+
+    #[test]
+    fn a_failing_method_leaves_nothing_behind() {
+        let out = sample_output(Visibility::Gray(vec![0.5; 6]));
+        let good = |_: usize| encode_method_outputs(&out, &[[0.0; 3]; 6], 3, 2);
+        // A new output directory: not created at all.
+        let dir = temp_dir("fail").join("new");
+        let fail_second = |i: usize| {
+            if i == 1 {
+                Err(io::Error::other("disk full"))
+            } else {
+                good(i)
+            }
+        };
+        let e = write_method_dirs(&dir, &["hard-sv", "ssv"], fail_second).unwrap_err();
+        assert_eq!(e.to_string(), "disk full");
+        assert!(!dir.parent().unwrap().exists());
+        // An existing output directory with an older run: left exactly as it was.
+        write_method_dirs(&dir, &["hard-sv"], good).unwrap();
+        std::fs::write(dir.join("hard-sv").join("mine.txt"), "x").unwrap();
+        write_method_dirs(&dir, &["hard-sv", "ssv"], fail_second).unwrap_err();
+        let listing = |d: &Path| {
+            let mut v: Vec<String> = std::fs::read_dir(d)
+                .unwrap()
+                .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+                .collect();
+            v.sort();
+            v
+        };
+        assert_eq!(listing(&dir), ["hard-sv"]);
+        assert!(listing(&dir.join("hard-sv")).contains(&"mine.txt".to_string()));
+        // Success replaces the method folder as a whole.
+        write_method_dirs(&dir, &["hard-sv", "ssv"], good).unwrap();
+        assert_eq!(listing(&dir), ["hard-sv", "ssv"]);
+        assert!(!listing(&dir.join("hard-sv")).contains(&"mine.txt".to_string()));
+        // A file where a method folder should be: refused before anything is written.
+        std::fs::remove_dir_all(dir.join("ssv")).unwrap();
+        std::fs::write(dir.join("ssv"), "a file").unwrap();
+        std::fs::remove_dir_all(dir.join("hard-sv")).unwrap();
+        let e = write_method_dirs(&dir, &["hard-sv", "ssv"], good).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "{}: cannot write outputs: exists and is not a directory",
+                dir.join("ssv").display()
+            )
+        );
+        assert_eq!(listing(&dir), ["ssv"]);
+        std::fs::remove_dir_all(dir.parent().unwrap()).unwrap();
     }
 
     #[test]

@@ -41,6 +41,7 @@
 //! Option values must be scalars (integer, float, bool, string). Every error is one line
 //! naming the file, and for syntax and schema errors the line and column.
 
+use super::input_file::read_input_file;
 use super::obj::{check_transform, load_obj};
 use super::validate::validate;
 use super::{builtin, Camera, Light, LightShape, Mesh, OptionValue, RawOptions, RgbTexture, Scene};
@@ -82,7 +83,7 @@ const DEFAULT_AMBIENT: f64 = 0.15;
 const DEFAULT_COLOR: [f64; 3] = [0.8, 0.8, 0.8];
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a scene table")]
 struct SceneDef {
     width: Option<u32>,
     height: Option<u32>,
@@ -97,34 +98,48 @@ struct SceneDef {
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a camera table")]
 struct CameraDef {
-    eye: [f64; 3],
-    target: [f64; 3],
-    up: [f64; 3],
+    eye: Three,
+    target: Three,
+    up: Three,
     vfov_deg: f64,
     near: Option<f64>,
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a light table")]
 struct LightDef {
     #[serde(rename = "type")]
     kind: String,
-    center: [f64; 3],
-    u: Option<[f64; 3]>,
-    v: Option<[f64; 3]>,
+    center: Three,
+    u: Option<Three>,
+    v: Option<Three>,
     radius: Option<f64>,
-    normal: Option<[f64; 3]>,
+    normal: Option<Three>,
     texture: Option<String>,
 }
 
 #[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, expecting = "a mesh table")]
 struct MeshDef {
     obj: String,
     transform: Option<Vec<f64>>,
-    color: Option<[f64; 3]>,
+    color: Option<Three>,
+}
+
+/// Exactly three numbers (a point, a vector or an RGB colour): a list of any other length is
+/// an error, not truncated (serde's fixed-size arrays let TOML drop the extra values).
+#[derive(Clone, Copy)]
+struct Three([f64; 3]);
+
+impl<'de> Deserialize<'de> for Three {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = Vec::<f64>::deserialize(d)?;
+        <[f64; 3]>::try_from(v.as_slice())
+            .map(Three)
+            .map_err(|_| de::Error::invalid_length(v.len(), &"exactly 3 numbers"))
+    }
 }
 
 /// An option value as written; arrays and tables are kept only to be reported as errors.
@@ -176,14 +191,21 @@ impl<'de> Deserialize<'de> for RawValue {
 /// texture paths relative to its directory). The scene's `source` is `path` as given.
 pub fn load_scene_file(path: &Path) -> Result<Scene, InputError> {
     let source = path.display().to_string();
+    let bytes = read_input_file(path)
+        .map_err(|m| InputError::new(&source, format!("cannot read scene file: {m}")))?;
     let format = Format::from_path(path).ok_or_else(|| {
         InputError::new(
             &source,
             "unknown scene file extension (expected .toml or .json)",
         )
     })?;
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| InputError::new(&source, format!("cannot read scene file: {e}")))?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        let (line, col) = line_col_of_bytes(e.as_bytes(), e.utf8_error().valid_up_to());
+        InputError::new(
+            &source,
+            format!("line {line}, column {col}: not UTF-8 text"),
+        )
+    })?;
     let base_dir = path.parent().unwrap_or(Path::new(""));
     parse_scene_str(&text, format, &source, base_dir)
 }
@@ -196,6 +218,13 @@ pub fn parse_scene_str(
     source_name: &str,
     base_dir: &Path,
 ) -> Result<Scene, InputError> {
+    if format == Format::Json && text.trim_start().starts_with('[') {
+        // serde would read an array as the scene's fields in order.
+        return Err(InputError::new(
+            source_name,
+            "the top level must be a JSON object ({...}) holding the scene, not an array",
+        ));
+    }
     let def: SceneDef = match format {
         Format::Toml => toml::from_str(text).map_err(|e| toml_error(source_name, text, &e))?,
         Format::Json => serde_json::from_str(text).map_err(|e| json_error(source_name, &e))?,
@@ -205,14 +234,15 @@ pub fn parse_scene_str(
     Ok(scene)
 }
 
-/// A built-in scene name or a scene file path. Built-in names take precedence; an argument
-/// that is neither gives an error listing the built-in scenes.
+/// A built-in scene name or a scene file path. Built-in names take precedence; an existing
+/// path is loaded as a scene file (a directory or special file gets the error of
+/// [`read_input_file`]); an argument that is neither gives an error listing the built-in scenes.
 pub fn resolve(arg: &str) -> Result<Scene, InputError> {
     if let Some(scene) = builtin::load(arg) {
         return Ok(scene);
     }
     let path = Path::new(arg);
-    if path.is_file() {
+    if std::fs::metadata(path).is_ok() {
         return load_scene_file(path);
     }
     Err(InputError::new(
@@ -260,6 +290,14 @@ fn one_line(s: &str) -> String {
         .join("; ")
 }
 
+/// 1-based line and column (in bytes) of byte offset `at` in `bytes`, which need not be text.
+fn line_col_of_bytes(bytes: &[u8], at: usize) -> (usize, usize) {
+    let before = &bytes[..at.min(bytes.len())];
+    let line = before.iter().filter(|b| **b == b'\n').count() + 1;
+    let col = before.iter().rev().take_while(|b| **b != b'\n').count() + 1;
+    (line, col)
+}
+
 /// 1-based line and column (in characters) of byte offset `at` in `text`.
 fn line_col(text: &str, at: usize) -> (usize, usize) {
     let mut at = at.min(text.len());
@@ -272,17 +310,17 @@ fn line_col(text: &str, at: usize) -> (usize, usize) {
     (line, col)
 }
 
-fn v3(a: [f64; 3]) -> Vec3 {
-    DVec3::from_array(a).as_vec3()
+fn v3(a: Three) -> Vec3 {
+    DVec3::from_array(a.0).as_vec3()
 }
 
 /// Turns the parsed definition into a scene: light fields per type, meshes, options.
 fn build(def: SceneDef, source: &str, base_dir: &Path) -> Result<Scene, InputError> {
     let at = |object: &str, message: String| InputError::at(source, object, message);
     let camera = Camera {
-        eye: DVec3::from_array(def.camera.eye),
-        target: DVec3::from_array(def.camera.target),
-        up: DVec3::from_array(def.camera.up),
+        eye: DVec3::from_array(def.camera.eye.0),
+        target: DVec3::from_array(def.camera.target.0),
+        up: DVec3::from_array(def.camera.up.0),
         vfov_deg: def.camera.vfov_deg,
         near: def.camera.near,
     };
@@ -460,7 +498,7 @@ fn build_mesh(m: &MeshDef, i: usize, source: &str, base_dir: &Path) -> Result<Me
             Some(mat)
         }
     };
-    let color = m.color.unwrap_or(DEFAULT_COLOR).map(|c| c as f32);
+    let color = m.color.map_or(DEFAULT_COLOR, |c| c.0).map(|c| c as f32);
     let path = base_dir.join(&m.obj);
     let display = path.display().to_string();
     load_obj(&path, &display, transform, color)
@@ -471,8 +509,9 @@ fn build_mesh(m: &MeshDef, i: usize, source: &str, base_dir: &Path) -> Result<Me
 /// images (EXR) are taken as linear. Alpha is ignored.
 fn load_texture(path: &Path) -> Result<RgbTexture, String> {
     let name = path.display().to_string();
-    let img = image::ImageReader::open(path)
-        .and_then(|r| r.with_guessed_format())
+    let bytes = read_input_file(path).map_err(|m| format!("cannot open {name}: {m}"))?;
+    let img = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
         .map_err(|e| format!("cannot open {name}: {e}"))?
         .decode()
         .map_err(|e| format!("cannot decode {name}: {e}"))?;
@@ -629,6 +668,53 @@ f = 0.5
         .to_string();
         assert!(
             e.starts_with("s.json: line 2, column ") && e.contains(": unknown field `x`"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn lists_of_three_take_exactly_three_numbers() {
+        let e = err(&GOOD.replace("color = [1, 0, 0]", "color = [1, 0, 0, 0.5]"));
+        assert!(
+            e.starts_with("s.toml: line 18, column ")
+                && e.contains("invalid length 4, expected exactly 3 numbers"),
+            "{e}"
+        );
+        let e = err(&GOOD.replace("eye = [0, 2, 5]", "eye = [0, 2]"));
+        assert!(
+            e.contains("invalid length 2, expected exactly 3 numbers"),
+            "{e}"
+        );
+        let json = r#"{"camera": {"eye": [0, 2, 5, 1], "target": [0, 0, 0], "up": [0, 1, 0],
+            "vfov_deg": 45}, "light": {"type": "point", "center": [0, 4, 0]}, "meshes": []}"#;
+        let e = parse_scene_str(json, Format::Json, "s.json", Path::new("."))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("invalid length 4, expected exactly 3 numbers"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn messages_name_no_internal_types() {
+        let e = parse_scene_str(" [1, 2]", Format::Json, "s.json", Path::new("."))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "s.json: the top level must be a JSON object ({...}) holding the scene, not an array"
+        );
+        let e = parse_scene_str("{\"camera\": 5}", Format::Json, "s.json", Path::new("."))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.ends_with("invalid type: integer `5`, expected a camera table"),
+            "{e}"
+        );
+        let e = err("camera = 5\n");
+        assert!(
+            e.contains("expected a camera table") && !e.contains("Def"),
             "{e}"
         );
     }

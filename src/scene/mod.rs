@@ -14,6 +14,7 @@
 
 pub mod builtin;
 pub mod file;
+pub mod input_file;
 pub mod obj;
 pub mod procedural;
 pub mod validate;

@@ -15,18 +15,20 @@
 //!
 //! Closedness is checked later by [`super::validate`], which names the mesh and the edge.
 
+use super::input_file::read_input_file;
 use super::procedural::transform_point;
 use super::Mesh;
 use crate::error::InputError;
 use glam::{Mat4, Vec3, Vec4};
 use std::collections::HashMap;
-use std::io::Cursor;
+use std::io::{BufRead, Cursor, Read};
 use std::path::Path;
 
 /// Loads the OBJ file at `path` as one mesh named `display_name` (also the file named in
 /// errors), optionally transformed, with albedo `color`.
 ///
-/// Errors (each naming `display_name`): unreadable file, OBJ parse error, a non-finite
+/// Errors (each naming `display_name`): unreadable file (not a regular file, too large: the
+/// rule of [`read_input_file`]), OBJ parse error (with the line and its cause), a non-finite
 /// coordinate, no triangles, a non-affine, non-finite or singular transform.
 pub fn load_obj(
     path: &Path,
@@ -34,8 +36,8 @@ pub fn load_obj(
     transform: Option<Mat4>,
     color: [f32; 3],
 ) -> Result<Mesh, InputError> {
-    let bytes = std::fs::read(path)
-        .map_err(|e| InputError::new(display_name, format!("cannot read OBJ file: {e}")))?;
+    let bytes = read_input_file(path)
+        .map_err(|m| InputError::new(display_name, format!("cannot read OBJ file: {m}")))?;
     parse_obj(&bytes, display_name, transform, color)
 }
 
@@ -53,10 +55,23 @@ pub fn parse_obj(
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, _materials) = tobj::load_obj_buf(&mut Cursor::new(bytes), &options, |_| {
+    let mut reader = LineCountingReader {
+        inner: Cursor::new(bytes),
+        newlines: 0,
+        at_line_start: true,
+    };
+    let (models, _materials) = tobj::load_obj_buf(&mut reader, &options, |_| {
         Err(tobj::LoadError::OpenFileFailed)
     })
-    .map_err(|e| err(format!("OBJ parse error: {e}")))?;
+    .map_err(|e| {
+        // tobj stops at the line it cannot use: the last line the reader handed out.
+        let line = reader.newlines + usize::from(!reader.at_line_start);
+        err(format!(
+            "OBJ parse error at line {line}: {} ({})",
+            load_error_cause(&e),
+            quoted_line(bytes, line)
+        ))
+    })?;
 
     let mut positions: Vec<Vec3> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
@@ -125,6 +140,76 @@ pub fn parse_obj(
         triangles,
         color,
     })
+}
+
+/// A `BufRead` over the OBJ bytes that counts the lines handed out, so that a `tobj` error,
+/// which carries no position, can name its line.
+struct LineCountingReader<'a> {
+    inner: Cursor<&'a [u8]>,
+    /// Newlines consumed so far.
+    newlines: usize,
+    /// Whether the last byte consumed was a newline (or nothing was consumed).
+    at_line_start: bool,
+}
+
+impl Read for LineCountingReader<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.count(&buf[..n]);
+        Ok(n)
+    }
+}
+
+impl BufRead for LineCountingReader<'_> {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        self.inner.fill_buf()
+    }
+
+    fn consume(&mut self, amt: usize) {
+        let start = self.inner.position() as usize;
+        let data = *self.inner.get_ref();
+        let end = (start + amt).min(data.len());
+        self.count(&data[start..end]);
+        self.inner.consume(amt);
+    }
+}
+
+impl LineCountingReader<'_> {
+    fn count(&mut self, consumed: &[u8]) {
+        if let Some(last) = consumed.last() {
+            self.newlines += consumed.iter().filter(|b| **b == b'\n').count();
+            self.at_line_start = *last == b'\n';
+        }
+    }
+}
+
+/// What a `tobj` error means, in words that say what the line should have been.
+fn load_error_cause(e: &tobj::LoadError) -> String {
+    use tobj::LoadError as E;
+    match e {
+        E::ReadError => "not UTF-8 text".into(),
+        E::PositionParseError => "a vertex position needs three numbers: v x y z".into(),
+        E::FaceParseError => "a face needs three or more vertex indices: f i j k".into(),
+        E::NormalParseError => "a normal needs three numbers: vn x y z".into(),
+        E::TexcoordParseError => "a texture coordinate needs one to three numbers: vt u v".into(),
+        E::FaceVertexOutOfBounds => "face vertex index out of bounds (no such vertex)".into(),
+        other => other.to_string(),
+    }
+}
+
+/// Line `line` (1-based) of `bytes`, quoted and shortened to 80 characters, as text.
+fn quoted_line(bytes: &[u8], line: usize) -> String {
+    let text = bytes
+        .split(|b| *b == b'\n')
+        .nth(line.saturating_sub(1))
+        .unwrap_or_default();
+    let text = String::from_utf8_lossy(text);
+    let text = text.trim_end_matches('\r');
+    let mut shown: String = text.chars().take(80).collect();
+    if shown.len() < text.len() {
+        shown.push('…');
+    }
+    format!("line reads {shown:?}")
 }
 
 /// A transform must be finite, affine (last row 0,0,0,1) and invertible.
@@ -222,9 +307,21 @@ mod tests {
     #[test]
     fn parse_errors() {
         let e = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", None).unwrap_err();
-        assert!(
-            e.to_string().starts_with("test.obj: OBJ parse error: "),
-            "{e}"
+        assert_eq!(
+            e.to_string(),
+            "test.obj: OBJ parse error at line 4: a face needs three or more vertex indices: \
+             f i j k (line reads \"f 1 2 x\")"
+        );
+        let e = parse("# c\nv 0 0 0\nv 0 zero 0\nv 0 1 0\n", None).unwrap_err();
+        assert_eq!(
+            e.message,
+            "OBJ parse error at line 3: a vertex position needs three numbers: v x y z \
+             (line reads \"v 0 zero 0\")"
+        );
+        let e = parse_obj(b"v 0 0 0\nv 1 \xff 0", "x.obj", None, [0.5; 3]).unwrap_err();
+        assert_eq!(
+            e.message,
+            "OBJ parse error at line 2: not UTF-8 text (line reads \"v 1 \u{fffd} 0\")"
         );
         let e = parse("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", None).unwrap_err();
         assert!(e.message.contains("out of bounds"), "{e}");

@@ -2,19 +2,20 @@
 //! one [`InputError`] naming the scene, the object and the problem (DESIGN.md "Bad input").
 //!
 //! Checked: image size in `1..=MAX_IMAGE_SIZE`; every number finite (camera, light, every
-//! vertex, colours); camera with `vfov_deg` in (0,180), `eye ≠ target`, `up` not parallel to
+//! vertex, colours); camera with `vfov_deg` from [`MIN_VFOV_DEG`] up to (not including) 180, `eye ≠ target`, `up` not parallel to
 //! the view direction, `near > 0` if given; 1 to [`MAX_LIGHTS`] lights, each of positive size (radius > 0; `u`, `v`
 //! non-zero and not parallel; disk normal non-zero; a non-empty texture of `width·height`
-//! texels in `[0, 1]`); at least one mesh, each a closed, consistently wound two-manifold
+//! texels in `[0, 1]`, emitting in every channel); at least one mesh, each a closed, consistently wound two-manifold
 //! ([`crate::geometry::adjacency::build`], the message names the offending edge) that is not
 //! inside out (signed volume not negative; flat two-sided meshes have volume 0); every light
-//! centre strictly outside every mesh (bounding box, then ray parity); `ambient` in `[0, 1]`;
+//! centre strictly outside every mesh (bounding box, then ray parity), and every light's
+//! shape (sphere, disk, rectangle) apart from every mesh ([`light_shape_touches`]); `ambient` in `[0, 1]`;
 //! a `methods` list, if given, not empty (the names are checked by the methods registry).
 
 use super::{Camera, Light, LightShape, Mesh, Scene};
 use crate::error::InputError;
 use crate::geometry::adjacency;
-use crate::limits::{MAX_IMAGE_SIZE, MAX_LIGHTS};
+use crate::limits::{MAX_IMAGE_SIZE, MAX_LIGHTS, MIN_VFOV_DEG};
 use glam::{DVec3, Vec3};
 
 /// Checks every invariant a [`Scene`] promises (see the module docs); the first violation is
@@ -71,7 +72,178 @@ pub fn validate(scene: &Scene) -> Result<(), InputError> {
             }
         }
     }
+    for (k, light) in scene.lights.iter().enumerate() {
+        for (i, mesh) in scene.meshes.iter().enumerate() {
+            if let Some(t) = light_shape_touches(mesh, light) {
+                return Err(err(
+                    &scene.light_object(k, "light"),
+                    format!(
+                        "light intersects geometry: the {} light around {} overlaps meshes[{i}] \
+                         ({}): its triangle {t} touches or crosses the light",
+                        light.shape.type_name(),
+                        fmt_f32v(light.center),
+                        mesh.name
+                    ),
+                ));
+            }
+        }
+    }
     Ok(())
+}
+
+/// The first triangle of the closed mesh `m` that the light's shape touches or crosses, for a
+/// light whose center is outside `m` ([`point_touches`]): a triangle within `radius` of a
+/// sphere's center, a triangle meeting a disk or a rectangle (its plane section, or the
+/// triangle itself when it lies in the light's plane, overlaps the light). A shape whose
+/// center is outside the mesh and which meets no triangle is outside the mesh. `None` for a
+/// point light and for a shape apart from the mesh.
+pub fn light_shape_touches(m: &Mesh, light: &Light) -> Option<usize> {
+    let c = light.center.as_dvec3();
+    let (shape, reach): (LightRegion, DVec3) = match &light.shape {
+        LightShape::Point => return None,
+        LightShape::Sphere { radius } => {
+            let r = f64::from(*radius);
+            (LightRegion::Ball(r), DVec3::splat(r))
+        }
+        LightShape::Disk { radius, normal } => {
+            let r = f64::from(*radius);
+            let n = normal.as_dvec3().normalize();
+            (LightRegion::Disk(r, n), DVec3::splat(r))
+        }
+        LightShape::Rect { u, v } | LightShape::TexturedRect { u, v, .. } => {
+            let (u, v) = (u.as_dvec3(), v.as_dvec3());
+            (LightRegion::Rect(u, v), u.abs() + v.abs())
+        }
+    };
+    let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+    for p in &m.positions {
+        lo = lo.min(p.as_dvec3());
+        hi = hi.max(p.as_dvec3());
+    }
+    if (c + reach).cmplt(lo).any() || (c - reach).cmpgt(hi).any() {
+        return None;
+    }
+    m.triangles.iter().position(|t| {
+        let tri = t.map(|i| m.positions[i as usize].as_dvec3());
+        shape.meets(c, tri)
+    })
+}
+
+/// The extent of a light around its center, for [`light_shape_touches`].
+enum LightRegion {
+    /// A ball of this radius.
+    Ball(f64),
+    /// A disk of this radius facing along the unit normal.
+    Disk(f64, DVec3),
+    /// The parallelogram spanned by these half-extent vectors.
+    Rect(DVec3, DVec3),
+}
+
+impl LightRegion {
+    /// Whether the region around `c` shares a point with the triangle `tri`.
+    fn meets(&self, c: DVec3, tri: [DVec3; 3]) -> bool {
+        let [a, b, p] = tri;
+        match self {
+            LightRegion::Ball(r) => closest_point_on_triangle(c, a, b, p).distance(c) <= *r,
+            LightRegion::Disk(r, n) => {
+                let closest = match plane_section(c, *n, tri).as_slice() {
+                    [] => return false,
+                    [q] => *q,
+                    [q0, q1] => closest_point_on_segment(c, *q0, *q1),
+                    _ => closest_point_on_triangle(c, a, b, p),
+                };
+                closest.distance(c) <= *r
+            }
+            LightRegion::Rect(u, v) => {
+                // Coordinates (s, t) with x − c = s·u + t·v + k·normal; the light is |s|, |t| ≤ 1.
+                let normal = u.cross(*v);
+                let (du, dv) = (v.cross(normal), normal.cross(*u));
+                let (su, tv) = (u.dot(du), v.dot(dv));
+                let st: Vec<[f64; 2]> = plane_section(c, normal, tri)
+                    .iter()
+                    .map(|q| [(*q - c).dot(du) / su, (*q - c).dot(dv) / tv])
+                    .collect();
+                !clip_to_unit_square(st).is_empty()
+            }
+        }
+    }
+}
+
+/// The points where triangle `tri` meets the plane through `c` with normal `n`: none, one
+/// point, the two ends of a segment, or the three corners when the triangle lies in the plane.
+fn plane_section(c: DVec3, n: DVec3, tri: [DVec3; 3]) -> Vec<DVec3> {
+    let d = tri.map(|x| n.dot(x - c));
+    if d.iter().all(|&x| x == 0.0) {
+        return tri.to_vec();
+    }
+    let mut pts = Vec::with_capacity(2);
+    for i in 0..3 {
+        let j = (i + 1) % 3;
+        if d[i] == 0.0 {
+            pts.push(tri[i]);
+        } else if (d[i] < 0.0) != (d[j] < 0.0) && d[j] != 0.0 {
+            pts.push(tri[i] + (tri[j] - tri[i]) * (d[i] / (d[i] - d[j])));
+        }
+    }
+    pts
+}
+
+/// Closest point to `p` on the segment `ab`.
+fn closest_point_on_segment(p: DVec3, a: DVec3, b: DVec3) -> DVec3 {
+    let d = b - a;
+    let l2 = d.length_squared();
+    if l2 == 0.0 {
+        a
+    } else {
+        a + d * ((p - a).dot(d) / l2).clamp(0.0, 1.0)
+    }
+}
+
+/// The convex polygon `poly` (a point or a segment allowed) clipped to the square
+/// [−1, 1]² (Sutherland–Hodgman); empty when they do not meet.
+fn clip_to_unit_square(mut poly: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
+    for (axis, side) in [(0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0)] {
+        let inside = |q: &[f64; 2]| q[axis] * side <= 1.0;
+        let n = poly.len();
+        let mut out = Vec::with_capacity(n + 2);
+        for i in 0..n {
+            let (p, q) = (poly[i], poly[(i + 1) % n]);
+            if inside(&p) {
+                out.push(p);
+            }
+            if n > 1 && inside(&p) != inside(&q) {
+                let t = (side - p[axis]) / (q[axis] - p[axis]);
+                out.push([p[0] + (q[0] - p[0]) * t, p[1] + (q[1] - p[1]) * t]);
+            }
+        }
+        poly = out;
+    }
+    poly
+}
+
+/// Largest f32 rounding of a stored coordinate that passes without a warning, as a fraction
+/// of the scene's size (the diagonal of [`Scene::bounds`]): 10⁻⁴, a tenth of a pixel of a
+/// 1024-pixel view of the whole scene.
+pub const F32_ROUNDING_WARN_FRACTION: f64 = 1e-4;
+
+/// A warning (not an error) for a scene whose coordinates lie so far from the origin that
+/// storing them as f32 (vertices and light centers are f32, as on a GPU) can move a point by
+/// more than [`F32_ROUNDING_WARN_FRACTION`] of the scene's size: half an f32 step at the
+/// largest coordinate. `None` when the rounding is below that.
+pub fn f32_rounding_warning(scene: &Scene) -> Option<String> {
+    let (lo, hi) = scene.bounds();
+    let size = (hi.as_dvec3() - lo.as_dvec3()).length();
+    let largest = lo.abs().max(hi.abs()).max_element();
+    let rounding = f64::from(f32::from_bits(largest.to_bits() + 1) - largest) / 2.0;
+    (rounding > F32_ROUNDING_WARN_FRACTION * size).then(|| {
+        format!(
+            "{}: warning: coordinates up to {largest} are stored as f32 and rounded by up to \
+             {rounding}, {:.1e} of the scene's size {size:.4} (warned above \
+             {F32_ROUNDING_WARN_FRACTION:e}); move the scene toward the origin",
+            crate::error::shortened(&scene.source),
+            rounding / size
+        )
+    })
 }
 
 /// Formats a vector as `(x, y, z)` with Rust's shortest round-trip digits.
@@ -99,10 +271,14 @@ fn validate_camera(c: &Camera) -> Result<(), (&'static str, String)> {
             return Err((what, format!("{} is not finite", fmt_v3(v))));
         }
     }
-    if !(c.vfov_deg.is_finite() && c.vfov_deg > 0.0 && c.vfov_deg < 180.0) {
+    if !(c.vfov_deg.is_finite() && c.vfov_deg >= MIN_VFOV_DEG && c.vfov_deg < 180.0) {
         return Err((
             "camera.vfov_deg",
-            format!("{} is outside (0, 180)", c.vfov_deg),
+            format!(
+                "{} is outside [{MIN_VFOV_DEG}, 180) (narrower views leave less than an f32 \
+                 step of the coordinates per pixel)",
+                c.vfov_deg
+            ),
         ));
     }
     if let Some(n) = c.near {
@@ -216,6 +392,20 @@ fn validate_light(l: &Light) -> Result<(), (&'static str, String)> {
                         texture.source, texture.texels[i]
                     ),
                 ));
+            }
+            // Visibility per channel is the light seen over the light emitted: 0/0 for a
+            // channel no texel emits in.
+            for (c, name) in ["red", "green", "blue"].into_iter().enumerate() {
+                if texture.texels.iter().all(|t| t[c] == 0.0) {
+                    return Err((
+                        "light.texture",
+                        format!(
+                            "{}: every texel's {name} is 0: the light emits no {name}, so its \
+                             {name} visibility (light seen / light emitted) would be 0/0",
+                            texture.source
+                        ),
+                    ));
+                }
             }
             Ok(())
         }
@@ -487,6 +677,14 @@ mod tests {
         let mut s = scene();
         s.camera.vfov_deg = 180.0;
         assert!(msg(&s).contains("camera.vfov_deg"));
+        s.camera.vfov_deg = 1e-30;
+        assert_eq!(
+            msg(&s),
+            "test-scene: camera.vfov_deg: 0.000000000000000000000000000001 is outside \
+             [0.1, 180) (narrower views leave less than an f32 step of the coordinates per pixel)"
+        );
+        s.camera.vfov_deg = MIN_VFOV_DEG;
+        validate(&s).unwrap();
         let mut s = scene();
         s.camera.near = Some(0.0);
         assert!(msg(&s).contains("camera.near"));
@@ -523,6 +721,21 @@ mod tests {
             },
         };
         assert!(msg(&s).contains("light.texture: t.png is empty"));
+        s.lights[0].shape = LightShape::TexturedRect {
+            u: Vec3::X,
+            v: Vec3::Z,
+            texture: RgbTexture {
+                width: 2,
+                height: 1,
+                texels: vec![[1.0, 0.0, 0.5], [0.25, 0.0, 0.0]],
+                source: "t.png".into(),
+            },
+        };
+        assert_eq!(
+            msg(&s),
+            "test-scene: light.texture: t.png: every texel's green is 0: the light emits no \
+             green, so its green visibility (light seen / light emitted) would be 0/0"
+        );
         s.lights[0].shape = LightShape::Point;
         s.lights[0].center.y = f32::INFINITY;
         assert!(msg(&s).contains("light.center"));
@@ -586,6 +799,8 @@ mod tests {
     #[test]
     fn light_inside_geometry() {
         let mut s = scene();
+        // A point light: only its center counts (area lights: `area_light_overlapping_geometry`).
+        s.lights[0].shape = LightShape::Point;
         s.lights[0].center = Vec3::new(0.1, 1.05, -0.02);
         let m = msg(&s);
         assert!(
@@ -610,6 +825,96 @@ mod tests {
         assert!(msg(&s).contains("on the surface of meshes[1] (quad)"));
         s.lights[0].center = Vec3::new(0.3, 3.0, 0.2);
         validate(&s).unwrap();
+    }
+
+    #[test]
+    fn area_light_overlapping_geometry() {
+        // The ball (centre (0, 1, 0), radius 0.5) and the floor (top face y = 0).
+        let mut s = scene();
+        let overlaps = |s: &Scene, mesh: &str| {
+            let m = msg(s);
+            assert!(
+                m.starts_with("test-scene: light: light intersects geometry: the ")
+                    && m.contains(&format!("overlaps {mesh}: its triangle ")),
+                "{m}"
+            );
+        };
+        let light = |c: [f32; 3], shape: LightShape| Light {
+            center: Vec3::from_array(c),
+            shape,
+        };
+        let rect = |u: Vec3, v: Vec3| LightShape::Rect { u, v };
+        let disk = |radius: f32, normal: Vec3| LightShape::Disk { radius, normal };
+        // (a light touching the mesh, the same light moved or shrunk clear of it, the mesh)
+        let cases = [
+            (
+                light([0.0, 1.9, 0.0], LightShape::Sphere { radius: 0.5 }),
+                light([0.0, 1.9, 0.0], LightShape::Sphere { radius: 0.35 }),
+                "meshes[1] (ball)",
+            ),
+            // A rectangle whose centre is clear of the ball but whose corner cuts into it.
+            (
+                light([0.7, 1.2, 0.0], rect(Vec3::X * 0.4, Vec3::Z * 0.4)),
+                light([1.0, 1.2, 0.0], rect(Vec3::X * 0.4, Vec3::Z * 0.4)),
+                "meshes[1] (ball)",
+            ),
+            // A vertical rectangle reaching down through the floor.
+            (
+                light([2.0, 0.3, 2.0], rect(Vec3::X * 0.2, Vec3::Y * 0.5)),
+                light([2.0, 0.6, 2.0], rect(Vec3::X * 0.2, Vec3::Y * 0.5)),
+                "meshes[0] (floor)",
+            ),
+            // A disk in the plane of the floor's top face, its centre just beyond the edge.
+            (
+                light([3.2, 0.0, 0.0], disk(0.5, Vec3::Y)),
+                light([3.2, 0.0, 0.0], disk(0.1, Vec3::Y)),
+                "meshes[0] (floor)",
+            ),
+            // A tilted disk dipping into the ball.
+            (
+                light([0.0, 1.7, 0.0], disk(0.6, Vec3::new(1.0, 1.0, 0.0))),
+                light([0.0, 1.7, 0.0], disk(0.1, Vec3::new(1.0, 1.0, 0.0))),
+                "meshes[1] (ball)",
+            ),
+        ];
+        for (touching, clear, mesh) in cases {
+            s.lights[0] = touching;
+            overlaps(&s, mesh);
+            s.lights[0] = clear;
+            validate(&s).unwrap();
+        }
+    }
+
+    #[test]
+    fn far_coordinates_warn() {
+        let mut s = scene();
+        assert_eq!(f32_rounding_warning(&s), None);
+        let far = Vec3::new(30000.0, 0.0, 0.0);
+        for m in &mut s.meshes {
+            for p in &mut m.positions {
+                *p += far;
+            }
+        }
+        s.lights[0].center += far;
+        let w = f32_rounding_warning(&s).unwrap();
+        assert!(
+            w.starts_with(
+                "test-scene: warning: coordinates up to 30003 are stored as f32 and rounded by \
+                 up to 0.0009765625, 1.0e-4 of the scene's size 9.42"
+            ),
+            "{w}"
+        );
+    }
+
+    #[test]
+    fn unit_square_clipping() {
+        assert!(clip_to_unit_square(vec![[2.0, 0.0], [3.0, 5.0]]).is_empty());
+        assert!(!clip_to_unit_square(vec![[2.0, 0.0], [0.0, 0.5]]).is_empty());
+        assert!(!clip_to_unit_square(vec![[0.5, 0.5]]).is_empty());
+        assert!(clip_to_unit_square(vec![[1.5, 0.5]]).is_empty());
+        // A big triangle around the square.
+        assert!(!clip_to_unit_square(vec![[-9.0, -9.0], [9.0, -9.0], [0.0, 9.0]]).is_empty());
+        assert!(clip_to_unit_square(vec![[2.0, 2.0], [3.0, 2.0], [2.0, 3.0]]).is_empty());
     }
 
     #[test]
