@@ -106,7 +106,10 @@ fn cutting_the_occluder_in_two_does_not_change_the_sphere_shadow() {
     assert!(max <= 4.0 * f32::EPSILON, "max |Δ| = {max}");
 }
 
-/// Sphere-light hard cases, every V-buffer format: values finite and in [0, 1].
+/// Sphere-light hard cases, every V-buffer format: values finite, and before the resolve's
+/// clamp in [0, 1] (`clamped_pixels` = 0) except where Paper III §5.3's object-overlap
+/// artifact drives the sum below 0 — on `cube-of-spheres-sphere` (pinned: 159 pixels with the
+/// float V-buffers, 157 with the 8-bit one at 48²):
 /// * `cylinder`, `cube-of-spheres-sphere`: faceted occluders (single-silhouette and overlap
 ///   artifacts, Paper III §5.3);
 /// * `eye-in-shadow` with a sphere: the eye in the hard shadow volume (z-fail) and in wedges;
@@ -147,11 +150,13 @@ fn sphere_hard_cases_stay_in_unit_interval() {
                 },
             );
             let v = gray(&r.visibility);
-            assert!(
-                v.iter().all(|x| x.is_finite() && (0.0..=1.0).contains(x)),
-                "{} {vbuffer:?}",
-                s.source
-            );
+            assert!(v.iter().all(|x| x.is_finite()), "{} {vbuffer:?}", s.source);
+            let pinned = match (s.source.as_str(), vbuffer) {
+                ("cube-of-spheres-sphere", VBufferFormat::Split8) => 157,
+                ("cube-of-spheres-sphere", _) => 159,
+                _ => 0,
+            };
+            assert_eq!(r.clamped_pixels, pinned, "{} {vbuffer:?}", s.source);
         }
     }
     // The large light leaves no umbra on the floor under the quad.

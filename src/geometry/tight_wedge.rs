@@ -167,11 +167,22 @@ impl ConvexPolyhedron {
         self.split(plane).0
     }
 
-    /// Whether `x` is inside or on every face plane (within `eps`).
+    /// Whether `x` is inside or on every face plane (within `eps`). Faces of no area — the
+    /// slivers clipping leaves where a cutting plane runs along an edge or through a vertex,
+    /// whose vertices coincide or line up to rounding — have no meaningful plane and are
+    /// skipped: a face counts when its Newell normal (twice its area) exceeds 10⁻¹² of the
+    /// polyhedron's squared size.
     pub fn contains(&self, x: DVec3, eps: f64) -> bool {
+        let Some(origin) = self.vertices().next().copied() else {
+            return false;
+        };
+        let size2 = self
+            .vertices()
+            .map(|v| (*v - origin).length_squared())
+            .fold(0.0, f64::max);
         self.faces.iter().all(|f| {
             let n = newell_normal(f);
-            n.dot(x - f[0]) <= eps * n.length()
+            n.length() <= 1e-12 * size2 || n.dot(x - f[0]) <= eps * n.length()
         })
     }
 }
