@@ -162,5 +162,10 @@ pub fn table(scene: &Scene, runs: &[MethodRun]) -> String {
             }
         }
     }
+    for r in runs {
+        for w in &r.output.stats.warnings {
+            s += &format!("warning: {}: {w}\n", r.method);
+        }
+    }
     s
 }

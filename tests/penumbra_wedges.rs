@@ -173,6 +173,19 @@ fn zfail_is_right_in_eye_in_shadow_and_zpass_is_not() {
         zpass > 5.0 * zfail && zpass > 0.1,
         "z-pass {zpass} vs z-fail {zfail}"
     );
+    // pw2002 has no z-fail (Paper I): its result here is the z-pass one, and it says so.
+    let warned = |frame: &Frame| {
+        penumbra::methods::run("pw2002", frame)
+            .unwrap()
+            .stats
+            .warnings
+            .iter()
+            .any(|w| w.contains("eye is in shadow"))
+    };
+    assert!(warned(&frame));
+    let cylinder = small("cylinder", 16);
+    let lit = Frame::render(&cylinder, GpuSettings::default()).unwrap();
+    assert!(!warned(&lit));
 }
 
 /// Floor + the lowest `k` quads of `overlap-stress` under a small sphere light; returns the LI

@@ -588,6 +588,7 @@ mod tests {
                 plan: serde_json::Value::Null,
                 passes: vec![],
                 totals: Counters::default(),
+                warnings: vec![],
                 clamped_pixels: 0,
             },
         }

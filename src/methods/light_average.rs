@@ -33,6 +33,16 @@ pub fn run(
     }
     let visibility = average(outputs.iter().map(|o| &o.visibility));
     let clamped_pixels = outputs.iter().map(|o| o.stats.clamped_pixels).sum();
+    let warnings = outputs
+        .iter()
+        .enumerate()
+        .flat_map(|(k, o)| {
+            o.stats
+                .warnings
+                .iter()
+                .map(move |w| format!("light {k}: {w}"))
+        })
+        .collect();
     let mut passes = vec![frame.pass.clone()];
     let mut raw_images = Vec::new();
     let mut plans = Vec::new();
@@ -65,6 +75,7 @@ pub fn run(
     };
     let mut stats = super::method_stats(method, frame, start, &plan, passes);
     stats.clamped_pixels = clamped_pixels;
+    stats.warnings = warnings;
     Ok(MethodOutput {
         visibility,
         raw_images,

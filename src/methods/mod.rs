@@ -181,6 +181,7 @@ pub fn method_stats(
         plan: serde_json::to_value(plan).unwrap_or(serde_json::Value::Null),
         passes,
         totals,
+        warnings: Vec::new(),
         clamped_pixels: 0,
     }
 }

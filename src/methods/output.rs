@@ -85,6 +85,9 @@ pub struct MethodStats {
     pub passes: Vec<PassStats>,
     /// Counters summed over all passes.
     pub totals: Counters,
+    /// What the user must know about this result (e.g. a paper's limit the scene runs into),
+    /// one sentence each; printed under the table.
+    pub warnings: Vec<String>,
     /// Pixels whose value the method's final resolve had to clamp into [0, 1] (what it
     /// computed there was outside); 0 for methods whose result cannot leave [0, 1]. Summed over
     /// the lights of a scene with several lights.

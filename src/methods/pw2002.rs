@@ -42,7 +42,7 @@ use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::li_buffer::{li_clamped, li_visibility, LiFormat, LiOverflow, LiTile};
 use crate::gpu::raster::{bin, draw, no_tile_culling};
 use crate::gpu::setup::CullMode;
-use crate::plan::{BufferPlan, MethodPlan};
+use crate::plan::{eye_in_shadow, representative_light_points, BufferPlan, MethodPlan};
 use crate::scene::{LightShape, Scene};
 use std::time::Instant;
 
@@ -325,6 +325,14 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         vec![frame.pass.clone(), pass],
     );
     stats.clamped_pixels = clamped;
+    let lights = representative_light_points(frame.scene);
+    if eye_in_shadow(frame.scene, frame.proj.near, &lights) {
+        stats.warnings.push(
+            "the eye is in shadow: Paper I counts wedges z-pass only, so this result is wrong \
+             where the eye's shadow volumes are (pw-restructured has Paper II's z-fail)"
+                .into(),
+        );
+    }
     Ok(MethodOutput {
         visibility,
         raw_images: vec![],

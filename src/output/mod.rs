@@ -653,6 +653,7 @@ mod tests {
                 plan: serde_json::json!({"passes": ["scene-depth"]}),
                 passes: vec![],
                 totals: Counters::default(),
+                warnings: vec![],
                 clamped_pixels: 0,
             },
         }
