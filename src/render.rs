@@ -167,5 +167,14 @@ pub fn table(scene: &Scene, runs: &[MethodRun]) -> String {
             s += &format!("warning: {}: {w}\n", r.method);
         }
     }
+    let sphere = scene
+        .lights
+        .iter()
+        .any(|l| matches!(l.shape, crate::scene::LightShape::Sphere { .. }));
+    if sphere && runs.iter().any(|r| r.method == "nsample") {
+        s += "note: a sphere light is the disk facing each receiver for raycast (unless \
+              raycast.sphere = fixed-disk) and the wedge methods, but one disk facing the \
+              center of the mesh bounds for nsample\n";
+    }
     s
 }

@@ -50,3 +50,45 @@ fn nsample_1024_agrees_with_raycast_on_single_quad() {
     };
     assert!(vis.iter().filter(|v| **v > 0.05 && **v < 0.95).count() > 50);
 }
+
+/// The two references' definitions of a sphere light differ: `raycast` sees the disk facing
+/// each receiver (the papers'), `nsample` one disk facing the center of the mesh bounds (one
+/// set of samples per frame). With `raycast`'s `sphere = fixed-disk` both use nsample's disk
+/// and agree to sampling noise (mean ≤ 1/(2k) as above, k = 16); with the default they differ
+/// by the definitions' gap, large under a sphere big next to the scene (radius 1.2 over the
+/// cylinder): pinned as a gap at least 3× the noise (measured at 48²: mean 0.0037 against
+/// 0.0009).
+#[test]
+fn references_agree_on_one_sphere_definition_and_differ_by_the_gap_otherwise() {
+    let mut s = builtin::load("cylinder").unwrap();
+    s.width = 48;
+    s.height = 48;
+    s.lights[0].shape = penumbra::scene::LightShape::Sphere { radius: 1.2 };
+    s.methods = Some(vec!["raycast".into(), "nsample".into()]);
+    let set =
+        |s: &mut penumbra::scene::Scene, m: &str, k: &str, v: penumbra::scene::OptionValue| {
+            s.options.entry(m.into()).or_default().insert(k.into(), v);
+        };
+    set(
+        &mut s,
+        "nsample",
+        "n",
+        penumbra::scene::OptionValue::Int(256),
+    );
+    let mean = |s: &penumbra::scene::Scene| {
+        let runs = penumbra::render::render_scene(s).unwrap();
+        let ns = runs.iter().find(|r| r.method == "nsample").unwrap();
+        ns.error.as_ref().unwrap().mean_abs
+    };
+    let facing = mean(&s);
+    set(
+        &mut s,
+        "raycast",
+        "sphere",
+        penumbra::scene::OptionValue::Str("fixed-disk".into()),
+    );
+    let fixed = mean(&s);
+    eprintln!("nsample 256 vs raycast: facing each receiver {facing}, fixed disk {fixed}");
+    assert!(fixed <= 1.0 / 32.0, "same definition: mean {fixed}");
+    assert!(facing >= 3.0 * fixed, "gap {facing} vs noise {fixed}");
+}

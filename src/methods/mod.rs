@@ -188,7 +188,10 @@ pub fn method_stats(
 
 /// `raycast` (the ground truth by definition): per pixel, the fraction of the light visible
 /// from the receiver point, with `samples` jittered stratified samples (default 1024, a perfect
-/// square) and `seed`. `receiver = "depth-buffer"` (default) uses the depth-buffer point the
+/// square) and `seed`. A sphere light is the disk facing each receiver (`sphere =
+/// facing-receiver`, the papers' definition) or, with `sphere = fixed-disk`, `nsample`'s one
+/// disk facing the center of the mesh bounds, so the two references can be compared on one
+/// definition. `receiver = "depth-buffer"` (default) uses the depth-buffer point the
 /// rasterized methods see; `"primary-ray"` the exact hit of the ray through the pixel center
 /// with the visible triangle's plane.
 fn run_raycast(frame: &Frame) -> Result<MethodOutput, InputError> {
@@ -214,7 +217,16 @@ fn run_raycast(frame: &Frame) -> Result<MethodOutput, InputError> {
         method: "raycast".into(),
         passes: vec![frame.pass.name.clone(), "raycast".into()],
         buffers: vec![],
-        settings: serde_json::json!({ "samples": settings.samples, "seed": settings.seed, "pattern": "jittered", "receiver": receiver }),
+        settings: serde_json::json!({
+            "samples": settings.samples,
+            "seed": settings.seed,
+            "pattern": "jittered",
+            "receiver": receiver,
+            "sphere": match settings.sphere_disk {
+                raycast::SphereDisk::FacingReceiver => "the disk facing each receiver".to_string(),
+                raycast::SphereDisk::Facing(p) => format!("one disk facing ({}, {}, {})", p.x, p.y, p.z),
+            },
+        }),
     };
     let passes = vec![frame.pass.clone(), pass];
     Ok(MethodOutput {
@@ -227,9 +239,18 @@ fn run_raycast(frame: &Frame) -> Result<MethodOutput, InputError> {
 /// Read and check `[options.raycast]`: the settings and the receiver choice.
 fn raycast_options(scene: &Scene) -> Result<(raycast::RaycastSettings, &'static str), InputError> {
     let mut r = options::OptionReader::new(scene, "raycast");
+    let sphere_disk = match r.choice(
+        "sphere",
+        &["facing-receiver", "fixed-disk"],
+        "facing-receiver",
+    )? {
+        "fixed-disk" => raycast::SphereDisk::Facing(nsample::sphere_disk_target(scene)),
+        _ => raycast::SphereDisk::FacingReceiver,
+    };
     let settings = raycast::RaycastSettings {
         samples: r.uint("samples", raycast::DEFAULT_SAMPLES as u64, 1..=65536)? as u32,
         seed: r.uint("seed", 0, 0..=u64::MAX >> 1)?,
+        sphere_disk,
     };
     settings
         .validate()

@@ -21,7 +21,7 @@ use crate::frame::{Frame, BACKGROUND};
 use crate::gpu::counters::Counters;
 use crate::light::sampling::{stratified, LightSample, Pattern};
 use crate::plan::{representative_light_points, BufferPlan, MethodPlan};
-use crate::scene::LightShape;
+use crate::scene::{LightShape, Scene};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -30,10 +30,10 @@ use std::time::Instant;
 pub const DEFAULT_SAMPLES: u64 = 1024;
 
 /// The point a sphere light's sampling disk faces: the center of the mesh bounds.
-pub fn sphere_disk_target(frame: &Frame) -> Vec3 {
+pub fn sphere_disk_target(scene: &Scene) -> Vec3 {
     let mut lo = Vec3::splat(f32::MAX);
     let mut hi = Vec3::splat(f32::MIN);
-    for m in &frame.scene.meshes {
+    for m in &scene.meshes {
         for p in &m.positions {
             lo = lo.min(*p);
             hi = hi.max(*p);
@@ -56,7 +56,7 @@ pub fn options(
         scene.light(),
         n as u32,
         Pattern::Centered,
-        sphere_disk_target(frame),
+        sphere_disk_target(frame.scene),
     )
     .map_err(|e| InputError::at(&scene.source, "options.nsample.n", e))?;
     Ok((samples, settings, mode))

@@ -112,14 +112,27 @@ pub const DEFAULT_SAMPLES: u32 = 1024;
 
 pub use crate::frame::Receiver;
 
+/// Which disk a sphere light is seen as.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SphereDisk {
+    /// The disk through the center facing each receiver (Paper IV §4.2.1; what the wedge
+    /// methods' coverage uses): the default.
+    FacingReceiver,
+    /// One disk for all receivers, facing this point (what `nsample` must use: one set of
+    /// light samples per frame, facing the center of the mesh bounds).
+    Facing(Vec3),
+}
+
 /// Options of the `raycast` method (issue 2, `raycast`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RaycastSettings {
     /// Light samples per receiver: a perfect square k×k ([`sampling::stratified`]); default
     /// [`DEFAULT_SAMPLES`].
     pub samples: u32,
     /// Seed of the jitter ([`Pattern::Jittered`]); default 0.
     pub seed: u64,
+    /// The disk a sphere light is seen as.
+    pub sphere_disk: SphereDisk,
 }
 
 impl Default for RaycastSettings {
@@ -127,6 +140,7 @@ impl Default for RaycastSettings {
         Self {
             samples: DEFAULT_SAMPLES,
             seed: 0,
+            sphere_disk: SphereDisk::FacingReceiver,
         }
     }
 }
@@ -766,10 +780,15 @@ pub fn raycast_visibility(
 ) -> Visibility {
     let caster = ShadowRayCaster::new(scene);
     let light = scene.light();
-    // Only sphere lights depend on the receiver (the facing disk); sample the others once.
-    let shared = match light.shape {
-        LightShape::Sphere { .. } => None,
-        _ => Some((
+    // Only sphere lights seen as the disk facing each receiver depend on the receiver; sample
+    // the others once.
+    let shared = match (&light.shape, settings.sphere_disk) {
+        (LightShape::Sphere { .. }, SphereDisk::FacingReceiver) => None,
+        (_, SphereDisk::Facing(toward)) => Some((
+            light_samples(light, toward, settings),
+            sampling::bounding_quad(light, toward),
+        )),
+        (_, SphereDisk::FacingReceiver) => Some((
             light_samples(light, light.center, settings),
             sampling::bounding_quad(light, light.center),
         )),
@@ -987,7 +1006,11 @@ mod tests {
         let s = scene(rect_light(), vec![floor(), slab]);
         let caster = ShadowRayCaster::new(&s);
         for (samples, seed) in [(1024, 0), (1024, 77), (256, 3)] {
-            let settings = RaycastSettings { samples, seed };
+            let settings = RaycastSettings {
+                samples,
+                seed,
+                ..Default::default()
+            };
             let v = caster.visibility(s.light(), &ON_FLOOR, &settings);
             let k = f64::from(samples).sqrt();
             assert!(
@@ -1065,6 +1088,7 @@ mod tests {
             let settings = RaycastSettings {
                 samples: 64,
                 seed: 5,
+                ..Default::default()
             };
             let run = |threads| {
                 rayon::ThreadPoolBuilder::new()
@@ -1182,6 +1206,7 @@ mod tests {
         let settings = RaycastSettings {
             samples: 256,
             seed: 11,
+            ..Default::default()
         };
         let mut empty_total = 0;
         for light in lights {
@@ -1273,13 +1298,13 @@ mod tests {
         assert!(RaycastSettings::default().validate().is_ok());
         assert!(RaycastSettings {
             samples: 1000,
-            seed: 0
+            ..Default::default()
         }
         .validate()
         .is_err());
         assert!(RaycastSettings {
             samples: 0,
-            seed: 0
+            ..Default::default()
         }
         .validate()
         .is_err());
