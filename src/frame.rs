@@ -22,6 +22,12 @@ use rayon::prelude::*;
 use std::sync::OnceLock;
 use std::time::Instant;
 
+/// How far off its triangle's plane a depth-buffer receiver may lie, relative to the scene's
+/// diagonal, before [`Frame::receivers`] puts it on the plane: half the ray-origin offset of
+/// the `raycast` reference (`methods::raycast::ORIGIN_OFFSET`), so that a receiver the depth
+/// buffer holds well enough is never below the surface its shadow rays start from.
+pub const RECEIVER_PLANE_TOLERANCE: f64 = 0.5e-4;
+
 /// The pixel at which no geometry was drawn.
 pub const BACKGROUND: u32 = u32::MAX;
 
@@ -99,7 +105,7 @@ pub struct Frame<'s> {
     /// Row-major visible primitive ids, computed on first use ([`Frame::prim_ids`]).
     prim_rows: OnceLock<Vec<u32>>,
     /// Row-major depth-buffer receivers, computed on first use ([`Frame::receivers`]).
-    depth_receivers: OnceLock<Vec<Option<Receiver>>>,
+    depth_receivers: OnceLock<(Vec<Option<Receiver>>, usize)>,
 }
 
 impl<'s> Frame<'s> {
@@ -241,23 +247,55 @@ impl<'s> Frame<'s> {
     /// Geometric unit normal of primitive `prim` (outward; visible faces face the camera
     /// because back faces are culled).
     pub fn normal_of(&self, prim: u32) -> Vec3 {
-        let (mi, ti) = self.prim_owner[prim as usize];
-        let m = &self.scene.meshes[mi as usize];
-        let [a, b, c] = m.triangles[ti as usize].map(|i| m.positions[i as usize].as_dvec3());
-        (b - a).cross(c - a).normalize_or_zero().as_vec3()
+        self.plane_of(prim).0.as_vec3()
     }
 
     /// The receiver of every pixel, row-major; `None` for background: the depth-buffer point,
     /// i.e. the pixel center un-projected at its stored depth — the point the rasterized
-    /// methods see (computed once per frame).
+    /// methods see (computed once per frame). Where the depth format cannot hold the surface
+    /// — the un-projected point lies farther than [`RECEIVER_PLANE_TOLERANCE`] of the scene's
+    /// diagonal off the visible triangle's plane (a near plane far too close for the depth
+    /// format, geometry far away) — the receiver is the exact hit of the pixel ray with that
+    /// plane instead, as [`Frame::primary_ray_receivers`] computes it: a reference evaluated
+    /// below the surface it should see shadows itself, and every method's error against it
+    /// would be the reference's ([`Frame::snapped_receivers`] counts these pixels).
     pub fn receivers(&self) -> &[Option<Receiver>] {
+        &self.depth_receivers_and_snaps().0
+    }
+
+    /// How many receivers of [`Frame::receivers`] were moved onto their triangle's plane
+    /// because the depth buffer could not hold the surface.
+    pub fn snapped_receivers(&self) -> usize {
+        self.depth_receivers_and_snaps().1
+    }
+
+    fn depth_receivers_and_snaps(&self) -> &(Vec<Option<Receiver>>, usize) {
         self.depth_receivers.get_or_init(|| {
             let depth = self.depth_values();
-            self.receivers_with(|i, x, y, _| {
-                self.proj
-                    .unproject(x, y, self.gpu.depth.to_window(depth[i]))
-            })
+            let (lo, hi) = self.scene.bounds();
+            let tolerance = RECEIVER_PLANE_TOLERANCE * (hi - lo).length() as f64;
+            let snapped = std::sync::atomic::AtomicUsize::new(0);
+            let receivers = self.receivers_with(|i, x, y, prim| {
+                let p = self
+                    .proj
+                    .unproject(x, y, self.gpu.depth.to_window(depth[i]));
+                let (n, a) = self.plane_of(prim);
+                if n.dot(p - a).abs() <= tolerance {
+                    return p;
+                }
+                snapped.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                self.primary_hit(x, y, prim)
+            });
+            (receivers, snapped.into_inner())
         })
+    }
+
+    /// The unit normal and a vertex of primitive `prim`'s triangle, in f64.
+    fn plane_of(&self, prim: u32) -> (DVec3, DVec3) {
+        let (mi, ti) = self.prim_owner[prim as usize];
+        let m = &self.scene.meshes[mi as usize];
+        let [a, b, c] = m.triangles[ti as usize].map(|i| m.positions[i as usize].as_dvec3());
+        ((b - a).cross(c - a).normalize_or_zero(), a)
     }
 
     /// Like [`Frame::receivers`], but each point is the exact intersection of the ray through

@@ -229,10 +229,19 @@ fn run_raycast(frame: &Frame) -> Result<MethodOutput, InputError> {
         }),
     };
     let passes = vec![frame.pass.clone(), pass];
+    let mut stats = method_stats("raycast", frame, start, &plan, passes);
+    let snapped = frame.snapped_receivers();
+    if snapped > 0 && receiver == "depth-buffer" {
+        stats.warnings.push(format!(
+            "{snapped} pixels: the depth buffer cannot hold the surface there (a near plane too \
+             close for the depth format?); their receivers, for every method, are the exact \
+             hits of the pixel rays with the visible triangles"
+        ));
+    }
     Ok(MethodOutput {
         visibility,
         raw_images: vec![],
-        stats: method_stats("raycast", frame, start, &plan, passes),
+        stats,
     })
 }
 

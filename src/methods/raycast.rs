@@ -1294,6 +1294,11 @@ mod tests {
     }
 
     #[test]
+    fn receivers_are_snapped_below_half_the_ray_offset() {
+        assert_eq!(crate::frame::RECEIVER_PLANE_TOLERANCE, ORIGIN_OFFSET / 2.0);
+    }
+
+    #[test]
     fn settings_validation() {
         assert!(RaycastSettings::default().validate().is_ok());
         assert!(RaycastSettings {
