@@ -19,8 +19,11 @@
 //!
 //! The ray from the receiver `p` to the sample `s` starts at `o = p + δ·n`, with `n` the
 //! receiver's camera-side normal and `δ = `[`ORIGIN_OFFSET`]` ×` the length (f32) of the
-//! diagonal of [`Scene::bounds`], so that a receiver read back from a quantized depth buffer
-//! does not shadow itself. The ray is blocked when it hits any triangle at a parameter
+//! diagonal of [`Scene::bounds`] `+ `[`ORIGIN_OFFSET_ULPS`]` × ε_f32 ×` the largest coordinate
+//! magnitude of the scene, so that a receiver read back from a quantized depth buffer does
+//! not shadow itself, and neither does one whose f32 coordinates far from the origin are
+//! rounded by more than the first term (a scene 3·10⁴ units out rounds receivers by ~0.002,
+//! more than 10⁻⁴ of a 10-unit scene). The ray is blocked when it hits any triangle at a parameter
 //! `t ∈ (ε, 1 − ε)` of the segment `o + t·(s − o)`, `ε = `[`SEGMENT_EPSILON`] (the far end
 //! keeps a light that lies on a surface from being blocked by that surface).
 //!
@@ -98,6 +101,10 @@ use rayon::prelude::*;
 /// Ray-origin offset along the receiver normal, relative to the scene diagonal (module doc,
 /// "Shadow rays").
 pub const ORIGIN_OFFSET: f64 = 1e-4;
+
+/// The part of the ray-origin offset that scales with the coordinates' magnitude, in f32 ulps
+/// (module doc, "Shadow rays"): receivers are f32 points, rounded by half an ulp.
+pub const ORIGIN_OFFSET_ULPS: f64 = 2.0;
 
 /// The open parameter interval `(ε, 1 − ε)` of the shadow segment in which a hit blocks it.
 pub const SEGMENT_EPSILON: f64 = 1e-6;
@@ -483,7 +490,8 @@ impl ShadowRayCaster {
             triangles,
             nodes,
             depth,
-            origin_offset: ORIGIN_OFFSET * bounds_diagonal,
+            origin_offset: ORIGIN_OFFSET * bounds_diagonal
+                + ORIGIN_OFFSET_ULPS * f64::from(f32::EPSILON) * magnitude,
             pad,
             scale: diagonal + magnitude,
         }
