@@ -227,6 +227,22 @@ impl Wedge {
     }
 }
 
+/// The smallest light radius the wedge construction uses, relative to the distance from the
+/// light to the farthest scene point (a quarter of [`far_distance`]); see [`wedge_radius`].
+pub const MIN_RELATIVE_RADIUS: f64 = 1e-5;
+
+/// The radius the wedges of a sphere light of `radius` are built with: `radius`, or
+/// [`MIN_RELATIVE_RADIUS`] of the light's distance to the farthest scene point if that is
+/// larger. Wedges of a smaller light are thinner than the arithmetic resolves — the front and
+/// back planes of an edge within ~10⁻⁶ rad of each other and of the light ray, so the side
+/// planes built from their intersection lines are rounding noise: a radius of 10⁻⁶ over a
+/// 1-unit box blackened 62% of the floor (RMSE 0.79 against `raycast`), 10⁻³⁰ as well —
+/// while the penumbra of such a light is far below a pixel at any image size, so widening it
+/// changes no visible result.
+pub fn wedge_radius(radius: f64, far: f64) -> f64 {
+    radius.max(MIN_RELATIVE_RADIUS * far / FAR_FACTOR)
+}
+
 /// Options of the wedge construction.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct WedgeOptions {
@@ -289,8 +305,11 @@ pub fn far_distance(scene: &Scene, c: DVec3) -> f64 {
         );
         r = r.max((p - c).length());
     }
-    4.0 * r.max(1e-3)
+    FAR_FACTOR * r.max(1e-3)
 }
+
+/// How much farther than the farthest scene point [`far_distance`] puts the far points.
+const FAR_FACTOR: f64 = 4.0;
 
 /// The quad normal of edge a→b from light center c: out of the hard shadow volume.
 pub fn quad_normal(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {

@@ -34,8 +34,8 @@ use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, BACKGROUND};
 use crate::geometry::penumbra_wedge::{
-    build_wedges, far_distance, li_amount, light_intensity, wedge_triangles, FaceKind,
-    WedgeOptions, WedgeSet,
+    build_wedges, far_distance, li_amount, light_intensity, wedge_radius, wedge_triangles,
+    FaceKind, WedgeOptions, WedgeSet,
 };
 use crate::gpu::buffers::alloc_tiles;
 use crate::gpu::depth::{DepthFunc, DepthState};
@@ -139,7 +139,7 @@ fn sphere_lights(scene: &Scene) -> Result<Vec<WedgeOptions>, InputError> {
         .map(|(k, l)| match l.shape {
             LightShape::Sphere { radius } => Ok(WedgeOptions {
                 center: l.center.as_dvec3(),
-                radius: radius as f64,
+                radius: wedge_radius(radius as f64, far_distance(scene, l.center.as_dvec3())),
                 far: far_distance(scene, l.center.as_dvec3()),
                 extra_corner_wedges: true,
                 parallel_rule: true,
@@ -240,17 +240,16 @@ pub fn render_li(
             };
             let w = &set.wedges[wi as usize];
             let dir = frame.proj.unproject(f.x, f.y, 0.5) - eye;
-            // The value at a wedge boundary point: §5 (`cancel`) uses 255 on the front plane and 0
-            // elsewhere; the §4 pseudocode (`compute`) evaluates s at the point itself.
-            let boundary = |k: FaceKind, t: f64| match s.side_planes {
-                SidePlanes::Cancel => {
-                    if k == FaceKind::Front {
-                        full
-                    } else {
-                        0
-                    }
-                }
-                SidePlanes::Compute => {
+            // The value at a wedge boundary point: 255 on the front plane and 0 on the back plane
+            // (equation 1 with t_f = 0 or t_b = 0, the identity §5 uses); on a side plane §5
+            // (`cancel`) uses 0, the §4 pseudocode (`compute`) evaluates s at the point itself.
+            // Evaluating the front and back planes numerically instead fails for wedges
+            // thinner than the arithmetic (a light of radius 1e-6 or less): t_f + t_b vanishes
+            // and s is noise or the 0/0 fallback, so the umbra step is lost or doubled.
+            let boundary = |k: FaceKind, t: f64| match (k, s.side_planes) {
+                (FaceKind::Front, _) => full,
+                (FaceKind::Back, _) | (_, SidePlanes::Cancel) => 0,
+                (_, SidePlanes::Compute) => {
                     li_amount(light_intensity(w, eye + dir * t, s.smooth), s.lights)
                 }
             };
