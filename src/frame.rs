@@ -158,6 +158,22 @@ impl<'s> Frame<'s> {
                 }
             },
         );
+        if tiles
+            .iter()
+            .all(|t| t.prim.iter().all(|&p| p == BACKGROUND))
+        {
+            let c = &scene.camera;
+            return Err(InputError::at(
+                &scene.source,
+                "camera",
+                format!(
+                    "no geometry in view: every pixel would be background (the eye at ({}, {}, \
+                     {}) looking at ({}, {}, {}) with vfov {}° sees none of the meshes, or \
+                     they are smaller than a pixel)",
+                    c.eye.x, c.eye.y, c.eye.z, c.target.x, c.target.y, c.target.z, c.vfov_deg
+                ),
+            ));
+        }
         tiles
             .par_iter_mut()
             .enumerate()
@@ -253,8 +269,8 @@ impl<'s> Frame<'s> {
     /// The receiver of every pixel, row-major; `None` for background: the depth-buffer point,
     /// i.e. the pixel center un-projected at its stored depth — the point the rasterized
     /// methods see (computed once per frame). Where the depth format cannot hold the surface
-    /// — the un-projected point lies farther than [`RECEIVER_PLANE_TOLERANCE`] of the scene's
-    /// diagonal off the visible triangle's plane (a near plane far too close for the depth
+    /// — the un-projected point lies farther than [`RECEIVER_PLANE_TOLERANCE`] of the meshes'
+    /// diagonal ([`Scene::mesh_bounds`]) off the visible triangle's plane (a near plane far too close for the depth
     /// format, geometry far away) — the receiver is the exact hit of the pixel ray with that
     /// plane instead, as [`Frame::primary_ray_receivers`] computes it: a reference evaluated
     /// below the surface it should see shadows itself, and every method's error against it
@@ -272,7 +288,7 @@ impl<'s> Frame<'s> {
     fn depth_receivers_and_snaps(&self) -> &(Vec<Option<Receiver>>, usize) {
         self.depth_receivers.get_or_init(|| {
             let depth = self.depth_values();
-            let (lo, hi) = self.scene.bounds();
+            let (lo, hi) = self.scene.mesh_bounds();
             let tolerance = RECEIVER_PLANE_TOLERANCE * (hi - lo).length() as f64;
             let snapped = std::sync::atomic::AtomicUsize::new(0);
             let receivers = self.receivers_with(|i, x, y, prim| {
@@ -412,6 +428,22 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("the near plane (near = 0.1)"), "{e}");
+    }
+
+    /// A camera that sees no mesh is an error naming the camera, not a blank frame.
+    #[test]
+    fn an_empty_frame_is_refused() {
+        let mut s = builtin::load("single-quad").unwrap();
+        s.width = 16;
+        s.height = 16;
+        s.camera.target = s.camera.eye + (s.camera.eye - s.camera.target) * 3.0;
+        let e = Frame::render(&s, GpuSettings::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("single-quad: camera: no geometry in view: every pixel would be"),
+            "{e}"
+        );
     }
 
     /// A near plane reaching into a tetrahedron, edge-on to one of its faces: its grid column

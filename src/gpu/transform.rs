@@ -22,10 +22,15 @@ use glam::{DMat4, DVec3, DVec4, Vec3};
 pub struct ClipVertex(pub [f32; 4]);
 
 /// Default near distance when the scene gives none: 1/1000 of the distance from the eye to
-/// the farthest corner of the scene bounds (light included). Chosen so that D24 keeps
-/// ~10 bits of depth resolution across a scene of that size with the infinite far plane.
-pub fn default_near(camera: &Camera, bounds: (Vec3, Vec3)) -> f64 {
-    let (lo, hi) = (bounds.0.as_dvec3(), bounds.1.as_dvec3());
+/// the farthest corner of the scene bounds (light included), chosen so that D24 keeps
+/// ~10 bits of depth resolution across a scene of that size with the infinite far plane —
+/// but never more than half the view depth of the nearest geometry the camera sees
+/// ([`nearest_visible_depth`]): a light or a mesh far away must not push the near plane past
+/// the scene in view (a light at 1e30 once cleared the whole frame to background).
+pub fn default_near(scene: &Scene) -> f64 {
+    let camera = &scene.camera;
+    let (lo, hi) = scene.bounds();
+    let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
     let mut far = 0.0f64;
     for i in 0..8 {
         let c = DVec3::new(
@@ -35,7 +40,62 @@ pub fn default_near(camera: &Camera, bounds: (Vec3, Vec3)) -> f64 {
         );
         far = far.max((c - camera.eye).length());
     }
-    (far * 1e-3).max(1e-6)
+    let seen = nearest_visible_depth(scene).unwrap_or(f64::INFINITY);
+    (far * 1e-3).min(seen * 0.5).max(1e-6)
+}
+
+/// The smallest view depth (distance along the view axis) of any mesh point inside the
+/// camera's view pyramid (the frustum without its near and far planes), or `None` when no
+/// triangle reaches into it. Each triangle is clipped against the pyramid's four sides and
+/// the eye's plane in f64 view space (Sutherland–Hodgman); back faces count too, since the
+/// near plane must not cut them either.
+pub fn nearest_visible_depth(scene: &Scene) -> Option<f64> {
+    let camera = &scene.camera;
+    let view = DMat4::look_at_rh(camera.eye, camera.target, camera.up);
+    let tan_y = (camera.vfov_deg.to_radians() * 0.5).tan();
+    let tan_x = tan_y * scene.width as f64 / scene.height as f64;
+    // Inside ≥ 0; view space looks down −z, so the depth is −z.
+    let planes: [fn(DVec3, f64, f64) -> f64; 5] = [
+        |v, _, _| -v.z,
+        |v, tx, _| -v.z * tx - v.x,
+        |v, tx, _| -v.z * tx + v.x,
+        |v, _, ty| -v.z * ty - v.y,
+        |v, _, ty| -v.z * ty + v.y,
+    ];
+    let mut nearest: Option<f64> = None;
+    for m in &scene.meshes {
+        let pts: Vec<DVec3> = m
+            .positions
+            .iter()
+            .map(|p| view.transform_point3(p.as_dvec3()))
+            .collect();
+        for t in &m.triangles {
+            let mut poly: Vec<DVec3> = t.iter().map(|&i| pts[i as usize]).collect();
+            for plane in planes {
+                let d: Vec<f64> = poly.iter().map(|&v| plane(v, tan_x, tan_y)).collect();
+                let mut out = Vec::with_capacity(poly.len() + 1);
+                for i in 0..poly.len() {
+                    let j = (i + 1) % poly.len();
+                    if d[i] >= 0.0 {
+                        out.push(poly[i]);
+                    }
+                    if (d[i] >= 0.0) != (d[j] >= 0.0) {
+                        let s = d[i] / (d[i] - d[j]);
+                        out.push(poly[i] + (poly[j] - poly[i]) * s);
+                    }
+                }
+                poly = out;
+                if poly.is_empty() {
+                    break;
+                }
+            }
+            for v in &poly {
+                let depth = (-v.z).max(0.0);
+                nearest = Some(nearest.map_or(depth, |n: f64| n.min(depth)));
+            }
+        }
+    }
+    nearest
 }
 
 /// The camera transform of one frame: view, projection and their product, in f64.
@@ -58,10 +118,7 @@ pub struct Projection {
 impl Projection {
     /// The projection of `scene`'s camera at the scene's image size.
     pub fn for_scene(scene: &Scene) -> Self {
-        let near = scene
-            .camera
-            .near
-            .unwrap_or_else(|| default_near(&scene.camera, scene.bounds()));
+        let near = scene.camera.near.unwrap_or_else(|| default_near(scene));
         Self::new(&scene.camera, scene.width, scene.height, near)
     }
 
@@ -269,6 +326,37 @@ mod tests {
             vfov_deg: 90.0,
             near: Some(0.5),
         }
+    }
+
+    /// The default near plane: 1/1000 of the farthest corner of the bounds where that is in
+    /// front of all geometry in view (single-quad: unchanged by the cap), and at most half the
+    /// nearest visible depth when a light far away stretches the bounds.
+    #[test]
+    fn default_near_stays_in_front_of_the_geometry_in_view() {
+        let mut s = crate::scene::builtin::load("single-quad").unwrap();
+        let seen = nearest_visible_depth(&s).unwrap();
+        let near = default_near(&s);
+        assert!(near < 0.5 * seen && near > 1e-4, "{near} vs {seen}");
+        s.lights[0].center.y = 1e30;
+        assert_eq!(nearest_visible_depth(&s), Some(seen));
+        assert_eq!(default_near(&s), 0.5 * seen);
+        // The floor passes under the eye: the nearest point in view is where the bottom of the
+        // view pyramid meets it, not a vertex (the floor's corners are behind the camera or
+        // outside the view).
+        let mut low = crate::scene::builtin::load("single-quad").unwrap();
+        low.camera.eye = DVec3::new(0.0, 0.5, 0.0);
+        low.camera.target = DVec3::new(0.0, 0.5, -1.0);
+        low.camera.vfov_deg = 90.0;
+        low.width = 64;
+        low.height = 64;
+        let seen = nearest_visible_depth(&low).unwrap();
+        // Bottom plane y = 0.5 − depth·tan(45°) meets the floor top y = 0 at depth 0.5.
+        assert!((seen - 0.5).abs() < 1e-9, "{seen}");
+        // Looking over every mesh (the floor would need a depth of 28 to enter the view).
+        low.camera.eye = DVec3::new(0.0, 5.0, 0.0);
+        low.camera.target = DVec3::new(10.0, 5.0, 0.0);
+        low.camera.vfov_deg = 20.0;
+        assert_eq!(nearest_visible_depth(&low), None);
     }
 
     #[test]

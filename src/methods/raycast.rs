@@ -18,14 +18,19 @@
 //! # Shadow rays
 //!
 //! The ray from the receiver `p` to the sample `s` starts at `o = p + δ·n`, with `n` the
-//! receiver's camera-side normal and `δ = `[`ORIGIN_OFFSET`]` ×` the length (f32) of the
-//! diagonal of [`Scene::bounds`] `+ `[`ORIGIN_OFFSET_ULPS`]` × ε_f32 ×` the largest coordinate
-//! magnitude of the scene, so that a receiver read back from a quantized depth buffer does
+//! receiver's camera-side normal and `δ = `[`ORIGIN_OFFSET`]` × D + `[`ORIGIN_OFFSET_ULPS`]
+//! `× ε_f32 ×` the largest coordinate magnitude of the meshes, `D` the length (f32) of the
+//! diagonal of [`Scene::mesh_bounds`] (receivers are mesh points: a light far away changes
+//! neither their extent nor their rounding — measured with the light's center in the bounds,
+//! a point light 10⁶ units up lifted every ray origin 100 units, above the occluder), so that a receiver read back from a quantized depth buffer does
 //! not shadow itself, and neither does one whose f32 coordinates far from the origin are
 //! rounded by more than the first term (a scene 3·10⁴ units out rounds receivers by ~0.002,
 //! more than 10⁻⁴ of a 10-unit scene). The ray is blocked when it hits any triangle at a parameter
-//! `t ∈ (ε, 1 − ε)` of the segment `o + t·(s − o)`, `ε = `[`SEGMENT_EPSILON`] (the far end
-//! keeps a light that lies on a surface from being blocked by that surface).
+//! `t ∈ (ε·min(1, D/L), 1 − ε)` of the segment `o + t·(s − o)` of length `L`,
+//! `ε = `[`SEGMENT_EPSILON`]: hits closer to the origin than `ε·min(L, D)` do not count (a
+//! relative start `ε·L` ignored the first unit of every ray to a light 10⁶ away, and the whole
+//! scene for a light at 10³⁰), and the far end keeps a light that lies on a surface from
+//! being blocked by that surface.
 //!
 //! # Self-occlusion
 //!
@@ -106,7 +111,8 @@ pub const ORIGIN_OFFSET: f64 = 1e-4;
 /// (module doc, "Shadow rays"): receivers are f32 points, rounded by half an ulp.
 pub const ORIGIN_OFFSET_ULPS: f64 = 2.0;
 
-/// The open parameter interval `(ε, 1 − ε)` of the shadow segment in which a hit blocks it.
+/// `ε` of the open parameter interval `(ε·min(1, D/L), 1 − ε)` of the shadow segment in which
+/// a hit blocks it (module doc, "Shadow rays").
 pub const SEGMENT_EPSILON: f64 = 1e-6;
 
 /// Padding of every triangle's BVH box and of every shaft, relative to the scene diagonal
@@ -176,10 +182,10 @@ struct Triangle {
 }
 
 impl Triangle {
-    /// True when the segment `o + t·d` hits the triangle at `t ∈ (ε, 1 − ε)`
+    /// True when the segment `o + t·d` hits the triangle at `t ∈ (t_start, 1 − ε)`
     /// (Möller & Trumbore 1997, f64, edges inclusive, both sides).
     #[inline]
-    fn blocks(&self, o: DVec3, d: DVec3) -> bool {
+    fn blocks(&self, o: DVec3, d: DVec3, t_start: f64) -> bool {
         let pvec = d.cross(self.e2);
         let det = self.e1.dot(pvec);
         if det == 0.0 {
@@ -197,7 +203,7 @@ impl Triangle {
             return false;
         }
         let t = self.e2.dot(qvec) * inv;
-        t > SEGMENT_EPSILON && t < 1.0 - SEGMENT_EPSILON
+        t > t_start && t < 1.0 - SEGMENT_EPSILON
     }
 }
 
@@ -422,6 +428,8 @@ pub struct ShadowRayCaster {
     depth: usize,
     /// `δ` of the module doc: the ray-origin offset in world units.
     origin_offset: f64,
+    /// `D` of the module doc: the diagonal of the meshes' bounds.
+    mesh_diagonal: f64,
     /// The box and shaft padding in world units.
     pad: f64,
     /// The scene's diagonal plus its largest coordinate magnitude (scale of rounding errors).
@@ -431,16 +439,21 @@ pub struct ShadowRayCaster {
 impl ShadowRayCaster {
     /// Collects the triangles of every mesh of `scene` and builds the BVH over them.
     pub fn new(scene: &Scene) -> Self {
-        let (bounds_lo, bounds_hi) = scene.bounds();
-        // δ uses the diagonal of `Scene::bounds` (meshes and light center) as an f32 length.
-        let bounds_diagonal = f64::from((bounds_hi - bounds_lo).length());
-        let bounds_diagonal = if bounds_diagonal.is_finite() && bounds_diagonal > 0.0 {
-            bounds_diagonal
+        let (mesh_lo, mesh_hi) = scene.mesh_bounds();
+        // δ uses the diagonal of the meshes' bounds as an f32 length.
+        let mesh_diagonal = f64::from((mesh_hi - mesh_lo).length());
+        let mesh_diagonal = if mesh_diagonal.is_finite() && mesh_diagonal > 0.0 {
+            mesh_diagonal
         } else {
             1.0
         };
+        let mesh_magnitude = f64::from(mesh_lo.abs().max(mesh_hi.abs()).max_element());
         // Padding and margins use the bounds of meshes and the whole light.
-        let (mut lo, mut hi) = (bounds_lo.as_dvec3(), bounds_hi.as_dvec3());
+        let (mut lo, mut hi) = (mesh_lo.as_dvec3(), mesh_hi.as_dvec3());
+        for l in &scene.lights {
+            lo = lo.min(l.center.as_dvec3());
+            hi = hi.max(l.center.as_dvec3());
+        }
         for q in sampling::bounding_quad(scene.light(), scene.light().center)
             .into_iter()
             .flatten()
@@ -490,11 +503,19 @@ impl ShadowRayCaster {
             triangles,
             nodes,
             depth,
-            origin_offset: ORIGIN_OFFSET * bounds_diagonal
-                + ORIGIN_OFFSET_ULPS * f64::from(f32::EPSILON) * magnitude,
+            origin_offset: ORIGIN_OFFSET * mesh_diagonal
+                + ORIGIN_OFFSET_ULPS * f64::from(f32::EPSILON) * mesh_magnitude,
+            mesh_diagonal,
             pad,
             scale: diagonal + magnitude,
         }
+    }
+
+    /// The start `ε·min(1, D/L)` of the blocking interval of the segment `d` of length `L`
+    /// (module doc, "Shadow rays").
+    #[inline]
+    fn segment_start(&self, d: DVec3) -> f64 {
+        SEGMENT_EPSILON * (self.mesh_diagonal / d.length()).min(1.0)
     }
 
     /// Number of triangles the caster tests against.
@@ -602,8 +623,14 @@ impl ShadowRayCaster {
             return true;
         }
         let g = GRID.min(samples.len().isqrt()).max(1);
-        // A hit at t > ε lies at depth > ε·h; half of that keeps rounding on the safe side.
-        let near = 0.5 * SEGMENT_EPSILON * h;
+        // A hit at t > ε·min(1, D/L) lies at depth > ε·h·min(1, D/L), and L is at most the
+        // distance to the farthest corner of the quad around the samples; half of that keeps
+        // rounding on the safe side.
+        let longest = quad
+            .iter()
+            .map(|c| (*c - origin).length())
+            .fold(0.0, f64::max);
+        let near = 0.5 * SEGMENT_EPSILON * h * (self.mesh_diagonal / longest).min(1.0);
         let far = h * (1.0 + 1e-6) + self.pad;
         scratch.binned.clear();
         scratch.global.clear();
@@ -682,6 +709,7 @@ impl ShadowRayCaster {
                 *lit = !self.blocked(origin, target, &mut scratch.stack);
                 continue;
             }
+            let t_start = self.segment_start(d);
             let (a, b) = plane.coords(origin + d * (h / qs));
             let c = cell_of(b, g) * g + cell_of(a, g);
             let cell = &scratch.cell_items
@@ -690,7 +718,7 @@ impl ShadowRayCaster {
                 .global
                 .iter()
                 .chain(cell)
-                .any(|&ti| self.triangles[ti as usize].blocks(origin, d));
+                .any(|&ti| self.triangles[ti as usize].blocks(origin, d, t_start));
         }
         true
     }
@@ -722,6 +750,7 @@ impl ShadowRayCaster {
         if d == DVec3::ZERO || self.nodes.is_empty() {
             return false;
         }
+        let t_start = self.segment_start(d);
         let o = origin.as_vec3();
         let inv = d.as_vec3().recip();
         stack[0] = 0;
@@ -747,7 +776,7 @@ impl ShadowRayCaster {
                 continue;
             }
             if node.leaf {
-                if self.triangles[node.index as usize].blocks(origin, d) {
+                if self.triangles[node.index as usize].blocks(origin, d, t_start) {
                     return true;
                 }
             } else {
@@ -1274,7 +1303,10 @@ mod tests {
                 let (a, b) = (jitter_pair(i, j), jitter_pair(j, i));
                 let target = DVec3::new(2.0 * a - 1.0, 4.0, 2.0 * b - 1.0);
                 let d = target - o;
-                let brute = caster.triangles.iter().any(|t| t.blocks(o, d));
+                let brute = caster
+                    .triangles
+                    .iter()
+                    .any(|t| t.blocks(o, d, caster.segment_start(d)));
                 assert_eq!(caster.blocked(o, target, &mut stack), brute);
                 blocked += usize::from(brute);
             }
@@ -1289,7 +1321,10 @@ mod tests {
                 DVec3::new(5.0, 0.5, 5.0),
             ] {
                 let d = target - o;
-                let brute = caster.triangles.iter().any(|t| t.blocks(o, d));
+                let brute = caster
+                    .triangles
+                    .iter()
+                    .any(|t| t.blocks(o, d, caster.segment_start(d)));
                 assert!(brute, "{o} → {target} crosses the floor top");
                 assert!(caster.blocked(o, target, &mut stack));
             }

@@ -34,8 +34,8 @@ pub struct Camera {
     pub up: DVec3,
     /// Full vertical field of view in degrees, in (0, 180).
     pub vfov_deg: f64,
-    /// Near-plane distance; `None` picks the default derived from the scene bounds
-    /// (see [`crate::gpu::transform::default_near`]).
+    /// Near-plane distance; `None` picks the default derived from the scene bounds and the
+    /// nearest geometry in view (see [`crate::gpu::transform::default_near`]).
     pub near: Option<f64>,
 }
 
@@ -209,6 +209,19 @@ impl Scene {
             lights: vec![self.lights[k].clone()],
             ..self.clone()
         }
+    }
+
+    /// Axis-aligned bounds (min, max) of all mesh vertices: the extent of every receiver and
+    /// occluder, the scale of their rounding errors (a light far away does not change it).
+    /// A scene without meshes (refused by validation) gives the light center's point.
+    pub fn mesh_bounds(&self) -> (Vec3, Vec3) {
+        let points = self.meshes.iter().flat_map(|m| m.positions.iter());
+        let first = points
+            .clone()
+            .next()
+            .copied()
+            .unwrap_or(self.light().center);
+        points.fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
     }
 
     /// Axis-aligned bounds (min, max) of all mesh vertices and every light center.
