@@ -24,6 +24,9 @@ pub struct MethodRun {
     pub shaded: Vec<[f32; 3]>,
     /// Error against the reference, when the reference ran and this is not it.
     pub error: Option<ErrorStats>,
+    /// For the reference: its own sampling noise, the reference against itself with the next
+    /// seed ([`methods::reference_noise_floor`]).
+    pub noise_floor: Option<ErrorStats>,
 }
 
 /// Read `[options.gpu]`: `tile_size` (power of two 2…256, default 8) and `depth`
@@ -108,11 +111,17 @@ pub fn render_scene(scene: &Scene) -> Result<Vec<MethodRun>, InputError> {
             .find(|r| r.method == methods::REFERENCE)
             .filter(|_| m != methods::REFERENCE)
             .map(|r| compare(&output.visibility, &r.output.visibility));
+        let noise_floor = if m == methods::REFERENCE {
+            Some(methods::reference_noise_floor(&frame, &output.visibility)?)
+        } else {
+            None
+        };
         runs.push(MethodRun {
             method: m.clone(),
             output,
             shaded,
             error,
+            noise_floor,
         });
     }
     Ok(runs)
@@ -147,7 +156,7 @@ pub fn table(scene: &Scene, runs: &[MethodRun]) -> String {
     for r in runs {
         let t = r.output.stats.wall_seconds;
         let mb = r.output.stats.totals.total_bytes() as f64 / 1e6;
-        match &r.error {
+        match r.error.as_ref().or(r.noise_floor.as_ref()) {
             Some(e) => {
                 s += &format!(
                     "{:<18} {:>10.3} {:>10.5} {:>10.5} {:>10.5} {:>12.3} {:>12.2}\n",
@@ -161,6 +170,14 @@ pub fn table(scene: &Scene, runs: &[MethodRun]) -> String {
                 )
             }
         }
+    }
+    if runs.iter().any(|r| r.noise_floor.is_some()) {
+        s += &format!(
+            "{}'s row: its own sampling noise, seed s against seed s + 1 at the penumbra pixels \
+             and their neighbours — differences of this size are the reference's, not the \
+             method's\n",
+            methods::REFERENCE
+        );
     }
     for r in runs {
         for w in &r.output.stats.warnings {

@@ -240,3 +240,39 @@ fn a_sun_far_away_is_drawn_and_agreed_on() {
         }
     }
 }
+
+/// The table's noise floor (`methods::reference_noise_floor`, the reference against itself
+/// with the next seed at the penumbra pixels and their neighbours) is what a full second run
+/// gives: on `single-quad` no pixel outside that neighbourhood differs between the seeds, so
+/// the estimate equals the full comparison. Its size is bounded by the stratification:
+/// each jittered run misclassifies at most one stratum column or row per occluder edge
+/// crossing the light, at most two edges cross at once (see the module doc): |Δ| ≤ 2·2/k.
+#[test]
+fn the_reference_noise_floor_is_the_full_second_run() {
+    let mut s = builtin::load("single-quad").unwrap();
+    s.width = 64;
+    s.height = 64;
+    let frame = penumbra::frame::Frame::render(&s, Default::default()).unwrap();
+    let first = penumbra::methods::run("raycast", &frame)
+        .unwrap()
+        .visibility;
+    let floor = penumbra::methods::reference_noise_floor(&frame, &first).unwrap();
+    let mut seed1 = s.clone();
+    seed1
+        .options
+        .entry("raycast".into())
+        .or_default()
+        .insert("seed".into(), penumbra::scene::OptionValue::Int(1));
+    let frame1 = penumbra::frame::Frame::render(&seed1, Default::default()).unwrap();
+    let second = penumbra::methods::run("raycast", &frame1)
+        .unwrap()
+        .visibility;
+    let full = penumbra::metrics::compare(&second, &first);
+    assert_eq!(floor, full);
+    assert!(
+        floor.pct_over_1_255 > 0.5,
+        "sampling noise exists: {floor:?}"
+    );
+    let k = 32.0;
+    assert!(floor.max_abs <= 4.0 / k, "{floor:?}");
+}
