@@ -133,7 +133,18 @@ fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     let runs = penumbra::render::render_scene(&scene)?;
     penumbra::render::write_runs(&a.out, &scene, &runs)?;
     print!("{}", penumbra::render::table(&scene, &runs));
-    println!("outputs: {}/METHOD/{{image.png, visibility.png, visibility.exr, visibility.pfm, stats.json}}", a.out.display());
+    let error_png = if runs
+        .iter()
+        .any(|r| r.method == penumbra::methods::REFERENCE)
+    {
+        "error.png, "
+    } else {
+        ""
+    };
+    println!(
+        "outputs: {}/METHOD/{{image.png, visibility.png, visibility.exr, visibility.pfm, {error_png}stats.json}}",
+        a.out.display()
+    );
     Ok(())
 }
 

@@ -6,7 +6,9 @@ use crate::error::InputError;
 use crate::frame::{Frame, GpuSettings, BACKGROUND};
 use crate::gpu::depth::DepthFormat;
 use crate::methods::{self, options::OptionReader, output::MethodOutput, output::Visibility};
+use crate::metrics::error_report::error_report;
 use crate::metrics::{compare, ErrorStats};
+use crate::output::Comparison;
 use crate::scene::Scene;
 use std::path::Path;
 
@@ -128,12 +130,35 @@ pub fn render_scene(scene: &Scene) -> Result<Vec<MethodRun>, InputError> {
 }
 
 /// Write every run's files under `dir/METHOD/`, all or nothing: the method folders appear
-/// only once every method's files were written ([`crate::output::write_method_dirs`]).
+/// only once every method's files were written ([`crate::output::write_method_dirs`]). When
+/// the reference ran, every other method also gets `error.png` and its error (whole image and
+/// penumbra only) in `stats.json` ([`Comparison`]).
 pub fn write_runs(dir: &Path, scene: &Scene, runs: &[MethodRun]) -> std::io::Result<()> {
     let names: Vec<&str> = runs.iter().map(|r| r.method.as_str()).collect();
+    let reference = runs.iter().find(|r| r.method == methods::REFERENCE);
     crate::output::write_method_dirs(dir, &names, |i| {
         let r = &runs[i];
-        crate::output::encode_method_outputs(&r.output, &r.shaded, scene.width, scene.height)
+        let comparison = match reference {
+            None => Comparison::NoReference,
+            Some(_) if r.method == methods::REFERENCE => Comparison::Reference {
+                noise_floor: r.noise_floor,
+            },
+            Some(reference) => Comparison::Against {
+                report: error_report(
+                    &r.output.visibility,
+                    &reference.output.visibility,
+                    methods::REFERENCE,
+                ),
+                reference: &reference.output.visibility,
+            },
+        };
+        crate::output::encode_method_outputs(
+            &r.output,
+            &r.shaded,
+            scene.width,
+            scene.height,
+            &comparison,
+        )
     })
 }
 
@@ -170,6 +195,12 @@ pub fn table(scene: &Scene, runs: &[MethodRun]) -> String {
                 )
             }
         }
+    }
+    if !runs.iter().any(|r| r.method == methods::REFERENCE) {
+        s += &format!(
+            "no reference in this run, so no error columns: add {} to the methods\n",
+            methods::REFERENCE
+        );
     }
     if runs.iter().any(|r| r.noise_floor.is_some()) {
         s += &format!(

@@ -405,6 +405,12 @@ fn small_render_writes_every_documented_output() {
         );
     }
     assert_eq!(stats["method"], "hard-sv");
+    assert!(stats["error"].is_null(), "no reference ran: {stats}");
+    assert!(stats["error_note"]
+        .as_str()
+        .unwrap()
+        .contains("add raycast"));
+    assert!(!dir.join("error.png").exists());
     assert_eq!(stats["width"], 32);
     assert_eq!(stats["height"], 32);
     let passes = stats["passes"].as_array().expect("passes is an array");
@@ -607,4 +613,51 @@ fn far_coordinates_warn_on_stderr() {
     );
     std::fs::remove_dir_all(out).unwrap();
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// With the reference in the run, every other method writes `error.png` (the signed error
+/// map, as big as the image) and its error in `stats.json`, whole image and penumbra only;
+/// the reference writes its noise floor. The numbers are the table's.
+#[test]
+fn a_run_with_the_reference_writes_error_maps_and_metrics() {
+    let (output, out) = render(
+        "errors",
+        &[
+            "single-quad",
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--methods",
+            "raycast,hard-sv",
+        ],
+    );
+    assert_eq!(output.status.code(), Some(0));
+    let stats = |m: &str| -> serde_json::Value {
+        serde_json::from_slice(&std::fs::read(out.join(m).join("stats.json")).unwrap()).unwrap()
+    };
+    let hard = stats("hard-sv");
+    let e = &hard["error"];
+    assert_eq!(e["reference"], "raycast");
+    assert_eq!(e["pixels"], 32 * 32);
+    let penumbra = e["penumbra_only"]["pixels"].as_u64().unwrap();
+    assert!(penumbra > 0 && penumbra < 32 * 32, "{e}");
+    // A hard shadow is wrong only in the penumbra, so its penumbra-only error is larger.
+    assert!(
+        e["penumbra_only"]["mean_abs"].as_f64() > e["mean_abs"].as_f64(),
+        "{e}"
+    );
+    let table = String::from_utf8_lossy(&output.stdout);
+    let row = table.lines().find(|l| l.starts_with("hard-sv")).unwrap();
+    assert!(
+        row.contains(&format!("{:.5}", e["rmse"].as_f64().unwrap())),
+        "{row} vs {e}"
+    );
+    let png = image::open(out.join("hard-sv").join("error.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (32, 32));
+    let reference = stats("raycast");
+    assert!(reference["error"].is_null());
+    assert!(reference["reference_noise_floor"]["pixels"].as_u64() == Some(32 * 32));
+    assert!(!out.join("raycast").join("error.png").exists());
+    std::fs::remove_dir_all(&out).unwrap();
 }

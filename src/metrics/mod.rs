@@ -8,6 +8,8 @@
 use crate::methods::output::Visibility;
 use serde::Serialize;
 
+pub mod error_report;
+
 /// Error of one visibility buffer against another (usually: a method against `raycast`).
 ///
 /// For RGB buffers every channel of every pixel is one sample of `rmse`, `max_abs` and

@@ -9,7 +9,8 @@
 //! | `visibility.exr` | OpenEXR, RGB f32 (gray replicated into the three channels) |
 //! | `visibility.pfm` | PFM with the exact f32 bits (`Pf` gray / `PF` RGB) — what goldens compare |
 //! | `<name>.png` | each [`RawImage8`] (e.g. `hard-sv`'s `stencil.png`), 8-bit grayscale, values as stored |
-//! | `stats.json` | [`MethodStats`](crate::methods::output::MethodStats) as pretty-printed JSON |
+//! | `error.png` | when the reference ran: the signed error against it, on the fixed scale of [`error_colour`](crate::metrics::error_report::error_colour) (white 0, red too bright, blue too dark) |
+//! | `stats.json` | [`MethodStats`](crate::methods::output::MethodStats) as pretty-printed JSON, plus `"error"`: the [`ErrorReport`] against the reference (whole image and penumbra only), or null with `"error_note"` when no reference ran; the reference itself has `"reference_noise_floor"` |
 //!
 //! **No partial output** (DESIGN.md "Bad input"): a run's method folders are written into a
 //! hidden staging folder inside the output directory and moved into place only once every
@@ -20,6 +21,8 @@
 //! All images are row-major with row 0 at the top, like [`Visibility`].
 
 use crate::methods::output::{MethodOutput, RawImage8, Visibility};
+use crate::metrics::error_report::ErrorReport;
+use crate::metrics::ErrorStats;
 use image::codecs::openexr::OpenExrEncoder;
 use image::codecs::png::PngEncoder;
 use image::{ExtendedColorType, ImageEncoder};
@@ -478,6 +481,7 @@ pub fn encode_method_outputs(
     shaded: &[[f32; 3]],
     width: u32,
     height: u32,
+    comparison: &Comparison,
 ) -> io::Result<Vec<(String, Vec<u8>)>> {
     check_len("shaded image", shaded.len(), width, height)?;
     check_len("visibility", out.visibility.len(), width, height)?;
@@ -517,11 +521,53 @@ pub fn encode_method_outputs(
         let png = encode_gray8_png(&raw.values, width, height)?;
         files.push((name, png));
     }
-    let mut json = serde_json::to_vec_pretty(&out.stats)
-        .map_err(|e| io::Error::other(format!("encoding stats.json: {e}")))?;
+    let encoding = |e: serde_json::Error| io::Error::other(format!("encoding stats.json: {e}"));
+    let mut stats = serde_json::to_value(&out.stats).map_err(encoding)?;
+    let error = match comparison {
+        Comparison::NoReference => {
+            stats["error_note"] = "no reference in this run: add raycast to the methods".into();
+            serde_json::Value::Null
+        }
+        Comparison::Reference { noise_floor } => {
+            stats["reference_noise_floor"] = serde_json::to_value(noise_floor).map_err(encoding)?;
+            serde_json::Value::Null
+        }
+        Comparison::Against { report, reference } => {
+            check_len("reference", reference.len(), width, height)?;
+            let map = crate::metrics::error_report::signed_error_map(&out.visibility, reference);
+            files.push((
+                "error.png".to_string(),
+                encode_rgb8_png(&map, width, height)?,
+            ));
+            serde_json::to_value(report).map_err(encoding)?
+        }
+    };
+    stats["error"] = error;
+    let mut json = serde_json::to_vec_pretty(&stats).map_err(encoding)?;
     json.push(b'\n');
     files.push(("stats.json".to_string(), json));
     Ok(files)
+}
+
+/// What a run knows about a method's error, for `stats.json` and `error.png` (module table).
+#[derive(Debug, Clone)]
+pub enum Comparison<'a> {
+    /// No reference ran: `"error": null` and an `"error_note"` saying so.
+    NoReference,
+    /// This method is the reference: `"error": null` and `"reference_noise_floor"`, the
+    /// reference against itself with the next seed
+    /// ([`reference_noise_floor`](crate::methods::reference_noise_floor)).
+    Reference {
+        /// Its noise floor, when it was measured.
+        noise_floor: Option<ErrorStats>,
+    },
+    /// Compared with the reference: `"error"` holds the report, `error.png` the signed map.
+    Against {
+        /// The metrics.
+        report: ErrorReport,
+        /// The reference's visibility.
+        reference: &'a Visibility,
+    },
 }
 
 /// The file name of a raw image, `<name>.png`; the name must be a plain, non-hidden file stem
@@ -544,7 +590,8 @@ pub fn raw_image_file_name(raw: &RawImage8) -> io::Result<String> {
 
 /// Writes all outputs of one method to `dir/METHOD/` (see the module table): `image.png`
 /// from `shaded` (linear RGB, `width·height` pixels, row 0 at the top), `visibility.png`,
-/// `visibility.exr`, `visibility.pfm`, one `<name>.png` per raw image, and `stats.json`.
+/// `visibility.exr`, `visibility.pfm`, one `<name>.png` per raw image, and `stats.json`
+/// (without a reference: [`Comparison::NoReference`]).
 ///
 /// The folder appears only once every file was encoded and written ([`write_method_dirs`]).
 pub fn write_method_outputs(
@@ -556,7 +603,7 @@ pub fn write_method_outputs(
     height: u32,
 ) -> io::Result<()> {
     write_method_dirs(dir, &[method], |_| {
-        encode_method_outputs(out, shaded, width, height)
+        encode_method_outputs(out, shaded, width, height, &Comparison::NoReference)
     })
 }
 
@@ -849,7 +896,8 @@ mod tests {
     #[test]
     fn a_failing_method_leaves_nothing_behind() {
         let out = sample_output(Visibility::Gray(vec![0.5; 6]));
-        let good = |_: usize| encode_method_outputs(&out, &[[0.0; 3]; 6], 3, 2);
+        let good =
+            |_: usize| encode_method_outputs(&out, &[[0.0; 3]; 6], 3, 2, &Comparison::NoReference);
         // A new output directory: not created at all.
         let dir = temp_dir("fail").join("new");
         let fail_second = |i: usize| {
