@@ -99,16 +99,14 @@ use crate::gpu::buffers::{alloc_tiles, DepthTile};
 use crate::gpu::color::{ColorFormat, ColorTile};
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFormat, DepthState, PolygonOffset};
-use crate::gpu::light_view::{LightView, MAX_LIGHT_VIEW_HALF_ANGLE_DEG};
+use crate::gpu::light_view::LightView;
 use crate::gpu::raster::{bin, draw, no_tile_culling, Fragment};
 use crate::gpu::setup::{setup_all_barycentric, CullMode};
 use crate::gpu::texture::Filter;
-use crate::gpu::tiling::Tiling;
 use crate::plan::{BufferPlan, MethodPlan};
 use crate::scene::LightShape;
 use rayon::prelude::*;
 use serde::Serialize;
-use std::ops::AddAssign;
 use std::time::Instant;
 
 /// The default polygon-offset units of the shadow map (`bias`): resolvable-difference steps.
@@ -134,7 +132,7 @@ impl Falloff {
     /// `I′` of `I`.
     pub fn apply(self, i: f64) -> f64 {
         match self {
-            Falloff::Smoothstep => 3.0 * i * i - 2.0 * i * i * i,
+            Falloff::Smoothstep => super::smoothstep(i),
             Falloff::Linear => i,
         }
     }
@@ -245,17 +243,6 @@ pub struct ScreenStats {
     pub out_of_range: u64,
 }
 
-/// `AddAssign` as the field-wise sum, for the per-tile and per-row tallies above.
-macro_rules! field_sum {
-    ($t:ty { $($f:ident),* }) => {
-        impl AddAssign for $t {
-            fn add_assign(&mut self, o: Self) {
-                $(self.$f += o.$f;)*
-            }
-        }
-    };
-}
-
 field_sum!(ProgramStats {
     fragments,
     discarded_behind_surface,
@@ -302,15 +289,6 @@ pub struct PenumbraMapRender {
     pub passes: Vec<PassStats>,
 }
 
-fn pass(name: &str, start: Instant, counters: Counters) -> PassStats {
-    PassStats {
-        name: name.into(),
-        wall_seconds: start.elapsed().as_secs_f64(),
-        runs: 1,
-        counters,
-    }
-}
-
 /// Render `penumbra-map` with `s` on `frame` (one sphere light).
 pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRender, InputError> {
     let scene = frame.scene;
@@ -322,21 +300,7 @@ pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRende
             "penumbra maps need a sphere light",
         ));
     };
-    let tiling = Tiling::new(s.map_size, s.map_size, frame.tiling.tile)
-        .map_err(|e| InputError::at(&scene.source, "options.penumbra-map.map_size", e))?;
-    let view = LightView::fit(scene, light.center, tiling, s.depth).map_err(|u| {
-        let m = &scene.meshes[u.mesh];
-        InputError::at(
-            &scene.source,
-            scene.light_object(0, "light"),
-            format!(
-                "one light frustum cannot cover the scene: vertex {} ({}, {}, {}) of meshes[{}] \
-                 ({}) is {:.1}° from the light's view axis (limit {MAX_LIGHT_VIEW_HALF_ANGLE_DEG}°); \
-                 penumbra maps need every receiver in front of the light center",
-                u.vertex, u.position.x, u.position.y, u.position.z, u.mesh, m.name, u.angle_deg
-            ),
-        )
-    })?;
+    let view = super::fit_light_view(frame, "penumbra-map", s.map_size, s.depth, "penumbra maps")?;
 
     // Pass 1: the shadow map.
     let t = Instant::now();
@@ -345,7 +309,7 @@ pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRende
         BiasStage::Lookup => PolygonOffset::NONE,
     };
     let (shadow_map, c1) = view.render_depth(scene, render_offset);
-    let pass1 = pass("shadow-map", t, c1);
+    let pass1 = PassStats::since("shadow-map", t, c1);
 
     // The silhouette from the light center (CPU; the paper's 30 %).
     let t = Instant::now();
@@ -357,7 +321,7 @@ pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRende
             e,
         )
     })?;
-    let pass_sil = pass("silhouettes", t, Counters::default());
+    let pass_sil = PassStats::since("silhouettes", t, Counters::default());
 
     // Pass 2: cones and sheets into the penumbra map.
     let t = Instant::now();
@@ -369,12 +333,12 @@ pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRende
         s.cone_segments,
     );
     let (color, program, c2) = render_penumbra_map(&view, &shadow_map, &geometry, s);
-    let pass2 = pass("penumbra-map", t, c2);
+    let pass2 = PassStats::since("penumbra-map", t, c2);
 
     // Pass 3: the screen.
     let t = Instant::now();
     let (visibility, screen, c3) = screen_pass(frame, &view, &shadow_map, &color, s);
-    let pass3 = pass("screen", t, c3);
+    let pass3 = PassStats::since("screen", t, c3);
 
     let silhouette = (
         sils.iter().map(|m| m.edges.len()).sum(),
