@@ -10,13 +10,13 @@
 //!    `distances = exact`, `storage = f16`), `hard-sv`, and — with the disk replaced by a
 //!    sphere of the same radius, the only light they take — `pw2002`, `ssv` and
 //!    `penumbra-map`.
-//! 2. The boundary-classification table on `disk-boxes` and `disk-slabs`: the fraction of
+//! 2. The boundary-classification table on `disk-block` and `disk-slab`: the fraction of
 //!    receiver pixels each method puts in the umbra (v = 0), the penumbra and the lit region
 //!    (v = 1), up to [`CLASS_TOLERANCE`], the fraction classified as `raycast` classifies them,
 //!    and the fractions that swap lit and penumbra (the outer boundary) and umbra and penumbra
 //!    (the inner one).
 //! 3. Time per pass of `dbuffer` (median of 5 runs, all threads) on `disk-small-sphere`
-//!    (224-triangle occluder), `disk-boxes` and `disk-torus` (5760) at 300², 600² and 1024²,
+//!    (224-triangle occluder), `disk-block` and `disk-torus` (5760) at 300², 600² and 1024²,
 //!    with the D-buffer's fragment and byte counts.
 //!
 //! Times are informational (wall clock on a shared machine); errors, classes and counters are
@@ -36,8 +36,8 @@ const CLASS_TOLERANCE: f64 = 1e-6;
 
 /// The disk-light built-ins.
 const SCENES: [&str; 5] = [
-    "disk-boxes",
-    "disk-slabs",
+    "disk-block",
+    "disk-slab",
     "disk-small-sphere",
     "disk-acute",
     "disk-torus",
@@ -139,7 +139,7 @@ fn main() {
     println!("# dbuffer time per pass (median of 5 runs, seconds) and D-buffer traffic\n");
     println!("| scene | triangles | size | volumes | dbuffer-scene | dbuffer-umbra | dbuffer-penumbra | screen | D-buffer fragments | D-buffer MB written |");
     println!("|---|---|---|---|---|---|---|---|---|---|");
-    for name in ["disk-small-sphere", "disk-boxes", "disk-torus"] {
+    for name in ["disk-small-sphere", "disk-block", "disk-torus"] {
         for size in [300, 600, 1024] {
             let scene = sized(name, size);
             let triangles: usize = scene.meshes.iter().map(|m| m.triangles.len()).sum();

@@ -131,13 +131,11 @@
 use super::adjacency::Adjacency;
 use super::loops::silhouette_loops;
 use super::silhouette::SilhouetteEdge;
-use crate::light::coverage::clip_polygon;
 use crate::light::sampling::orthonormal_basis;
 use crate::scene::Mesh;
 use glam::{DVec2, DVec3, Vec3};
 use serde::Serialize;
 use std::f64::consts::{PI, TAU};
-use std::ops::{Add, Mul, Sub};
 
 /// How far beyond 1 the tangent parameter q = r/|a − c| may be and still be taken as a tangent
 /// plane (rounding of a face plane that touches the rim).
@@ -347,36 +345,6 @@ pub struct VolumeVertex {
     pub silhouette: DVec3,
 }
 
-impl Add for VolumeVertex {
-    type Output = Self;
-    fn add(self, o: Self) -> Self {
-        Self {
-            position: self.position + o.position,
-            silhouette: self.silhouette + o.silhouette,
-        }
-    }
-}
-
-impl Sub for VolumeVertex {
-    type Output = Self;
-    fn sub(self, o: Self) -> Self {
-        Self {
-            position: self.position - o.position,
-            silhouette: self.silhouette - o.silhouette,
-        }
-    }
-}
-
-impl Mul<f64> for VolumeVertex {
-    type Output = Self;
-    fn mul(self, s: f64) -> Self {
-        Self {
-            position: self.position * s,
-            silhouette: self.silhouette * s,
-        }
-    }
-}
-
 /// A vertex on a silhouette (its own silhouette point).
 fn on_silhouette(p: DVec3) -> VolumeVertex {
     VolumeVertex {
@@ -439,12 +407,16 @@ pub struct Volumes {
     pub stats: VolumeStats,
 }
 
-/// The extrusion of one volume edge: its tangent point and the quad polygon.
+/// The extrusion of one volume edge a → b: its tangent point and the directions of the quad's
+/// two sides, from a and from b (the rays away from the tangent point, or a corner's seam).
+#[derive(Debug, Clone, Copy)]
 struct Quad {
     /// The extrusion point p_u or p_p.
     point: DVec3,
-    /// a, b, f(b), f(a), possibly trimmed.
-    polygon: Vec<VolumeVertex>,
+    /// The side from a.
+    start: DVec3,
+    /// The side from b.
+    end: DVec3,
 }
 
 /// The settings of the extrusion.
@@ -457,10 +429,10 @@ pub struct Extrusion {
 }
 
 impl Extrusion {
-    /// The point where the ray from `from` through `x` leaves the sphere of radius
-    /// [`Extrusion::bound`] around `center` (`x` itself if it is not inside).
-    pub fn far(&self, center: DVec3, from: DVec3, x: DVec3) -> DVec3 {
-        let Some(u) = (x - from).try_normalize() else {
+    /// The point where the ray from `x` along `dir` leaves the sphere of radius
+    /// [`Extrusion::bound`] around `center` (`x` itself if it is not inside or `dir` is 0).
+    pub fn far(&self, center: DVec3, x: DVec3, dir: DVec3) -> DVec3 {
+        let Some(u) = dir.try_normalize() else {
             return x;
         };
         let m = x - center;
@@ -543,13 +515,10 @@ fn extrude_volume(
                 Tangents::Points { points, parallel } => {
                     stats.parallel_edges += parallel as u64;
                     let p = extrusion_point(mesh, e, points, volume, stats);
-                    let far = |x: DVec3| VolumeVertex {
-                        position: ex.far(c, p, x),
-                        silhouette: x,
-                    };
                     Some(Quad {
                         point: p,
-                        polygon: vec![on_silhouette(a), on_silhouette(b), far(b), far(a)],
+                        start: a - p,
+                        end: b - p,
                     })
                 }
                 Tangents::Inside => {
@@ -563,14 +532,12 @@ fn extrude_volume(
             }
         })
         .collect();
-    // Corners: the trimming planes of every quad (applied below, start corner first) and the
-    // fans, per loop position.
-    let mut cuts: Vec<Vec<(DVec3, DVec3, bool)>> = vec![Vec::new(); edges.len()];
+    // Corners: seams replace the sides of converging quads, fans close diverging ones.
     let mut fans: Vec<Vec<[VolumeVertex; 3]>> = vec![Vec::new(); edges.len()];
     for lp in &loops {
         for k in 0..lp.len() {
             let (i1, i2) = (lp[k], lp[(k + 1) % lp.len()]);
-            let (Some(q1), Some(q2)) = (&quads[i1], &quads[i2]) else {
+            let (Some(q1), Some(q2)) = (quads[i1], quads[i2]) else {
                 continue;
             };
             let a1 = edges[i1].edge.a.as_dvec3();
@@ -581,14 +548,24 @@ fn extrude_volume(
             // Q2's far edge at v outside Q1's half-space: the quads meet at a convex corner
             // and part at a reflex one (module doc, "Corners").
             if (m1.dot(v - q2.point) > 0.0) == convex {
+                // The seam: the planes' common line through v, away from the light.
+                let Some(mut seam) = m1.cross(m2).try_normalize() else {
+                    continue;
+                };
+                if seam.dot(q1.end + q2.start) < 0.0 {
+                    seam = -seam;
+                }
                 if convex {
                     stats.trimmed_convex += 1;
                 } else {
                     stats.trimmed_reflex += 1;
                 }
-                // Keep the inside (convex) or the outside (reflex) of the other plane.
-                cuts[i1].push((v, m2, convex));
-                cuts[i2].insert(0, (v, m1, convex));
+                if let Some(q) = &mut quads[i1] {
+                    q.end = seam;
+                }
+                if let Some(q) = &mut quads[i2] {
+                    q.start = seam;
+                }
             } else {
                 let fan = corner_fan(disk, ex, v, q1.point, q2.point);
                 if !fan.is_empty() {
@@ -602,33 +579,51 @@ fn extrude_volume(
             }
         }
     }
-    for (q, planes) in quads.iter_mut().zip(&cuts) {
-        if let Some(q) = q {
-            for &(v, m, inside) in planes {
-                let sign = if inside { -1.0 } else { 1.0 };
-                q.polygon =
-                    clip_polygon(&q.polygon, |x: VolumeVertex| sign * m.dot(x.position - v));
-                // A kept vertex on the plane also comes back as the crossing of its edge.
-                q.polygon.dedup_by(|x, y| x.position == y.position);
-                while q.polygon.len() > 1
-                    && q.polygon[0].position == q.polygon[q.polygon.len() - 1].position
-                {
-                    q.polygon.pop();
-                }
-            }
-        }
-    }
     for lp in &loops {
         for &i in lp {
             if let Some(q) = &quads[i] {
-                for k in 1..q.polygon.len().saturating_sub(1) {
-                    out.push([q.polygon[0], q.polygon[k], q.polygon[k + 1]]);
-                }
+                let e = &edges[i].edge;
+                out.extend(quad_triangles(c, ex, e.a.as_dvec3(), e.b.as_dvec3(), q));
             }
             out.extend_from_slice(&fans[i]);
         }
     }
     Ok(())
+}
+
+/// The triangles of the (trimmed) quad of edge a → b (module doc, "Corners"): the region
+/// between its two sides up to the bounding sphere — the triangle (a, b, P) when the sides
+/// meet at P inside the sphere, else (a, b, f_b), (a, f_b, f_a) with f the sides' exits.
+fn quad_triangles(
+    c: DVec3,
+    ex: &Extrusion,
+    a: DVec3,
+    b: DVec3,
+    q: &Quad,
+) -> Vec<[VolumeVertex; 3]> {
+    let (va, vb) = (on_silhouette(a), on_silhouette(b));
+    let den = q.start.cross(q.end).length_squared();
+    // a + λ·start = b + μ·end, solved in the plane of the quad.
+    if den > 0.0 {
+        let w = b - a;
+        let cross = q.start.cross(q.end);
+        let lambda = w.cross(q.end).dot(cross) / den;
+        let mu = w.cross(q.start).dot(cross) / den;
+        let p = a + q.start * lambda;
+        if lambda > 0.0 && mu > 0.0 && (p - c).length() < ex.bound {
+            let apex = VolumeVertex {
+                position: p,
+                silhouette: (a + b) * 0.5,
+            };
+            return vec![[va, vb, apex]];
+        }
+    }
+    let far = |x: DVec3, dir: DVec3| VolumeVertex {
+        position: ex.far(c, x, dir),
+        silhouette: x,
+    };
+    let (fa, fb) = (far(a, q.start), far(b, q.end));
+    vec![[va, vb, fb], [va, fb, fa]]
 }
 
 /// The fan closing a diverging corner at `v` from extrusion point `p1` to `p2` (module doc).
@@ -651,7 +646,7 @@ fn corner_fan(
         k => disk.rim_point(t1 + delta * k as f64 / steps as f64),
     };
     let far = |p: DVec3| VolumeVertex {
-        position: ex.far(disk.center, p, v),
+        position: ex.far(disk.center, v, v - p),
         silhouette: v,
     };
     (0..steps)

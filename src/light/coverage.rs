@@ -499,9 +499,8 @@ fn clip_to_light(poly: &[DVec3]) -> Vec<DVec2> {
         .collect()
 }
 
-/// One Sutherland–Hodgman step: keep the part of `poly` where `dist ≥ 0` (vertices that are
-/// kept stay as they are; a crossing is interpolated from the edge's first vertex).
-pub fn clip_polygon<V, F>(poly: &[V], dist: F) -> Vec<V>
+/// One Sutherland–Hodgman step: keep the part of `poly` where `dist ≥ 0`.
+fn clip_polygon<V, F>(poly: &[V], dist: F) -> Vec<V>
 where
     V: Copy
         + std::ops::Sub<Output = V>

@@ -18,8 +18,8 @@
 //! | `two-lights` | Paper I Fig. 16 analogue: the `cylinder` occluder and a box | two spheres r 0.3, 0.25 | 120 |
 //! | `forest-spheres` | Forest et al. 2006 Fig. 1: 3×3×3 spheres of 760 triangles (20 stacks × 20 slices), r 0.2, spacing 0.45 | rect ½-extents 0.6 | 20532 |
 //! | `forest-spheres-1`, `-4`, `-9` | the cost series of Fig. 12: 1 sphere, 2×2 and 3×3 in one layer | as `forest-spheres` | 772, 3052, 6852 |
-//! | `disk-boxes` | CGI 2004 Fig. 1/7: a thin slab and a tall block narrowing downward, side by side, with mirror-image tops (the same silhouette from the light center) | disk r 1.5 facing down | 36 |
-//! | `disk-slabs` | `disk-boxes` with the block replaced by the mirror image of the slab (same silhouette from c) | as `disk-boxes` | 36 |
+//! | `disk-block` | CGI 2004 Fig. 1/7: a 1×0.7×1 block floating at y = 0.9 straight below the light center (the silhouette from c is its top) | disk r 1.2 facing down | 24 |
+//! | `disk-slab` | `disk-block` cut down to its top 0.1: the same silhouette from c, a different shadow | as `disk-block` | 24 |
 //! | `disk-small-sphere` | CGI 2004 Fig. 8a / §4 case 2: a sphere r 0.25 of 224 triangles (16 slices × 8 stacks) under a larger disk: no umbra on the floor | disk r 0.8 | 236 |
 //! | `disk-acute` | CGI 2004 §4 case 3: a flat triangular prism with a 14° tip | disk r 0.5 | 20 |
 //! | `disk-torus` | CGI 2004 Fig. 8c: a tilted torus of 5760 triangles (60 × 48), concave and self-shadowing | disk r 0.6 | 5772 |
@@ -47,8 +47,8 @@ const NAMES: &[&str] = &[
     "forest-spheres-1",
     "forest-spheres-4",
     "forest-spheres-9",
-    "disk-boxes",
-    "disk-slabs",
+    "disk-block",
+    "disk-slab",
     "disk-small-sphere",
     "disk-acute",
     "disk-torus",
@@ -76,8 +76,8 @@ pub fn load(name: &str) -> Option<Scene> {
         "forest-spheres-1" => forest_spheres([1, 1, 1]),
         "forest-spheres-4" => forest_spheres([2, 1, 2]),
         "forest-spheres-9" => forest_spheres([3, 1, 3]),
-        "disk-boxes" => disk_boxes(),
-        "disk-slabs" => disk_slabs(),
+        "disk-block" => disk_block(),
+        "disk-slab" => disk_slab(),
         "disk-small-sphere" => disk_small_sphere(),
         "disk-acute" => disk_acute(),
         "disk-torus" => disk_torus(),
@@ -337,57 +337,38 @@ fn disk_down(center: Vec3, radius: f32) -> Light {
     }
 }
 
-/// A block from y = `y[0]` to `y[1]` and z = ±0.5 whose top spans x ∈ `top` and whose
-/// bottom spans x ∈ `bottom` (a box with its bottom corners moved along x).
-fn tapered_block(name: &str, top: [f32; 2], bottom: [f32; 2], y: [f32; 2]) -> Mesh {
-    let mut m = box_mesh(
-        name,
-        Vec3::new(top[0], y[0], -0.5),
-        Vec3::new(top[1], y[1], 0.5),
-        OCCLUDER,
-    );
-    // box_mesh vertex i: x = max if bit 0, y = max if bit 1.
-    for (i, p) in m.positions.iter_mut().enumerate() {
-        if i & 2 == 0 {
-            p.x = bottom[i & 1];
-        }
-    }
-    m
-}
-
-/// CGI 2004 Fig. 1 and Fig. 7: two occluders side by side under a disk light large enough
-/// that their sides are silhouette faces — on the left a thin slab, on the right `right`, whose
-/// top mirrors the slab's at y = 1.6. Each side that would face the light center (the inner
-/// ones) leans away from it, so from c only the tops are seen: the silhouettes from c are the
-/// two top rectangles, mirror images, whatever lies below them.
-fn disk_pair(right: Mesh) -> Scene {
+/// CGI 2004 Fig. 1 and Fig. 7: an occluder under a disk light large enough that its sides
+/// are silhouette faces, with the light center straight above it, so that from c only its top
+/// is seen: the silhouette from c is the top square (x, z ∈ ±0.5 at y = 1.6), whatever lies
+/// below it. The camera is low enough to see the floor under the occluder.
+fn disk_pair(occluder: Mesh) -> Scene {
     scene(
-        camera([0.0, 5.4, 5.2], [0.0, 0.0, -0.2], 55.0),
-        disk_down(Vec3::new(0.0, 3.8, 0.0), 1.5),
-        vec![
-            floor([-5.0, 5.0], [-4.0, 4.0]),
-            tapered_block("slab", [-2.0, -1.0], [-2.0, -1.08], [1.5, 1.6]),
-            right,
-        ],
+        camera([0.0, 1.4, 3.6], [0.0, 0.25, 0.0], 55.0),
+        disk_down(Vec3::new(0.0, 3.8, 0.0), 1.2),
+        vec![floor([-4.0, 4.0], [-4.0, 4.0]), occluder],
     )
 }
 
-/// `disk-boxes`: the slab and a tall block narrowing downward (bottom at y = 0.3), whose umbra
-/// is bounded by its bottom edges — the true shadows of the two differ although a method
-/// working from the silhouette seen from c shades both alike.
-fn disk_boxes() -> Scene {
-    disk_pair(tapered_block("block", [1.0, 2.0], [1.65, 2.0], [0.3, 1.6]))
+/// `disk-block`: a tall block floating from y = 0.9 to 1.6, whose umbra is bounded by its bottom
+/// edges — a true shadow that differs from `disk-slab`'s although a method working from the
+/// silhouette seen from c shades both alike.
+fn disk_block() -> Scene {
+    disk_pair(box_mesh(
+        "block",
+        Vec3::new(-0.5, 0.9, -0.5),
+        Vec3::new(0.5, 1.6, 0.5),
+        OCCLUDER,
+    ))
 }
 
-/// `disk-slabs`: `disk-boxes` with the block replaced by the mirror image of the slab (the same
-/// top, so the same silhouette from c): the twin that shows what a single silhouette cannot
-/// see.
-fn disk_slabs() -> Scene {
-    disk_pair(tapered_block(
-        "slab-right",
-        [0.6, 1.6],
-        [0.65, 1.6],
-        [1.5, 1.6],
+/// `disk-slab`: `disk-block` with the block cut down to its top 0.1 (the same silhouette from
+/// c): the twin that shows what a single silhouette cannot see.
+fn disk_slab() -> Scene {
+    disk_pair(box_mesh(
+        "slab",
+        Vec3::new(-0.5, 1.5, -0.5),
+        Vec3::new(0.5, 1.6, 0.5),
+        OCCLUDER,
     ))
 }
 
@@ -663,8 +644,8 @@ mod tests {
         assert_eq!(count("pw-2002"), 12 + 22 * 12);
         assert_eq!(count("two-lights"), 12 + 96 + 12);
         assert_eq!(load("two-lights").unwrap().lights.len(), 2);
-        assert_eq!(count("disk-boxes"), 36);
-        assert_eq!(count("disk-slabs"), 36);
+        assert_eq!(count("disk-block"), 24);
+        assert_eq!(count("disk-slab"), 24);
         assert_eq!(count("disk-small-sphere"), 12 + 224);
         assert_eq!(count("disk-acute"), 12 + 8);
         assert_eq!(count("disk-torus"), 12 + 5760);
