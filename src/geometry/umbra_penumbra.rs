@@ -69,11 +69,14 @@
 //! the plane), the penumbra the t whose t′ is outside. When rounding leaves neither (a face
 //! plane through a tangent point), the same rule decides.
 //!
-//! **Extrusion.** A quad is a → b → f(b) → f(a), with f(x) the point where the ray from the
-//! extrusion point through x leaves the sphere of radius `bound` around c — a sphere that
-//! holds every mesh vertex, so every receiver lies between the silhouette and the quad's far
-//! edge, and the quads are no longer than the scene needs (their distance values are
-//! interpolated linearly, §3.2, so the error grows with their length).
+//! **Extrusion.** A quad is the region of the plane through a → b and its extrusion point
+//! between its two sides, the rays from a and from b away from the extrusion point (or the
+//! seams that replace them at trimmed corners, below), up to the sphere of radius `bound`
+//! around c — a sphere that holds every mesh vertex, so every receiver lies between the
+//! silhouette and the quad's far edge, and the quads are no longer than the scene needs (their
+//! distance values are interpolated linearly, §3.2, so the error grows with their length). It
+//! is the triangles (a, b, f_b), (a, f_b, f_a), f the points where the sides leave the sphere,
+//! or the triangle (a, b, P) when the two sides meet at P inside it.
 //!
 //! # Corners (§2.1: trimming and closing)
 //!
@@ -88,8 +91,11 @@
 //! * the quads **converge** when it points out of Q1's half-space at a convex corner
 //!   (M1·(v − p2) > 0), or into it at a reflex one: they intersect along a line through v and
 //!   are **trimmed** there ("the extruded quads of the umbra volume need to be trimmed as they
-//!   will otherwise intersect"): each is clipped by the other's plane, keeping the side inside
-//!   it at a convex corner and the side outside it at a reflex one;
+//!   will otherwise intersect"): the **seam**, the common line of the two planes from v away
+//!   from the light (direction ±M1 × M2), becomes the end side of Q1 and the start side of Q2,
+//!   so each keeps the part on its own side of it (inside the other's half-space at a convex
+//!   corner, outside at a reflex one) and both share the seam's two vertices bit for bit: no
+//!   crack between them for a ray to pass through;
 //! * otherwise they **diverge** and the gap is closed by a fan of triangles (v, f(p(θ_k)),
 //!   f(p(θ_k+1))) with p(θ) the rim point at angle θ, interpolating from p1 to p2 along the
 //!   shorter arc in ⌈|Δθ|·`fan_segments`/2π⌉ steps ("in the case of a circular light source,
@@ -101,12 +107,12 @@
 //! the penumbra (their union is bounded by a cone piece from v between them), as the paper
 //! describes for convex occluders; at a reflex corner the roles swap (the penumbra quads cross,
 //! the umbra needs the cone piece). The paper names only the first case; we apply the one rule
-//! at every corner and count each kind ([`VolumeStats`]). Before the rule looked at the
-//! corner's convexity, the zigzag silhouettes of `disk-torus` left radial streaks of wrong
-//! umbra distances where reflex corners were trimmed instead of closed. Intersections between
-//! quads that are not neighbours in their loop are not trimmed: §4 handles them with the depth
-//! test ("it is much easier to use depth test to ensure storing of proper distances"), and
-//! that is the paper's no-umbra artifact.
+//! at every corner and count each kind ([`VolumeStats`]) (the zigzag silhouettes of
+//! `disk-torus` have both kinds all along). Intersections between quads that are not
+//! neighbours in their loop are not trimmed: §4 handles them with the depth test ("it is much
+//! easier to use depth test to ensure storing of proper distances"), and that is the paper's
+//! no-umbra artifact — also where a short edge separates two long ones, as the vertical edges
+//! of a thin slab whose sides are silhouette faces (measured in `tests/dbuffer.rs`).
 //!
 //! # Silhouette faces (§3.3)
 //!
@@ -121,11 +127,11 @@
 //!
 //! [`build_volumes`] returns the triangles of both volumes in submission order: mesh by mesh
 //! in file order, loop by loop ([`super::loops::silhouette_loops`]), edge by edge in walk
-//! order: the edge's (trimmed) quad fanned from its first vertex, then the fan of the corner
-//! at its end; for the umbra, then the mesh's silhouette faces not facing c, in triangle order.
-//! Every vertex carries its **silhouette point** e: the vertex itself for points on a
-//! silhouette edge and for silhouette faces, the edge point it was extruded from for far
-//! points (a point created by trimming carries the linear interpolation of its segment's),
+//! order: the edge's quad, then the fan of the corner at its end; for the umbra, then the
+//! mesh's silhouette faces not facing c, in triangle order. Every vertex carries its
+//! **silhouette point** e: the vertex itself for points on a silhouette edge and for
+//! silhouette faces, the edge end whose side it ends for far points (a seam's far point: the
+//! corner vertex), the middle of the edge for the meeting point P of a quad's two sides —
 //! which is what eq. 2's "dist(c, e)" and "dir(c, e)" are evaluated at in the vertex program.
 
 use super::adjacency::Adjacency;
