@@ -10,11 +10,12 @@
 //!    `distances = exact`, `storage = f16`), `hard-sv`, and — with the disk replaced by a
 //!    sphere of the same radius, the only light they take — `pw2002`, `ssv` and
 //!    `penumbra-map`.
-//! 2. The boundary-classification table on `disk-block` and `disk-slab`: the fraction of
+//! 2. The boundary-classification table on every scene: the fraction of
 //!    receiver pixels each method puts in the umbra (v = 0), the penumbra and the lit region
 //!    (v = 1), up to [`CLASS_TOLERANCE`], the fraction classified as `raycast` classifies them,
 //!    and the fractions that swap lit and penumbra (the outer boundary) and umbra and penumbra
-//!    (the inner one).
+//!    (the inner one) — over every receiver pixel and over the floor's alone (the occluders'
+//!    own faces carry the self-shadowing artifacts).
 //! 3. Time per pass of `dbuffer` (median of 5 runs, all threads) on `disk-small-sphere`
 //!    (224-triangle occluder), `disk-block` and `disk-torus` (5760) at 300², 600² and 1024²,
 //!    with the D-buffer's fragment and byte counts.
@@ -109,20 +110,24 @@ fn main() {
         let frame_scene = sized(name, size);
         let frame = Frame::render(&frame_scene, GpuSettings::default()).expect("frame");
         let receiver = |i: usize| frame.prim_ids()[i] != penumbra::frame::BACKGROUND;
+        let floor = |i: usize| receiver(i) && frame.prim_owner[frame.prim_ids()[i] as usize].0 == 0;
         println!("## {name}\n");
         println!(
-            "| method | RMSE | mean abs | % > 1/255 | umbra | penumbra | lit | same class as raycast | lit↔penumbra | umbra↔penumbra |"
+            "| method | RMSE | mean abs | % > 1/255 | umbra | penumbra | lit | same class as raycast | lit↔penumbra | umbra↔penumbra | floor: same class | floor: lit↔penumbra | floor: umbra↔penumbra |"
         );
-        println!("|---|---|---|---|---|---|---|---|---|---|");
+        println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
         let reference = &res[0].1;
         for (label, v) in &res {
             let e = compare(v, reference);
             let t = ClassTable::of(reference, v, CLASS_TOLERANCE, receiver);
             let n = t.pixels() as f64;
             let frac = |c| t.total(c, false) as f64 / n;
-            let swap = |a: usize, b: usize| (t.counts[a][b] + t.counts[b][a]) as f64 / n;
+            let swap = |t: &ClassTable, a: usize, b: usize| {
+                (t.counts[a][b] + t.counts[b][a]) as f64 / t.pixels() as f64
+            };
+            let f = ClassTable::of(reference, v, CLASS_TOLERANCE, floor);
             println!(
-                "| {label} | {:.4} | {:.4} | {:.2} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} |",
+                "| {label} | {:.4} | {:.4} | {:.2} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} |",
                 e.rmse,
                 e.mean_abs,
                 e.pct_over_1_255,
@@ -130,8 +135,11 @@ fn main() {
                 frac(ShadowClass::Penumbra),
                 frac(ShadowClass::Lit),
                 t.agreement(),
-                swap(1, 2),
-                swap(0, 1)
+                swap(&t, 1, 2),
+                swap(&t, 0, 1),
+                f.agreement(),
+                swap(&f, 1, 2),
+                swap(&f, 0, 1)
             );
         }
         println!();

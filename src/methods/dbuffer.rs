@@ -38,7 +38,8 @@
 //!      The paper keeps one |cx_s| channel for both volumes ("generated simultaneously with
 //!      |cx_uv| and |cx_pv|"); where a texel's ray crosses both volumes (overlapping
 //!      occluders), the penumbra draw writes it last and the umbra branch reads the penumbra
-//!      edge's |cx_s| — one of the overlap artifacts (pinned).
+//!      edge's |cx_s| — one of the overlap artifacts (such texels are counted,
+//!      [`DBufferStats::shared_a_texels`]).
 //!
 //!    **|cx_s|** (eq. 2) is computed per vertex at its silhouette point e
 //!    ([`crate::geometry::umbra_penumbra`], "Output"), as printed:
@@ -46,9 +47,9 @@
 //!    dist(c, e) on the silhouette itself; elsewhere it is not the distance along the ray to
 //!    the silhouette's depth, h_e/(dir(c, x)·n), which the inverted ratio would give — the two
 //!    differ to first order in the angle between the directions. The inverted ratio changed
-//!    the RMSE vs `raycast` by less than 0.002 on every disk built-in (256², measured while
-//!    building this; it is not an option), so the printed one stays. A vertex whose ratio is
-//!    not finite (e at the light's height) gets dist(c, e), counted.
+//!    the RMSE vs `raycast` by at most 0.0017 on each of five disk scenes at 256² (measured
+//!    during development, not kept as an option), so the printed one stays. A vertex whose
+//!    ratio is not finite (e at the light's height) gets dist(c, e), counted.
 //!
 //!    **Distances** (`distances`): `interpolated` (default) is the paper's vertex program;
 //!    `exact` computes, per fragment, the distance along the texel's ray from c to the
@@ -70,10 +71,11 @@
 //!      for (the umbra side is where the occluder lies between c and x);
 //!    * umbra side: no umbra volume on the ray (G = 0) or x before it (|cx| < |cx_uv|):
 //!      **umbra**, V = 0; else the first branch of eq. 3, t =
-//!      |cx_s|(|cx| − |cx_uv|) / (2|cx_uv|(|cx_uv| − |cx_s|));
+//!      |cx_s|(|cx| − |cx_uv|) / (2|cx_uv|·D) with D = |cx| − |cx_s| (printed:
+//!      |cx_uv| − |cx_s|; below);
 //!    * penumbra side: no penumbra volume (B = 0) or x before it (|cx| < |cx_pv|): **lit**,
-//!      V = 1; else the second branch, t = 1 − |cx_s|(|cx| − |cx_pv|) /
-//!      (2|cx_pv|(|cx_pv| − |cx_s|));
+//!      V = 1; else the second branch, t = 1 − |cx_s|(|cx| − |cx_pv|) / (2|cx_pv|·D), D =
+//!      |cx| − |cx_s| (printed: |cx_pv| − |cx_s|);
 //!    * V = 3t² − 2t³ (eq. 4, `falloff = smoothstep`) or √t (§6.2, `falloff = sqrt`).
 //!
 //!    **Eq. 3's denominator** (`eq3`). In the paper's 2D projection (Fig. 4), with
@@ -84,12 +86,14 @@
 //!    form agrees at the volume (t = 0, with the same slope: it is the linearization there) but
 //!    contradicts the paper's own derivation of the second branch, "observing symmetry around
 //!    c where t = ½": on the ray through the silhouette (|cx_uv| = |cx_s|) the printed t is
-//!    s(d − s)/0, the corrected one ½ for every x. Rendered as printed, the inner penumbra
-//!    next to c's hard-shadow line gets t ≫ 1 and comes out fully lit, the outer penumbra next
-//!    to it t ≪ 0 and black — a shadow turned inside out that the paper's figures do not show
-//!    (measured in `docs/dbuffer.md`). So `eq3 = corrected` is the default and
-//!    `eq3 = printed` reproduces the printed arithmetic. With the corrected denominator t stays
-//!    in [0, ½] on the umbra side and [½, 1] on the other whenever z ≥ z_v ≥ h.
+//!    s(d − s)/0, the corrected one ½ for every x. Rendered as printed, the rays through the
+//!    silhouette faces of §3.3 (whose |cx_uv| and |cx_s| are the same distances) divide by 0,
+//!    the inner penumbra next to c's hard-shadow line gets t > 1 (lit) and the outer penumbra
+//!    next to it t < 0 (black): bright and black rings the paper's figures do not show
+//!    (RMSE vs `raycast` 1.8–3.9 times the corrected formula's on the disk built-ins,
+//!    `docs/dbuffer.md`). So `eq3 = corrected` is the default and `eq3 = printed` reproduces
+//!    the printed arithmetic. With the corrected denominator t stays in [0, ½] on the umbra
+//!    side and [½, 1] on the other whenever z ≥ z_v ≥ h.
 //!    A denominator that is not positive (or a t that is not finite) is **degenerate**: t = ½
 //!    (the corrected formula's value at the silhouette), counted. t outside [0, 1] is counted
 //!    before it is clamped to [0, 1] (`saturate`), and those pixels are
@@ -117,17 +121,12 @@ use crate::gpu::light_view::LightView;
 use crate::gpu::raster::{bin, draw, no_tile_culling, Fragment};
 use crate::gpu::setup::{setup_all_barycentric, CullMode};
 use crate::gpu::transform::ClipVertex;
-use crate::plan::{BufferPlan, MethodPlan};
+use crate::plan::BufferPlan;
 use crate::scene::LightShape;
 use glam::DVec3;
-use rayon::prelude::*;
 use serde::Serialize;
 use std::time::Instant;
 
-/// The default polygon-offset units of the R channel (`bias`).
-pub const DEFAULT_BIAS_UNITS: f64 = 4.0;
-/// The default slope-scaled polygon-offset factor of the R channel (`slope_bias`).
-pub const DEFAULT_SLOPE_BIAS: f64 = 1.0;
 /// The largest `map_size` (the RGBA f32 target of 4096² texels takes 256 MB).
 pub const MAX_MAP_SIZE: u32 = 4096;
 /// The default number of corner-fan triangles per full circle (`fan_segments`).
@@ -136,24 +135,8 @@ pub const DEFAULT_FAN_SEGMENTS: u32 = 32;
 /// distance range beyond that sphere.
 pub const BOUND_MARGIN: f64 = 0.01;
 
-/// V(t) (§4 eq. 4, §6.2).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-pub enum Falloff {
-    /// V = 3t² − 2t³ (eq. 4).
-    Smoothstep,
-    /// V = √t (§6.2, for small occluders).
-    Sqrt,
-}
-
-impl Falloff {
-    /// V of `t` in [0, 1].
-    pub fn apply(self, t: f64) -> f64 {
-        match self {
-            Falloff::Smoothstep => super::smoothstep(t),
-            Falloff::Sqrt => t.sqrt(),
-        }
-    }
-}
+/// V(t): 3t² − 2t³ (smoothstep, §4 eq. 4) or √t (§6.2, for small occluders).
+pub use super::Falloff;
 
 /// Eq. 3's denominator (module doc, pass 3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -200,22 +183,18 @@ pub struct DBufferSettings {
 pub fn read_settings(frame: &Frame) -> Result<DBufferSettings, InputError> {
     let scene = frame.scene;
     let mut r = OptionReader::new(scene, "dbuffer");
-    let map_size = r.uint(
-        "map_size",
-        scene.width.max(scene.height).min(MAX_MAP_SIZE) as u64,
-        8..=MAX_MAP_SIZE as u64,
-    )? as u32;
+    let map_size = r.map_size(scene, MAX_MAP_SIZE)?;
     let depth = r.depth_format("depth", frame.gpu.depth)?;
     let storage = match r.choice("storage", &["f32", "f16"], "f32")? {
         "f16" => ColorFormat::F16,
         _ => ColorFormat::F32,
     };
-    let units = r.float("bias", DEFAULT_BIAS_UNITS, 0.0..=16_777_215.0)?;
-    let factor = r.float("slope_bias", DEFAULT_SLOPE_BIAS, 0.0..=1000.0)?;
-    let falloff = match r.choice("falloff", &["smoothstep", "sqrt"], "smoothstep")? {
-        "sqrt" => Falloff::Sqrt,
-        _ => Falloff::Smoothstep,
-    };
+    // The shadow maps' defaults (`penumbra-map`'s).
+    let offset = r.polygon_offset(
+        super::penumbra_map::DEFAULT_BIAS_UNITS,
+        super::penumbra_map::DEFAULT_SLOPE_BIAS,
+    )?;
+    let falloff = Falloff::read(&mut r, &["smoothstep", "sqrt"])?;
     let eq3 = match r.choice("eq3", &["corrected", "printed"], "corrected")? {
         "printed" => Eq3::Printed,
         _ => Eq3::Corrected,
@@ -230,7 +209,7 @@ pub fn read_settings(frame: &Frame) -> Result<DBufferSettings, InputError> {
         map_size,
         depth,
         storage,
-        offset: PolygonOffset { factor, units },
+        offset,
         falloff,
         eq3,
         fan_segments,
@@ -353,6 +332,8 @@ pub struct DBufferStats {
     pub a_writes: u64,
     /// Volume vertices whose eq. 2 ratio was not finite (dist(c, e) used).
     pub s_not_finite: u64,
+    /// Texels holding both an umbra and a penumbra distance: their A is the penumbra draw's.
+    pub shared_a_texels: u64,
 }
 
 /// What the screen pass found (module doc, pass 3).
@@ -386,7 +367,8 @@ field_sum!(DBufferStats {
     penumbra_fragments,
     b_writes,
     a_writes,
-    s_not_finite
+    s_not_finite,
+    shared_a_texels
 });
 field_sum!(ScreenStats {
     receivers,
@@ -683,6 +665,12 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
     let mut dbuffer = Vec::with_capacity(tiles.len());
     for tile in tiles {
         program += tile.stats;
+        program.shared_a_texels += tile
+            .color
+            .values
+            .iter()
+            .filter(|v| v[1] != 0 && v[2] != 0)
+            .count() as u64;
         dbuffer.push(tile.color);
     }
 
@@ -721,57 +709,35 @@ fn screen_pass(
     let receivers = frame.primary_ray_receivers();
     let width = frame.scene.width as usize;
     let texel_bytes = 4 * s.storage.bytes();
-    type Row = (Vec<(f32, Option<Shade>)>, ScreenStats, Counters);
-    let rows: Vec<Row> = receivers
-        .par_chunks(width)
-        .map(|row| {
-            let mut st = ScreenStats::default();
-            let mut cn = Counters::default();
-            let values = row
-                .iter()
-                .map(|r| {
-                    let Some(r) = r else {
-                        return (1.0, None);
-                    };
-                    st.receivers += 1;
-                    cn.fragments_shaded += 1;
-                    let Some([x, y, _]) = view.window(r.point) else {
-                        st.behind_light += 1;
-                        return (1.0, None);
-                    };
-                    let (tile, local) = view.nearest_texel(x, y);
-                    cn.color_read_bytes += texel_bytes;
-                    let texel = dbuffer[tile].texel(local);
-                    let shade = screen_program((r.point.as_dvec3() - c).length(), texel, s);
-                    match shade.region {
-                        Region::Umbra => {
-                            st.umbra += 1;
-                            st.umbra_without_volume += (texel[1] <= 0.0) as u64;
-                        }
-                        Region::InnerPenumbra => st.inner_penumbra += 1,
-                        Region::OuterPenumbra => st.outer_penumbra += 1,
-                        Region::Lit => st.lit += 1,
-                    }
-                    st.degenerate_t += shade.degenerate as u64;
-                    st.t_out_of_range += shade.t.is_some_and(|t| !(0.0..=1.0).contains(&t)) as u64;
-                    (shade.v as f32, Some(shade))
-                })
-                .collect();
-            (values, st, cn)
-        })
-        .collect();
-    let mut values = Vec::with_capacity(receivers.len());
-    let mut shades = Vec::with_capacity(receivers.len());
-    let mut stats = ScreenStats::default();
-    let mut counters = Counters::default();
-    for (v, st, cn) in rows {
-        for (x, shade) in v {
-            values.push(x);
-            shades.push(shade);
-        }
-        stats += st;
-        counters += cn;
-    }
+    let (pixels, stats, counters) =
+        super::shade_receivers(&receivers, width, |_, r, st: &mut ScreenStats, cn| {
+            let Some(r) = r else {
+                return (1.0, None);
+            };
+            st.receivers += 1;
+            cn.fragments_shaded += 1;
+            let Some([x, y, _]) = view.window(r.point) else {
+                st.behind_light += 1;
+                return (1.0, None);
+            };
+            let (tile, local) = view.nearest_texel(x, y);
+            cn.color_read_bytes += texel_bytes;
+            let texel = dbuffer[tile].texel(local);
+            let shade = screen_program((r.point.as_dvec3() - c).length(), texel, s);
+            match shade.region {
+                Region::Umbra => {
+                    st.umbra += 1;
+                    st.umbra_without_volume += (texel[1] <= 0.0) as u64;
+                }
+                Region::InnerPenumbra => st.inner_penumbra += 1,
+                Region::OuterPenumbra => st.outer_penumbra += 1,
+                Region::Lit => st.lit += 1,
+            }
+            st.degenerate_t += shade.degenerate as u64;
+            st.t_out_of_range += shade.t.is_some_and(|t| !(0.0..=1.0).contains(&t)) as u64;
+            (shade.v as f32, Some(shade))
+        });
+    let (values, shades) = pixels.into_iter().unzip();
     (Visibility::Gray(values), shades, stats, counters)
 }
 
@@ -780,26 +746,23 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let start = Instant::now();
     let s = read_settings(frame)?;
     let r = render(frame, &s)?;
-    let mut passes = vec![frame.pass.clone()];
-    passes.extend(r.passes.iter().cloned());
     let n = s.map_size;
-    let plan = MethodPlan {
-        method: "dbuffer".into(),
-        passes: passes.iter().map(|p| p.name.clone()).collect(),
-        buffers: vec![
-            BufferPlan::depth(&frame.gpu),
-            BufferPlan {
-                name: format!("D-buffer RGBA {n}x{n} (R |cx_o|, G |cx_uv|, B |cx_pv|, A |cx_s|)"),
-                format: format!("{:?}", s.storage),
-                bytes_per_sample: 4 * s.storage.bytes() as u32,
-            },
-            BufferPlan {
-                name: format!("D-buffer depth {n}x{n}"),
-                format: format!("{:?}", s.depth),
-                bytes_per_sample: s.depth.bytes() as u32,
-            },
-        ],
-        settings: serde_json::json!({
+    let buffers = vec![
+        BufferPlan::depth(&frame.gpu),
+        BufferPlan::color_target(
+            format!("D-buffer RGBA {n}x{n} (R |cx_o|, G |cx_uv|, B |cx_pv|, A |cx_s|)"),
+            s.storage,
+            4,
+        ),
+        BufferPlan::depth_target(format!("D-buffer depth {n}x{n}"), s.depth),
+    ];
+    let mut stats = super::stats_after_scene_pass(
+        "dbuffer",
+        frame,
+        start,
+        &r.passes,
+        buffers,
+        serde_json::json!({
             "settings": s,
             "light_view": {
                 "axis": r.view.axis.to_array(),
@@ -816,8 +779,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             "screen": r.screen,
             "gpu": frame.gpu,
         }),
-    };
-    let mut stats = super::method_stats("dbuffer", frame, start, &plan, passes);
+    );
     stats.clamped_pixels = r.screen.t_out_of_range;
     Ok(MethodOutput {
         visibility: r.visibility,
@@ -917,25 +879,23 @@ mod tests {
             fan_segments: 32,
             distances: Distances::Interpolated,
         };
-        // Lit: nothing nearer, no penumbra volume.
-        assert_eq!(
-            screen_program(5.0, [5.0, 0.0, 0.0, 0.0], &s).region,
-            Region::Lit
-        );
-        // Before the penumbra volume: lit; beyond it: outer penumbra, V in (0.5, 1].
-        assert_eq!(screen_program(3.0, [3.0, 0.0, 4.0, 2.0], &s).v, 1.0);
-        let outer = screen_program(5.0, [5.0, 0.0, 4.0, 2.0], &s);
-        assert_eq!(outer.region, Region::OuterPenumbra);
-        assert!(outer.v > 0.5 && outer.v < 1.0);
-        // Behind an occluder, before the umbra volume's end: umbra; no umbra volume: umbra.
-        assert_eq!(
-            screen_program(3.0, [2.0, 4.0, 0.0, 2.0], &s).region,
-            Region::Umbra
-        );
-        assert_eq!(screen_program(3.0, [2.0, 0.0, 0.0, 0.0], &s).v, 0.0);
+        // (|cx|, texel, region, V range): nothing nearer and no penumbra volume, before the
+        // penumbra volume, beyond it; behind an occluder before the umbra volume's end, without
+        // an umbra volume, beyond it.
+        let cases: [(f64, [f32; 4], Region, [f64; 2]); 6] = [
+            (5.0, [5.0, 0.0, 0.0, 0.0], Region::Lit, [1.0, 1.0]),
+            (3.0, [3.0, 0.0, 4.0, 2.0], Region::Lit, [1.0, 1.0]),
+            (5.0, [5.0, 0.0, 4.0, 2.0], Region::OuterPenumbra, [0.5, 1.0]),
+            (3.0, [2.0, 4.0, 0.0, 2.0], Region::Umbra, [0.0, 0.0]),
+            (3.0, [2.0, 0.0, 0.0, 0.0], Region::Umbra, [0.0, 0.0]),
+            (5.0, [2.0, 4.0, 0.0, 2.0], Region::InnerPenumbra, [0.0, 0.5]),
+        ];
+        for (d, texel, region, [lo, hi]) in cases {
+            let shade = screen_program(d, texel, &s);
+            assert_eq!(shade.region, region, "{d} {texel:?}");
+            assert!((lo..=hi).contains(&shade.v), "{d} {texel:?}: {}", shade.v);
+        }
         let inner = screen_program(5.0, [2.0, 4.0, 0.0, 2.0], &s);
-        assert_eq!(inner.region, Region::InnerPenumbra);
-        assert!(inner.v > 0.0 && inner.v < 0.5);
         // √t is brighter than smoothstep for t < ½.
         let sqrt = DBufferSettings {
             falloff: Falloff::Sqrt,

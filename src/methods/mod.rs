@@ -35,7 +35,7 @@ use crate::gpu::counters::Counters;
 use crate::gpu::depth::DepthFormat;
 use crate::gpu::light_view::{LightView, MAX_LIGHT_VIEW_HALF_ANGLE_DEG};
 use crate::gpu::tiling::Tiling;
-use crate::plan::MethodPlan;
+use crate::plan::{BufferPlan, MethodPlan};
 use crate::scene::{LightShape, Scene};
 use output::{MethodOutput, MethodStats, PassStats};
 use std::time::Instant;
@@ -181,10 +181,41 @@ fn run_one_light(method: &str, frame: &Frame) -> Result<MethodOutput, InputError
     }
 }
 
-/// The smoothstep 3x² − 2x³ (the Bernstein interpolant of Parker et al. that the penumbra-map
-/// falloff and the D-buffer's eq. 4 both use).
-pub fn smoothstep(x: f64) -> f64 {
-    3.0 * x * x - 2.0 * x * x * x
+/// How a visibility parameter in [0, 1] becomes a visibility: each method accepts the falloffs
+/// its paper names (`penumbra-map`: smoothstep or linear; `dbuffer`: smoothstep or √t).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum Falloff {
+    /// 3x² − 2x³, the Bernstein interpolant of Parker et al. (Wyman & Hansen §3, CGI 2004
+    /// eq. 4).
+    Smoothstep,
+    /// x.
+    Linear,
+    /// √x (CGI 2004 §6.2, for occluders smaller than the light).
+    Sqrt,
+}
+
+impl Falloff {
+    /// The falloff of `x`.
+    pub fn apply(self, x: f64) -> f64 {
+        match self {
+            Falloff::Smoothstep => 3.0 * x * x - 2.0 * x * x * x,
+            Falloff::Linear => x,
+            Falloff::Sqrt => x.sqrt(),
+        }
+    }
+
+    /// Read option `falloff` of `r` among `allowed` (option names `smoothstep`, `linear`,
+    /// `sqrt`), smoothstep by default.
+    pub fn read(
+        r: &mut options::OptionReader,
+        allowed: &[&'static str],
+    ) -> Result<Self, InputError> {
+        Ok(match r.choice("falloff", allowed, "smoothstep")? {
+            "linear" => Falloff::Linear,
+            "sqrt" => Falloff::Sqrt,
+            _ => Falloff::Smoothstep,
+        })
+    }
 }
 
 /// The light view of `frame`'s (only) light for `method`: a `map_size`² target of format
@@ -214,6 +245,66 @@ pub fn fit_light_view(
             ),
         )
     })
+}
+
+/// A screen pass: the fragment program `program(pixel, receiver, stats, counters)` run on the
+/// receiver of every pixel (`None` for background), rows in parallel, each row's tallies summed
+/// in row order (integer sums: independent of the thread count). Returns the program's outputs
+/// in row-major order, the summed stats and the summed counters.
+pub fn shade_receivers<T, S>(
+    receivers: &[Option<crate::frame::Receiver>],
+    width: usize,
+    program: impl Fn(usize, Option<&crate::frame::Receiver>, &mut S, &mut Counters) -> T + Sync,
+) -> (Vec<T>, S, Counters)
+where
+    T: Send,
+    S: Default + std::ops::AddAssign + Send,
+{
+    use rayon::prelude::*;
+    let rows: Vec<(Vec<T>, S, Counters)> = receivers
+        .par_chunks(width)
+        .enumerate()
+        .map(|(row, pixels)| {
+            let mut st = S::default();
+            let mut c = Counters::default();
+            let out = pixels
+                .iter()
+                .enumerate()
+                .map(|(k, r)| program(row * width + k, r.as_ref(), &mut st, &mut c))
+                .collect();
+            (out, st, c)
+        })
+        .collect();
+    let mut out = Vec::with_capacity(receivers.len());
+    let mut stats = S::default();
+    let mut counters = Counters::default();
+    for (o, st, c) in rows {
+        out.extend(o);
+        stats += st;
+        counters += c;
+    }
+    (out, stats, counters)
+}
+
+/// [`MethodStats`] of a method that started at `start` and ran `passes` after the frame's
+/// scene pass: the plan lists the scene pass and them, with `buffers` and `settings`.
+pub fn stats_after_scene_pass(
+    method: &str,
+    frame: &Frame,
+    start: Instant,
+    passes: &[PassStats],
+    buffers: Vec<BufferPlan>,
+    settings: serde_json::Value,
+) -> MethodStats {
+    let mut all = vec![frame.pass.clone()];
+    all.extend(passes.iter().cloned());
+    let plan = MethodPlan {
+        method: method.into(),
+        passes: all.iter().map(|p| p.name.clone()).collect(),
+        buffers,
+        settings,
+    };
+    method_stats(method, frame, start, &plan, all)
 }
 
 /// Assemble [`MethodStats`] for a method that started at `start` (totals summed over passes).

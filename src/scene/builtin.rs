@@ -76,8 +76,8 @@ pub fn load(name: &str) -> Option<Scene> {
         "forest-spheres-1" => forest_spheres([1, 1, 1]),
         "forest-spheres-4" => forest_spheres([2, 1, 2]),
         "forest-spheres-9" => forest_spheres([3, 1, 3]),
-        "disk-block" => disk_block(),
-        "disk-slab" => disk_slab(),
+        "disk-block" => disk_pair("block", 0.9),
+        "disk-slab" => disk_pair("slab", 1.5),
         "disk-small-sphere" => disk_small_sphere(),
         "disk-acute" => disk_acute(),
         "disk-torus" => disk_torus(),
@@ -337,39 +337,27 @@ fn disk_down(center: Vec3, radius: f32) -> Light {
     }
 }
 
-/// CGI 2004 Fig. 1 and Fig. 7: an occluder under a disk light large enough that its sides
-/// are silhouette faces, with the light center straight above it, so that from c only its top
-/// is seen: the silhouette from c is the top square (x, z ∈ ±0.5 at y = 1.6), whatever lies
-/// below it. The camera is low enough to see the floor under the occluder.
-fn disk_pair(occluder: Mesh) -> Scene {
+/// CGI 2004 Fig. 1 and Fig. 7: a box `name` (x, z ∈ ±0.5, y from `bottom` to 1.6) under a
+/// disk light large enough that its sides are silhouette faces, with the light center straight
+/// above it, so that from c only its top is seen: the silhouette from c is the top square,
+/// whatever the bottom. `disk-block` (bottom 0.9: a tall block floating above the floor, whose
+/// umbra is bounded by its bottom edges) and `disk-slab` (bottom 1.5: the block cut down to its
+/// top 0.1) cast different true shadows although a method working from the silhouette seen from
+/// c shades them alike. The camera is low enough to see the floor under the occluder.
+fn disk_pair(name: &str, bottom: f32) -> Scene {
     scene(
         camera([0.0, 1.4, 3.6], [0.0, 0.25, 0.0], 55.0),
         disk_down(Vec3::new(0.0, 3.8, 0.0), 1.2),
-        vec![floor([-4.0, 4.0], [-4.0, 4.0]), occluder],
+        vec![
+            floor([-4.0, 4.0], [-4.0, 4.0]),
+            box_mesh(
+                name,
+                Vec3::new(-0.5, bottom, -0.5),
+                Vec3::new(0.5, 1.6, 0.5),
+                OCCLUDER,
+            ),
+        ],
     )
-}
-
-/// `disk-block`: a tall block floating from y = 0.9 to 1.6, whose umbra is bounded by its bottom
-/// edges — a true shadow that differs from `disk-slab`'s although a method working from the
-/// silhouette seen from c shades both alike.
-fn disk_block() -> Scene {
-    disk_pair(box_mesh(
-        "block",
-        Vec3::new(-0.5, 0.9, -0.5),
-        Vec3::new(0.5, 1.6, 0.5),
-        OCCLUDER,
-    ))
-}
-
-/// `disk-slab`: `disk-block` with the block cut down to its top 0.1 (the same silhouette from
-/// c): the twin that shows what a single silhouette cannot see.
-fn disk_slab() -> Scene {
-    disk_pair(box_mesh(
-        "slab",
-        Vec3::new(-0.5, 1.5, -0.5),
-        Vec3::new(0.5, 1.6, 0.5),
-        OCCLUDER,
-    ))
 }
 
 /// CGI 2004 Fig. 8a and §4 case 2: a small sphere (224 triangles, Table 1's first row) under
