@@ -136,6 +136,28 @@ impl BufferPlan {
         }
     }
 
+    /// A depth target named `name` (a shadow map, a map's depth channel) in `format`.
+    pub fn depth_target(name: String, format: crate::gpu::depth::DepthFormat) -> Self {
+        Self {
+            name,
+            format: format!("{format:?}"),
+            bytes_per_sample: format.bytes() as u32,
+        }
+    }
+
+    /// A colour target named `name` with `channels` channels, each in `format`.
+    pub fn color_target(
+        name: String,
+        format: crate::gpu::color::ColorFormat,
+        channels: u32,
+    ) -> Self {
+        Self {
+            name,
+            format: format!("{format:?}"),
+            bytes_per_sample: channels * format.bytes() as u32,
+        }
+    }
+
     /// An 8-bit stencil buffer.
     pub fn stencil8() -> Self {
         Self {

@@ -101,11 +101,19 @@ const BAD_FILES: &[(&str, &[&str])] = &[
     ),
     ("light-overlaps-mesh.toml", &["light intersects geometry"]),
     ("top-level-array.json", &["not an array"]),
+    (
+        "dbuffer-frustum.toml",
+        &["one light frustum cannot cover the scene"],
+    ),
 ];
 
 /// Files whose problem is in their own method list or in a method that list names, which
 /// `--methods` would replace: they run with their own list.
-const OWN_METHODS: &[&str] = &["unknown-method.toml", "penumbra-map-frustum.toml"];
+const OWN_METHODS: &[&str] = &[
+    "unknown-method.toml",
+    "penumbra-map-frustum.toml",
+    "dbuffer-frustum.toml",
+];
 
 #[test]
 fn every_bad_scene_file_is_rejected() {
@@ -290,6 +298,11 @@ fn bad_options_and_methods() {
             &["--methods", "penumbra-map"],
             &["method penumbra-map does not support rect lights"],
         ),
+        (
+            "the D-buffer needs a disk light",
+            &["--methods", "dbuffer"],
+            &["method dbuffer does not support rect lights"],
+        ),
     ];
     for (what, args, keywords) in cases {
         let all: Vec<&str> = [&[scene][..], &small, args].concat();
@@ -300,6 +313,29 @@ fn bad_options_and_methods() {
             scene
         };
         assert_bad_input(what, &render(what, &all), file, keywords);
+    }
+    // dbuffer's own options, on a disk-light scene.
+    let disk_cases: &[(&str, &[&str], &[&str])] = &[
+        (
+            "dbuffer eq3",
+            &["--opt", "dbuffer.eq3=exact"],
+            &["dbuffer.eq3", "corrected, printed"],
+        ),
+        (
+            "dbuffer storage",
+            &["--opt", "dbuffer.storage=unorm8"],
+            &["dbuffer.storage", "f32, f16"],
+        ),
+        (
+            "dbuffer map size",
+            &["--opt", "dbuffer.map_size=4"],
+            &["dbuffer.map_size"],
+        ),
+    ];
+    for (what, args, keywords) in disk_cases {
+        let all: Vec<&str> =
+            [&["disk-block"][..], &small, &["--methods", "dbuffer"], args].concat();
+        assert_bad_input(what, &render(what, &all), "disk-block", keywords);
     }
     for size in ["0", "100000"] {
         assert_bad_input(

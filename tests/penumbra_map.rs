@@ -11,12 +11,11 @@
 //! gone at r = 1.5; the true penumbra reaches out to half-width 0.75 + r/2.
 
 use penumbra::frame::{Frame, GpuSettings, Receiver};
-use penumbra::methods::output::Visibility;
 use penumbra::methods::penumbra_map::{self, PenumbraMapRender, PenumbraMapSettings};
 use penumbra::scene::{LightShape, OptionValue, Scene};
 
 mod sphere_hard_cases;
-use sphere_hard_cases::{small, with_sphere};
+use sphere_hard_cases::{gray, small, with_sphere};
 
 fn set(scene: &mut Scene, method: &str, key: &str, v: OptionValue) {
     scene
@@ -24,13 +23,6 @@ fn set(scene: &mut Scene, method: &str, key: &str, v: OptionValue) {
         .entry(method.into())
         .or_default()
         .insert(key.into(), v);
-}
-
-fn gray(v: &Visibility) -> Vec<f32> {
-    match v {
-        Visibility::Gray(g) => g.clone(),
-        Visibility::Rgb(_) => panic!("gray expected"),
-    }
 }
 
 /// Everything a test looks at: the method's render, `raycast` with 256 samples (when asked),

@@ -12,7 +12,7 @@ use std::cmp::Ordering;
 use std::collections::BTreeMap;
 
 mod sphere_hard_cases;
-use sphere_hard_cases::{small, with_sphere};
+use sphere_hard_cases::{gray, small, with_sphere};
 
 fn wedge_settings(frame: &Frame) -> WedgeSettings {
     let mut r = penumbra::methods::options::OptionReader::new(frame.scene, "pw2002");
@@ -132,15 +132,7 @@ fn pw2002_and_restructured_agree_bit_for_bit_with_the_eye_outside_shadow() {
 }
 
 use penumbra::gpu::li_buffer::{LiFormat, LiOverflow};
-use penumbra::methods::output::Visibility;
 use penumbra::scene::LightShape;
-
-fn gray(v: &Visibility) -> Vec<f32> {
-    match v {
-        Visibility::Gray(g) => g.clone(),
-        Visibility::Rgb(_) => panic!("gray expected"),
-    }
-}
 
 fn mean_abs(a: &[f32], b: &[f32]) -> f64 {
     a.iter()

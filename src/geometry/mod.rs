@@ -1,6 +1,6 @@
 //! Geometry preparation: mesh adjacency, possible silhouettes from a light point, silhouette
 //! loops (Paper V), hard shadow volumes with caps, penumbra wedges, and the cones and sheets
-//! of penumbra maps.
+//! of penumbra maps and the umbra and penumbra volumes of a disk light (CGI 2004).
 
 pub mod adjacency;
 pub mod loops;
@@ -10,3 +10,4 @@ pub mod shadow_volume;
 pub mod silhouette;
 pub mod ssv_wedge;
 pub mod tight_wedge;
+pub mod umbra_penumbra;

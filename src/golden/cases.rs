@@ -96,6 +96,12 @@ impl GoldenCase {
 /// Every method on the foundation scenes (explicit, so that a method that stops supporting
 /// one fails instead of disappearing).
 pub const FOUNDATION: &[(&str, &[&str])] = &[
+    // dbuffer (CGI 2004) on every disk-light built-in.
+    ("disk-block", &["dbuffer"]),
+    ("disk-slab", &["dbuffer"]),
+    ("disk-small-sphere", &["dbuffer"]),
+    ("disk-acute", &["dbuffer"]),
+    ("disk-torus", &["dbuffer"]),
     (
         "cube-of-spheres",
         &[
@@ -366,6 +372,23 @@ pub const VARIANTS: &[GoldenCase] = &[
         "wedge-blending",
         "meshes-zfail",
         &[("silhouettes", "meshes"), ("mode", "zfail")],
+    ),
+    // dbuffer (CGI 2004): the falloff of §6.2, f16 distance channels, eq. 3 as printed.
+    GoldenCase::variant("disk-block", "dbuffer", "sqrt", &[("falloff", "sqrt")]),
+    GoldenCase::variant("disk-block", "dbuffer", "f16", &[("storage", "f16")]),
+    GoldenCase::variant("disk-block", "dbuffer", "printed", &[("eq3", "printed")]),
+    GoldenCase::variant(
+        "disk-small-sphere",
+        "dbuffer",
+        "sqrt",
+        &[("falloff", "sqrt")],
+    ),
+    GoldenCase::variant("disk-small-sphere", "dbuffer", "f16", &[("storage", "f16")]),
+    GoldenCase::variant(
+        "disk-small-sphere",
+        "dbuffer",
+        "printed",
+        &[("eq3", "printed")],
     ),
     // penumbra-map (Wyman & Hansen 2003): map sizes and storage formats.
     GoldenCase::variant(

@@ -27,12 +27,18 @@ pub struct DepthTile {
 impl DepthTile {
     /// A tile of `len` samples cleared to depth 1.0.
     pub fn cleared(format: DepthFormat, len: usize) -> Self {
-        let far = format.far();
+        Self::cleared_to(format, 1.0, len)
+    }
+
+    /// A tile of `len` samples cleared to window depth `z_w` (`glClearDepth`, quantized as a
+    /// fragment's depth is).
+    pub fn cleared_to(format: DepthFormat, z_w: f32, len: usize) -> Self {
+        let z = format.quantize(z_w);
         Self {
             format,
-            values: vec![far; len],
-            zmin: far,
-            zmax: far,
+            values: vec![z; len],
+            zmin: z,
+            zmax: z,
         }
     }
 

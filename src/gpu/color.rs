@@ -9,6 +9,10 @@
 //! * [`ColorFormat::F32`]: `v` rounded to f32.
 //!
 //! Values are stored as `u32` (the unorm value or the float's bits).
+//!
+//! Targets with four channels ([`RgbaTile`], the D-buffer of CGI 2004 §3) store each channel
+//! in the same format and write only the channels a [`ColorMask`] enables (`glColorMask`), so
+//! one target can be filled by several draws that each own some of its channels.
 
 use super::counters::Counters;
 use half::f16;
@@ -111,6 +115,50 @@ impl ColorTile {
     }
 }
 
+/// `glColorMask(r, g, b, a)`: which channels of an RGBA target a draw writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct ColorMask(pub [bool; 4]);
+
+/// The RGBA samples of one tile, every channel in one format.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RgbaTile {
+    /// Storage format of every channel.
+    pub format: ColorFormat,
+    /// Stored values per sample and channel ([`ColorFormat::encode`]).
+    pub values: Vec<[u32; 4]>,
+}
+
+impl RgbaTile {
+    /// A tile of `len` samples cleared to `value` (the clear is not counted).
+    pub fn cleared(format: ColorFormat, value: [f64; 4], len: usize) -> Self {
+        Self {
+            format,
+            values: vec![value.map(|v| format.encode(v).0); len],
+        }
+    }
+
+    /// Write the channels of `v` that `mask` enables to sample `i` (each counted; a
+    /// saturated or overflowed conversion counts an overflow event).
+    #[inline]
+    pub fn write_masked(&mut self, i: usize, v: [f64; 4], mask: ColorMask, c: &mut Counters) {
+        for ((value, on), slot) in v.iter().zip(mask.0).zip(&mut self.values[i]) {
+            if on {
+                let (stored, overflow) = self.format.encode(*value);
+                c.color_write_bytes += self.format.bytes();
+                c.overflow_events += overflow as u64;
+                *slot = stored;
+            }
+        }
+    }
+
+    /// The four values of sample `i` (not counted: reads of a finished target are counted by
+    /// the pass that samples it).
+    #[inline]
+    pub fn texel(&self, i: usize) -> [f32; 4] {
+        self.values[i].map(|v| self.format.decode(v))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -141,5 +189,22 @@ mod tests {
         assert_eq!(t.value(2), 0.25);
         assert_eq!(t.value(0), 1.0);
         assert_eq!((c.color_write_bytes, c.overflow_events), (2, 0));
+    }
+
+    #[test]
+    fn masked_writes_touch_only_their_channels() {
+        let mut t = RgbaTile::cleared(ColorFormat::F16, [9.0, 0.0, 0.0, 0.0], 2);
+        let mut c = Counters::default();
+        t.write_masked(
+            1,
+            [1.0, 2.5, 3.0, 4.0],
+            ColorMask([false, true, false, true]),
+            &mut c,
+        );
+        assert_eq!(t.texel(1), [9.0, 2.5, 0.0, 4.0]);
+        assert_eq!(t.texel(0), [9.0, 0.0, 0.0, 0.0]);
+        assert_eq!((c.color_write_bytes, c.overflow_events), (4, 0));
+        t.write_masked(0, [1e6; 4], ColorMask([true; 4]), &mut c);
+        assert_eq!(c.overflow_events, 4);
     }
 }

@@ -193,6 +193,13 @@ impl DepthState {
         func: DepthFunc::Less,
         write: true,
     };
+
+    /// GREATER with depth writes, on a target cleared to 0: the farthest surface (or largest
+    /// value) wins.
+    pub const GREATER_WRITE: DepthState = DepthState {
+        func: DepthFunc::Greater,
+        write: true,
+    };
 }
 
 #[cfg(test)]

@@ -30,6 +30,17 @@
 //!   (1 + [`FRUSTUM_MARGIN`]) · the largest: the tightest depth range, which is what D16 and
 //!   D24 precision depend on.
 //!
+//! # Distance as depth (the D-buffer, CGI 2004 §3.2)
+//!
+//! "Instead of using standard matrix multiplication to transform the vertices from world space
+//! to light source view space, the z-coordinate of the vertices is calculated as the distance
+//! between the vertex and c": [`LightView::distance_clip_point`] keeps x, y and w of the
+//! view's projection (so the vertex lands on the same texel) and replaces z by
+//! `w·(2·|p − c|/range − 1)`, so that the window depth is `|p − c|/range` for distances in
+//! [0, `range`]; the rasterizer then interpolates it linearly in window space like any depth
+//! and the depth format quantizes it. Clipping against z keeps exactly the distances in
+//! [0, `range`].
+//!
 //! # The shadow map
 //!
 //! [`LightView::render_depth`]: every mesh in file order, triangles in order, through the
@@ -43,7 +54,7 @@ use super::counters::Counters;
 use super::depth::{DepthFormat, DepthState, PolygonOffset};
 use super::raster::{bin, draw, no_tile_culling, Fragment};
 use super::setup::{setup_all, CullMode};
-use super::texture::{sample_2d, Filter, Wrap};
+use super::texture::{nearest, sample_2d, Filter, Wrap};
 use super::tiling::Tiling;
 use super::transform::{viewport, ClipVertex, Projection};
 use crate::scene::Scene;
@@ -227,6 +238,25 @@ impl LightView {
         (clip.0[3] > 0.0).then(|| viewport(clip, self.size(), self.size()))
     }
 
+    /// The D-buffer's vertex stage (module doc, "Distance as depth"): clip coordinates of
+    /// world point `p` with the distance to the light center as depth over [0, `range`]
+    /// (f64, rounded once to f32).
+    pub fn distance_clip_point(&self, p: DVec3, range: f64) -> ClipVertex {
+        let h = self.proj.view_proj * p.extend(1.0);
+        let z = h.w * (2.0 * (p - self.center).length() / range - 1.0);
+        ClipVertex([h.x as f32, h.y as f32, z as f32, h.w as f32])
+    }
+
+    /// The texel of a map of this view that nearest sampling reads at window coordinates
+    /// (x, y), clamped to the edge, as (tile, index in the tile) — the texel
+    /// [`LightView::sample`] reads with [`Filter::Nearest`].
+    pub fn nearest_texel(&self, x: f32, y: f32) -> (usize, usize) {
+        let n = self.size();
+        let i = nearest(x as f64, n, Wrap::ClampToEdge);
+        let row = n - 1 - nearest(y as f64, n, Wrap::ClampToEdge);
+        (self.tiling.tile_of(i, row), self.tiling.local(i, row))
+    }
+
     /// Sample a map of this view stored tile-major (one value per texel, read with
     /// `texel(tile, local)`) at window coordinates (x, y) with `filter`, clamped to the edge
     /// ([`super::texture`]; window y points up, so texel row j is image row size − 1 − j).
@@ -380,6 +410,30 @@ mod tests {
         dirs.insert(0, (axis + u * 0.1).normalize());
         let got = enclosing_cone_axis(&dirs);
         assert!(got.angle_between(axis) < 0.02, "{got:?}");
+    }
+
+    #[test]
+    fn nearest_texel_is_the_texel_nearest_sampling_reads_and_distance_is_depth() {
+        let scene = builtin::load("single-quad").unwrap();
+        let view =
+            LightView::fit(&scene, scene.light().center, tiling(16), DepthFormat::D24).unwrap();
+        let id = |t: usize, l: usize| (t * 1000 + l) as f64;
+        for (x, y) in [(0.2f32, 0.3f32), (7.5, 9.99), (15.9, 0.0), (-3.0, 20.0)] {
+            let (t, l) = view.nearest_texel(x, y);
+            assert_eq!(
+                view.sample(x, y, Filter::Nearest, id),
+                id(t, l),
+                "({x}, {y})"
+            );
+        }
+        // The distance vertex stage: same window x, y; window depth = distance / range.
+        let p = DVec3::new(0.3, 1.0, -0.2);
+        let d = (p - view.center).length();
+        let clip = view.distance_clip_point(p, 4.0 * d);
+        let [x, y, z] = viewport(clip, 16, 16);
+        let [x0, y0, _] = view.window(p.as_vec3()).unwrap();
+        assert!((x - x0).abs() < 1e-4 && (y - y0).abs() < 1e-4);
+        assert!((z - 0.25).abs() < 1e-6, "{z}");
     }
 
     #[test]

@@ -3,6 +3,19 @@
 //! with several lights: the penumbra-wedge methods render them in one LI buffer (Paper I §7),
 //! every other method once per light ([`light_average`]).
 
+/// `AddAssign` as the field-wise sum, for the per-tile and per-row tallies of a method's
+/// fragment programs (`field_sum!(Stats { a, b })`).
+macro_rules! field_sum {
+    ($t:ty { $($f:ident),* }) => {
+        impl std::ops::AddAssign for $t {
+            fn add_assign(&mut self, o: Self) {
+                $(self.$f += o.$f;)*
+            }
+        }
+    };
+}
+
+pub mod dbuffer;
 pub mod hard_sv;
 pub mod light_average;
 pub mod nsample;
@@ -19,7 +32,10 @@ pub mod wedge_blending;
 use crate::error::InputError;
 use crate::frame::Frame;
 use crate::gpu::counters::Counters;
-use crate::plan::MethodPlan;
+use crate::gpu::depth::DepthFormat;
+use crate::gpu::light_view::{LightView, MAX_LIGHT_VIEW_HALF_ANGLE_DEG};
+use crate::gpu::tiling::Tiling;
+use crate::plan::{BufferPlan, MethodPlan};
 use crate::scene::{LightShape, Scene};
 use output::{MethodOutput, MethodStats, PassStats, Visibility};
 use std::time::Instant;
@@ -35,6 +51,7 @@ pub const ALL: &[&str] = &[
     "ssv",
     "wedge-blending",
     "penumbra-map",
+    "dbuffer",
 ];
 
 /// The reference every other method's error is measured against.
@@ -86,6 +103,8 @@ pub fn supports(method: &str, shape: &LightShape) -> bool {
         ),
         // Forest et al. 2006 §4.2: rectangular lights, in light space [−1, 1]².
         "wedge-blending" => matches!(shape, LightShape::Rect { .. }),
+        // CGI 2004 §2: "the light source is approximated by a circular disk".
+        "dbuffer" => matches!(shape, LightShape::Disk { .. }),
         _ => false,
     }
 }
@@ -153,12 +172,139 @@ fn run_one_light(method: &str, frame: &Frame) -> Result<MethodOutput, InputError
         "pw-restructured" => pw_restructured::run(frame),
         "wedge-blending" => wedge_blending::run(frame),
         "penumbra-map" => penumbra_map::run(frame),
+        "dbuffer" => dbuffer::run(frame),
         _ => Err(InputError::at(
             &frame.scene.source,
             "methods",
             format!("unknown method {method:?}"),
         )),
     }
+}
+
+/// How a visibility parameter in [0, 1] becomes a visibility: each method accepts the falloffs
+/// its paper names (`penumbra-map`: smoothstep or linear; `dbuffer`: smoothstep or √t).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum Falloff {
+    /// 3x² − 2x³, the Bernstein interpolant of Parker et al. (Wyman & Hansen §3, CGI 2004
+    /// eq. 4).
+    Smoothstep,
+    /// x.
+    Linear,
+    /// √x (CGI 2004 §6.2, for occluders smaller than the light).
+    Sqrt,
+}
+
+impl Falloff {
+    /// The falloff of `x`.
+    pub fn apply(self, x: f64) -> f64 {
+        match self {
+            Falloff::Smoothstep => 3.0 * x * x - 2.0 * x * x * x,
+            Falloff::Linear => x,
+            Falloff::Sqrt => x.sqrt(),
+        }
+    }
+
+    /// Read option `falloff` of `r` among `allowed` (option names `smoothstep`, `linear`,
+    /// `sqrt`), smoothstep by default.
+    pub fn read(
+        r: &mut options::OptionReader,
+        allowed: &[&'static str],
+    ) -> Result<Self, InputError> {
+        Ok(match r.choice("falloff", allowed, "smoothstep")? {
+            "linear" => Falloff::Linear,
+            "sqrt" => Falloff::Sqrt,
+            _ => Falloff::Smoothstep,
+        })
+    }
+}
+
+/// The light view of `frame`'s (only) light for `method`: a `map_size`² target of format
+/// `depth` fitted around the scene ([`LightView::fit`]). Errors name `options.METHOD.map_size`
+/// for a size the tiling rejects, and the light, the farthest vertex and its angle when one
+/// frustum cannot cover the scene (`who` names the maps in the message, e.g. "penumbra maps").
+pub fn fit_light_view(
+    frame: &Frame,
+    method: &str,
+    map_size: u32,
+    depth: DepthFormat,
+    who: &str,
+) -> Result<LightView, InputError> {
+    let scene = frame.scene;
+    let tiling = Tiling::new(map_size, map_size, frame.tiling.tile)
+        .map_err(|e| InputError::at(&scene.source, format!("options.{method}.map_size"), e))?;
+    LightView::fit(scene, scene.light().center, tiling, depth).map_err(|u| {
+        let m = &scene.meshes[u.mesh];
+        InputError::at(
+            &scene.source,
+            scene.light_object(0, "light"),
+            format!(
+                "one light frustum cannot cover the scene: vertex {} ({}, {}, {}) of meshes[{}] \
+                 ({}) is {:.1}° from the light's view axis (limit {MAX_LIGHT_VIEW_HALF_ANGLE_DEG}°); \
+                 {who} need every receiver in front of the light center",
+                u.vertex, u.position.x, u.position.y, u.position.z, u.mesh, m.name, u.angle_deg
+            ),
+        )
+    })
+}
+
+/// A screen pass: the fragment program `program(pixel, receiver, stats, counters)` run on the
+/// receiver of every pixel (`None` for background), rows in parallel, each row's tallies summed
+/// in row order (integer sums: independent of the thread count). Returns the program's outputs
+/// in row-major order, the summed stats and the summed counters.
+pub fn shade_receivers<T, S>(
+    receivers: &[Option<crate::frame::Receiver>],
+    width: usize,
+    program: impl Fn(usize, Option<&crate::frame::Receiver>, &mut S, &mut Counters) -> T + Sync,
+) -> (Vec<T>, S, Counters)
+where
+    T: Send,
+    S: Default + std::ops::AddAssign + Send,
+{
+    use rayon::prelude::*;
+    let rows: Vec<(Vec<T>, S, Counters)> = receivers
+        .par_chunks(width)
+        .enumerate()
+        .map(|(row, pixels)| {
+            let mut st = S::default();
+            let mut c = Counters::default();
+            let out = pixels
+                .iter()
+                .enumerate()
+                .map(|(k, r)| program(row * width + k, r.as_ref(), &mut st, &mut c))
+                .collect();
+            (out, st, c)
+        })
+        .collect();
+    let mut out = Vec::with_capacity(receivers.len());
+    let mut stats = S::default();
+    let mut counters = Counters::default();
+    for (o, st, c) in rows {
+        out.extend(o);
+        stats += st;
+        counters += c;
+    }
+    (out, stats, counters)
+}
+
+/// [`MethodStats`] of a method that started at `start` and ran `passes` after the frame's
+/// scene pass: the plan lists the scene pass and them, with `buffers` and `settings`.
+pub fn stats_after_scene_pass(
+    method: &str,
+    frame: &Frame,
+    start: Instant,
+    passes: &[PassStats],
+    buffers: Vec<BufferPlan>,
+    settings: serde_json::Value,
+) -> MethodStats {
+    let mut all = vec![frame.pass.clone()];
+    all.extend(passes.iter().cloned());
+    let plan = MethodPlan {
+        method: method.into(),
+        passes: all.iter().map(|p| p.name.clone()).collect(),
+        buffers,
+        settings,
+    };
+    method_stats(method, frame, start, &plan, all)
 }
 
 /// Assemble [`MethodStats`] for a method that started at `start` (totals summed over passes).
@@ -378,6 +524,7 @@ fn check_options_one_light(method: &str, frame: &Frame) -> Result<(), InputError
         "ssv-optimized" => ssv_optimized::options(frame).map(drop),
         "wedge-blending" => wedge_blending::options(frame).map(drop),
         "penumbra-map" => penumbra_map::read_settings(frame).map(drop),
+        "dbuffer" => dbuffer::read_settings(frame).map(drop),
         _ => Err(InputError::at(
             &frame.scene.source,
             "methods",

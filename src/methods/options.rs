@@ -3,7 +3,7 @@
 //! `options.METHOD.KEY`.
 
 use crate::error::InputError;
-use crate::gpu::depth::DepthFormat;
+use crate::gpu::depth::{DepthFormat, PolygonOffset};
 use crate::scene::{OptionValue, Scene};
 use std::collections::BTreeMap;
 
@@ -112,6 +112,21 @@ impl OptionReader {
     ) -> Result<DepthFormat, InputError> {
         let name = self.choice(key, &DepthFormat::OPTION_NAMES, default.option_name())?;
         Ok(DepthFormat::from_option(name).unwrap_or(default))
+    }
+
+    /// The edge of a map rendered from the light (`map_size`): 8…`max` texels, by default the
+    /// image's larger side (at most `max`).
+    pub fn map_size(&mut self, scene: &Scene, max: u32) -> Result<u32, InputError> {
+        let default = scene.width.max(scene.height).min(max);
+        Ok(self.uint("map_size", default as u64, 8..=max as u64)? as u32)
+    }
+
+    /// A shadow map's polygon offset: `bias` (units of the depth format's resolvable
+    /// difference, default `units`) and `slope_bias` (the slope factor, default `factor`).
+    pub fn polygon_offset(&mut self, units: f64, factor: f64) -> Result<PolygonOffset, InputError> {
+        let units = self.float("bias", units, 0.0..=16_777_215.0)?;
+        let factor = self.float("slope_bias", factor, 0.0..=1000.0)?;
+        Ok(PolygonOffset { factor, units })
     }
 
     /// Error for the first key nobody asked for.

@@ -68,6 +68,18 @@ pub struct PassStats {
     pub counters: Counters,
 }
 
+impl PassStats {
+    /// The stats of one run of pass `name` that started at `start` with `counters`.
+    pub fn since(name: &str, start: std::time::Instant, counters: Counters) -> Self {
+        Self {
+            name: name.into(),
+            wall_seconds: start.elapsed().as_secs_f64(),
+            runs: 1,
+            counters,
+        }
+    }
+}
+
 /// Everything `stats.json` holds for one method.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct MethodStats {

@@ -99,16 +99,13 @@ use crate::gpu::buffers::{alloc_tiles, DepthTile};
 use crate::gpu::color::{ColorFormat, ColorTile};
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFormat, DepthState, PolygonOffset};
-use crate::gpu::light_view::{LightView, MAX_LIGHT_VIEW_HALF_ANGLE_DEG};
+use crate::gpu::light_view::LightView;
 use crate::gpu::raster::{bin, draw, no_tile_culling, Fragment};
 use crate::gpu::setup::{setup_all_barycentric, CullMode};
 use crate::gpu::texture::Filter;
-use crate::gpu::tiling::Tiling;
-use crate::plan::{BufferPlan, MethodPlan};
+use crate::plan::BufferPlan;
 use crate::scene::LightShape;
-use rayon::prelude::*;
 use serde::Serialize;
-use std::ops::AddAssign;
 use std::time::Instant;
 
 /// The default polygon-offset units of the shadow map (`bias`): resolvable-difference steps.
@@ -121,24 +118,10 @@ pub const MAX_MAP_SIZE: u32 = 4096;
 /// The default number of triangles per cone (`cone_segments`).
 pub const DEFAULT_CONE_SEGMENTS: u32 = 16;
 
-/// How the penumbra intensity falls off across the penumbra (§3).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-pub enum Falloff {
-    /// `I′ = 3I² − 2I³` (Parker et al.'s approximation of the spherical light's falloff).
-    Smoothstep,
-    /// `I′ = I`.
-    Linear,
-}
-
-impl Falloff {
-    /// `I′` of `I`.
-    pub fn apply(self, i: f64) -> f64 {
-        match self {
-            Falloff::Smoothstep => 3.0 * i * i - 2.0 * i * i * i,
-            Falloff::Linear => i,
-        }
-    }
-}
+/// How the penumbra intensity falls off across the penumbra (§3): `I′ = 3I² − 2I³`
+/// (smoothstep, Parker et al.'s approximation of the spherical light's falloff) or `I′ = I`
+/// (linear).
+pub use super::Falloff;
 
 /// Where the shadow-map bias is applied (module doc, pass 1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -177,23 +160,15 @@ pub struct PenumbraMapSettings {
 pub fn read_settings(frame: &Frame) -> Result<PenumbraMapSettings, InputError> {
     let scene = frame.scene;
     let mut r = OptionReader::new(scene, "penumbra-map");
-    let map_size = r.uint(
-        "map_size",
-        scene.width.max(scene.height).min(MAX_MAP_SIZE) as u64,
-        8..=MAX_MAP_SIZE as u64,
-    )? as u32;
+    let map_size = r.map_size(scene, MAX_MAP_SIZE)?;
     let depth = r.depth_format("depth", frame.gpu.depth)?;
-    let units = r.float("bias", DEFAULT_BIAS_UNITS, 0.0..=16_777_215.0)?;
-    let factor = r.float("slope_bias", DEFAULT_SLOPE_BIAS, 0.0..=1000.0)?;
+    let offset = r.polygon_offset(DEFAULT_BIAS_UNITS, DEFAULT_SLOPE_BIAS)?;
     let bias_stage = match r.choice("bias_stage", &["render", "lookup"], "render")? {
         "lookup" => BiasStage::Lookup,
         _ => BiasStage::Render,
     };
     let cone_segments = r.uint("cone_segments", DEFAULT_CONE_SEGMENTS as u64, 3..=1024)? as u32;
-    let falloff = match r.choice("falloff", &["smoothstep", "linear"], "smoothstep")? {
-        "linear" => Falloff::Linear,
-        _ => Falloff::Smoothstep,
-    };
+    let falloff = Falloff::read(&mut r, &["smoothstep", "linear"])?;
     let storage = r.choice("storage", &ColorFormat::OPTION_NAMES, "unorm8")?;
     let storage = ColorFormat::from_option(storage).unwrap_or(ColorFormat::Unorm8);
     let filter = match r.choice("filter", &["nearest", "bilinear"], "nearest")? {
@@ -204,7 +179,7 @@ pub fn read_settings(frame: &Frame) -> Result<PenumbraMapSettings, InputError> {
     Ok(PenumbraMapSettings {
         map_size,
         depth,
-        offset: PolygonOffset { factor, units },
+        offset,
         bias_stage,
         cone_segments,
         falloff,
@@ -243,17 +218,6 @@ pub struct ScreenStats {
     pub behind_light: u64,
     /// Values outside [0, 1] (or not a number) before the final clamp.
     pub out_of_range: u64,
-}
-
-/// `AddAssign` as the field-wise sum, for the per-tile and per-row tallies above.
-macro_rules! field_sum {
-    ($t:ty { $($f:ident),* }) => {
-        impl AddAssign for $t {
-            fn add_assign(&mut self, o: Self) {
-                $(self.$f += o.$f;)*
-            }
-        }
-    };
 }
 
 field_sum!(ProgramStats {
@@ -302,15 +266,6 @@ pub struct PenumbraMapRender {
     pub passes: Vec<PassStats>,
 }
 
-fn pass(name: &str, start: Instant, counters: Counters) -> PassStats {
-    PassStats {
-        name: name.into(),
-        wall_seconds: start.elapsed().as_secs_f64(),
-        runs: 1,
-        counters,
-    }
-}
-
 /// Render `penumbra-map` with `s` on `frame` (one sphere light).
 pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRender, InputError> {
     let scene = frame.scene;
@@ -322,21 +277,7 @@ pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRende
             "penumbra maps need a sphere light",
         ));
     };
-    let tiling = Tiling::new(s.map_size, s.map_size, frame.tiling.tile)
-        .map_err(|e| InputError::at(&scene.source, "options.penumbra-map.map_size", e))?;
-    let view = LightView::fit(scene, light.center, tiling, s.depth).map_err(|u| {
-        let m = &scene.meshes[u.mesh];
-        InputError::at(
-            &scene.source,
-            scene.light_object(0, "light"),
-            format!(
-                "one light frustum cannot cover the scene: vertex {} ({}, {}, {}) of meshes[{}] \
-                 ({}) is {:.1}° from the light's view axis (limit {MAX_LIGHT_VIEW_HALF_ANGLE_DEG}°); \
-                 penumbra maps need every receiver in front of the light center",
-                u.vertex, u.position.x, u.position.y, u.position.z, u.mesh, m.name, u.angle_deg
-            ),
-        )
-    })?;
+    let view = super::fit_light_view(frame, "penumbra-map", s.map_size, s.depth, "penumbra maps")?;
 
     // Pass 1: the shadow map.
     let t = Instant::now();
@@ -345,7 +286,7 @@ pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRende
         BiasStage::Lookup => PolygonOffset::NONE,
     };
     let (shadow_map, c1) = view.render_depth(scene, render_offset);
-    let pass1 = pass("shadow-map", t, c1);
+    let pass1 = PassStats::since("shadow-map", t, c1);
 
     // The silhouette from the light center (CPU; the paper's 30 %).
     let t = Instant::now();
@@ -357,7 +298,7 @@ pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRende
             e,
         )
     })?;
-    let pass_sil = pass("silhouettes", t, Counters::default());
+    let pass_sil = PassStats::since("silhouettes", t, Counters::default());
 
     // Pass 2: cones and sheets into the penumbra map.
     let t = Instant::now();
@@ -369,12 +310,12 @@ pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRende
         s.cone_segments,
     );
     let (color, program, c2) = render_penumbra_map(&view, &shadow_map, &geometry, s);
-    let pass2 = pass("penumbra-map", t, c2);
+    let pass2 = PassStats::since("penumbra-map", t, c2);
 
     // Pass 3: the screen.
     let t = Instant::now();
     let (visibility, screen, c3) = screen_pass(frame, &view, &shadow_map, &color, s);
-    let pass3 = pass("screen", t, c3);
+    let pass3 = PassStats::since("screen", t, c3);
 
     let silhouette = (
         sils.iter().map(|m| m.edges.len()).sum(),
@@ -536,56 +477,34 @@ fn screen_pass(
         Filter::Nearest => 1,
         Filter::Bilinear => 4,
     };
-    let rows: Vec<(Vec<f32>, ScreenStats, Counters)> = receivers
-        .par_chunks(width)
-        .zip(prims.par_chunks(width))
-        .map(|(row, row_prims)| {
-            let mut st = ScreenStats::default();
-            let mut c = Counters::default();
-            let values = row
-                .iter()
-                .zip(row_prims)
-                .map(|(r, prim)| {
-                    let Some(r) = r else {
-                        return 1.0;
-                    };
-                    st.receivers += 1;
-                    c.fragments_shaded += 1;
-                    let Some([x, y, z]) = view.window(r.point) else {
-                        st.behind_light += 1;
-                        return 1.0;
-                    };
-                    c.depth_read_bytes += depth_bytes;
-                    let z = match slopes.get(*prim as usize) {
-                        Some(&(m, z_max)) => {
-                            (z as f64 - s.offset.amount(view.depth, m, z_max)) as f32
-                        }
-                        None => z,
-                    };
-                    if !view.lit(shadow_map, [x, y, z]) {
-                        st.umbra += 1;
-                        return 0.0;
-                    }
-                    c.color_read_bytes += taps * s.storage.bytes();
-                    let v = view.sample(x, y, s.filter, |t, l| penumbra_map[t].value(l) as f64);
-                    if !(0.0..=1.0).contains(&v) {
-                        st.out_of_range += 1;
-                    }
-                    st.penumbra += (v < 1.0) as u64;
-                    v.clamp(0.0, 1.0) as f32
-                })
-                .collect();
-            (values, st, c)
-        })
-        .collect();
-    let mut values = Vec::with_capacity(receivers.len());
-    let mut stats = ScreenStats::default();
-    let mut counters = Counters::default();
-    for (v, st, c) in rows {
-        values.extend(v);
-        stats += st;
-        counters += c;
-    }
+    let (values, stats, counters) =
+        super::shade_receivers(&receivers, width, |i, r, st: &mut ScreenStats, c| {
+            let Some(r) = r else {
+                return 1.0;
+            };
+            st.receivers += 1;
+            c.fragments_shaded += 1;
+            let Some([x, y, z]) = view.window(r.point) else {
+                st.behind_light += 1;
+                return 1.0;
+            };
+            c.depth_read_bytes += depth_bytes;
+            let z = match slopes.get(prims[i] as usize) {
+                Some(&(m, z_max)) => (z as f64 - s.offset.amount(view.depth, m, z_max)) as f32,
+                None => z,
+            };
+            if !view.lit(shadow_map, [x, y, z]) {
+                st.umbra += 1;
+                return 0.0;
+            }
+            c.color_read_bytes += taps * s.storage.bytes();
+            let v = view.sample(x, y, s.filter, |t, l| penumbra_map[t].value(l) as f64);
+            if !(0.0..=1.0).contains(&v) {
+                st.out_of_range += 1;
+            }
+            st.penumbra += (v < 1.0) as u64;
+            v.clamp(0.0, 1.0) as f32
+        });
     (Visibility::Gray(values), stats, counters)
 }
 
@@ -594,31 +513,20 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let start = Instant::now();
     let s = read_settings(frame)?;
     let r = render(frame, &s)?;
-    let mut passes = vec![frame.pass.clone()];
-    passes.extend(r.passes.iter().cloned());
     let n = s.map_size;
-    let plan = MethodPlan {
-        method: "penumbra-map".into(),
-        passes: passes.iter().map(|p| p.name.clone()).collect(),
-        buffers: vec![
-            BufferPlan::depth(&frame.gpu),
-            BufferPlan {
-                name: format!("shadow-map {n}x{n}"),
-                format: format!("{:?}", s.depth),
-                bytes_per_sample: s.depth.bytes() as u32,
-            },
-            BufferPlan {
-                name: format!("penumbra-map colour {n}x{n}"),
-                format: format!("{:?}", s.storage),
-                bytes_per_sample: s.storage.bytes() as u32,
-            },
-            BufferPlan {
-                name: format!("penumbra-map depth {n}x{n}"),
-                format: format!("{:?}", s.depth),
-                bytes_per_sample: s.depth.bytes() as u32,
-            },
-        ],
-        settings: serde_json::json!({
+    let buffers = vec![
+        BufferPlan::depth(&frame.gpu),
+        BufferPlan::depth_target(format!("shadow-map {n}x{n}"), s.depth),
+        BufferPlan::color_target(format!("penumbra-map colour {n}x{n}"), s.storage, 1),
+        BufferPlan::depth_target(format!("penumbra-map depth {n}x{n}"), s.depth),
+    ];
+    let stats = super::stats_after_scene_pass(
+        "penumbra-map",
+        frame,
+        start,
+        &r.passes,
+        buffers,
+        serde_json::json!({
             "settings": s,
             "light_view": {
                 "axis": r.view.axis.to_array(),
@@ -637,11 +545,11 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             "screen": r.screen,
             "gpu": frame.gpu,
         }),
-    };
+    );
     Ok(MethodOutput {
         visibility: r.visibility,
         raw_images: vec![],
-        stats: super::method_stats("penumbra-map", frame, start, &plan, passes),
+        stats,
     })
 }
 

@@ -128,6 +128,100 @@ pub fn compare_where(a: &Visibility, b: &Visibility, keep: impl Fn(usize) -> boo
     }
 }
 
+/// The shadow region a visibility value puts a pixel in, up to a tolerance τ (CGI 2004's
+/// claim is about these boundaries): umbra when v ≤ τ, lit when v ≥ 1 − τ, penumbra between.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum ShadowClass {
+    /// v ≤ τ.
+    Umbra,
+    /// τ < v < 1 − τ.
+    Penumbra,
+    /// v ≥ 1 − τ.
+    Lit,
+}
+
+impl ShadowClass {
+    /// The three classes in table order.
+    pub const ALL: [ShadowClass; 3] = [ShadowClass::Umbra, ShadowClass::Penumbra, ShadowClass::Lit];
+
+    /// The class of visibility `v` with tolerance `tol` (a NaN is penumbra: neither end).
+    pub fn of(v: f32, tol: f64) -> Self {
+        let v = f64::from(v);
+        if v <= tol {
+            ShadowClass::Umbra
+        } else if v >= 1.0 - tol {
+            ShadowClass::Lit
+        } else {
+            ShadowClass::Penumbra
+        }
+    }
+}
+
+/// How a method's shadow regions compare with the reference's, pixel by pixel:
+/// `counts[r][m]` pixels are of class `ShadowClass::ALL[r]` in the reference and
+/// `ShadowClass::ALL[m]` in the method (gray values; RGB averaged).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct ClassTable {
+    /// Pixel counts, reference class × method class.
+    pub counts: [[u64; 3]; 3],
+}
+
+impl ClassTable {
+    /// The table of `method` against `reference` over the pixels `i` with `keep(i)`, with
+    /// tolerance `tol` ([`ShadowClass::of`]).
+    ///
+    /// # Panics
+    /// If the buffers have different pixel counts (as [`compare`]).
+    pub fn of(
+        reference: &Visibility,
+        method: &Visibility,
+        tol: f64,
+        keep: impl Fn(usize) -> bool,
+    ) -> Self {
+        assert_eq!(
+            reference.len(),
+            method.len(),
+            "ClassTable: buffers of different sizes"
+        );
+        let mut t = Self::default();
+        let index = |c: ShadowClass| ShadowClass::ALL.iter().position(|x| *x == c).unwrap_or(1);
+        for i in (0..reference.len()).filter(|i| keep(*i)) {
+            let r = index(ShadowClass::of(reference.gray(i), tol));
+            let m = index(ShadowClass::of(method.gray(i), tol));
+            t.counts[r][m] += 1;
+        }
+        t
+    }
+
+    /// Pixels counted.
+    pub fn pixels(&self) -> u64 {
+        self.counts.iter().flatten().sum()
+    }
+
+    /// Pixels of class `c` in the reference (`reference = true`) or in the method.
+    pub fn total(&self, c: ShadowClass, reference: bool) -> u64 {
+        let k = ShadowClass::ALL.iter().position(|x| *x == c).unwrap_or(1);
+        (0..3)
+            .map(|j| {
+                if reference {
+                    self.counts[k][j]
+                } else {
+                    self.counts[j][k]
+                }
+            })
+            .sum()
+    }
+
+    /// The fraction of pixels classified as the reference classifies them (1 when empty).
+    pub fn agreement(&self) -> f64 {
+        let same: u64 = (0..3).map(|k| self.counts[k][k]).sum();
+        match self.pixels() {
+            0 => 1.0,
+            n => same as f64 / n as f64,
+        }
+    }
+}
+
 /// Smallest red intensity of a differing pixel in [`diff_mask`], so that even a one-ulp
 /// difference is visible against the black of equal pixels.
 pub const DIFF_MIN_RED: u8 = 64;
@@ -202,6 +296,21 @@ pub fn diff_mask_u8(a: &[u8], b: &[u8], w: u32, h: u32) -> Vec<[u8; 3]> {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn class_table_counts_reference_against_method() {
+        use super::*;
+        let r = Visibility::Gray(vec![0.0, 0.5, 1.0, 0.002, 0.999]);
+        let m = Visibility::Gray(vec![0.0, 0.0, 1.0, 0.1, 1.0]);
+        let t = ClassTable::of(&r, &m, 1.0 / 255.0, |_| true);
+        // Umbra: pixels 0, 3 (0.002 ≤ 1/255); lit: 2, 4; penumbra: 1.
+        assert_eq!(t.counts, [[1, 1, 0], [1, 0, 0], [0, 0, 2]]);
+        assert_eq!(t.pixels(), 5);
+        assert_eq!(t.total(ShadowClass::Umbra, true), 2);
+        assert_eq!(t.total(ShadowClass::Umbra, false), 2);
+        assert!((t.agreement() - 0.6).abs() < 1e-12);
+        assert_eq!(ClassTable::of(&r, &m, 0.01, |i| i != 1).agreement(), 0.75);
+    }
+
     use super::*;
 
     fn gray(v: &[f32]) -> Visibility {

@@ -18,10 +18,15 @@
 //! | `two-lights` | Paper I Fig. 16 analogue: the `cylinder` occluder and a box | two spheres r 0.3, 0.25 | 120 |
 //! | `forest-spheres` | Forest et al. 2006 Fig. 1: 3×3×3 spheres of 760 triangles (20 stacks × 20 slices), r 0.2, spacing 0.45 | rect ½-extents 0.6 | 20532 |
 //! | `forest-spheres-1`, `-4`, `-9` | the cost series of Fig. 12: 1 sphere, 2×2 and 3×3 in one layer | as `forest-spheres` | 772, 3052, 6852 |
+//! | `disk-block` | CGI 2004 Fig. 1/7: a 1×0.7×1 block floating at y = 0.9 straight below the light center (the silhouette from c is its top) | disk r 1.2 facing down | 24 |
+//! | `disk-slab` | `disk-block` cut down to its top 0.1: the same silhouette from c, a different shadow | as `disk-block` | 24 |
+//! | `disk-small-sphere` | CGI 2004 Fig. 8a / §4 case 2: a sphere r 0.25 of 224 triangles (16 slices × 8 stacks) under a larger disk: no umbra on the floor | disk r 0.8 | 236 |
+//! | `disk-acute` | CGI 2004 §4 case 3: a flat triangular prism with a 14° tip | disk r 0.5 | 20 |
+//! | `disk-torus` | CGI 2004 Fig. 8c: a tilted torus of 5760 triangles (60 × 48), concave and self-shadowing | disk r 0.6 | 5772 |
 
-use super::procedural::{box_mesh, cylinder, two_sided_quad, uv_sphere};
+use super::procedural::{box_mesh, cylinder, prism, torus, transformed, two_sided_quad, uv_sphere};
 use super::{Camera, Light, LightShape, Mesh, RawOptions, Scene};
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Mat4, Vec3};
 
 /// The scene `penumbra render` uses when none is given.
 pub const DEFAULT: &str = "cube-of-spheres";
@@ -42,6 +47,11 @@ const NAMES: &[&str] = &[
     "forest-spheres-1",
     "forest-spheres-4",
     "forest-spheres-9",
+    "disk-block",
+    "disk-slab",
+    "disk-small-sphere",
+    "disk-acute",
+    "disk-torus",
 ];
 
 /// Names of all built-in scenes.
@@ -66,6 +76,11 @@ pub fn load(name: &str) -> Option<Scene> {
         "forest-spheres-1" => forest_spheres([1, 1, 1]),
         "forest-spheres-4" => forest_spheres([2, 1, 2]),
         "forest-spheres-9" => forest_spheres([3, 1, 3]),
+        "disk-block" => disk_pair("block", 0.9),
+        "disk-slab" => disk_pair("slab", 1.5),
+        "disk-small-sphere" => disk_small_sphere(),
+        "disk-acute" => disk_acute(),
+        "disk-torus" => disk_torus(),
         _ => return None,
     };
     Some(Scene {
@@ -311,6 +326,79 @@ fn two_lights() -> Scene {
     s
 }
 
+/// A disk light of `radius` at `center` facing straight down (CGI 2004: one circular light).
+fn disk_down(center: Vec3, radius: f32) -> Light {
+    Light {
+        center,
+        shape: LightShape::Disk {
+            radius,
+            normal: Vec3::NEG_Y,
+        },
+    }
+}
+
+/// CGI 2004 Fig. 1 and Fig. 7: a box `name` (x, z ∈ ±0.5, y from `bottom` to 1.6) under a
+/// disk light large enough that its sides are silhouette faces, with the light center straight
+/// above it, so that from c only its top is seen: the silhouette from c is the top square,
+/// whatever the bottom. `disk-block` (bottom 0.9: a tall block floating above the floor, whose
+/// umbra is bounded by its bottom edges) and `disk-slab` (bottom 1.5: the block cut down to its
+/// top 0.1) cast different true shadows although a method working from the silhouette seen from
+/// c shades them alike. The camera is low enough to see the floor under the occluder.
+fn disk_pair(name: &str, bottom: f32) -> Scene {
+    scene(
+        camera([0.0, 1.4, 3.6], [0.0, 0.25, 0.0], 55.0),
+        disk_down(Vec3::new(0.0, 3.8, 0.0), 1.2),
+        vec![
+            floor([-4.0, 4.0], [-4.0, 4.0]),
+            box_mesh(
+                name,
+                Vec3::new(-0.5, bottom, -0.5),
+                Vec3::new(0.5, 1.6, 0.5),
+                OCCLUDER,
+            ),
+        ],
+    )
+}
+
+/// CGI 2004 Fig. 8a and §4 case 2: a small sphere (224 triangles, Table 1's first row) under
+/// a larger disk, so that its umbra ends above the floor.
+fn disk_small_sphere() -> Scene {
+    scene(
+        camera([0.0, 2.6, 3.2], [0.0, 0.3, 0.0], 45.0),
+        disk_down(Vec3::new(0.0, 3.6, 0.0), 0.8),
+        vec![
+            floor([-3.0, 3.0], [-3.0, 3.0]),
+            uv_sphere("sphere", Vec3::new(0.0, 1.8, 0.0), 0.25, 8, 16, OCCLUDER),
+        ],
+    )
+}
+
+/// CGI 2004 §4 case 3: a flat triangular prism whose tip is a 14° silhouette corner.
+fn disk_acute() -> Scene {
+    let base = [[0.9, 0.0], [-0.7, 0.2], [-0.7, -0.2]];
+    scene(
+        camera([0.0, 2.8, 3.4], [0.2, 0.2, 0.0], 45.0),
+        disk_down(Vec3::new(0.2, 3.0, 0.0), 0.5),
+        vec![
+            floor([-3.0, 3.0], [-3.0, 3.0]),
+            prism("wedge", &base, [1.0, 1.08], OCCLUDER),
+        ],
+    )
+}
+
+/// CGI 2004 Fig. 8c: a complex, concave occluder — a torus of 5760 triangles (Table 1's
+/// third row) tilted 30° about x, shadowing itself and the floor.
+fn disk_torus() -> Scene {
+    let t = torus("torus", Vec3::ZERO, 0.5, 0.16, [60, 48], OCCLUDER);
+    let m = Mat4::from_translation(Vec3::new(0.0, 1.1, 0.0))
+        * Mat4::from_rotation_x(std::f32::consts::FRAC_PI_6);
+    scene(
+        camera([0.6, 2.8, 3.6], [0.0, 0.5, 0.0], 45.0),
+        disk_down(Vec3::new(0.3, 3.4, 0.2), 0.6),
+        vec![floor([-3.0, 3.0], [-3.0, 3.0]), transformed(&t, m)],
+    )
+}
+
 /// Paper II Fig. 9 analogue ("column scene"): two rows of four columns on a floor, lit from
 /// above and to the side so their long shadows and penumbrae overlap on the floor.
 fn pw_columns() -> Scene {
@@ -544,6 +632,11 @@ mod tests {
         assert_eq!(count("pw-2002"), 12 + 22 * 12);
         assert_eq!(count("two-lights"), 12 + 96 + 12);
         assert_eq!(load("two-lights").unwrap().lights.len(), 2);
+        assert_eq!(count("disk-block"), 24);
+        assert_eq!(count("disk-slab"), 24);
+        assert_eq!(count("disk-small-sphere"), 12 + 224);
+        assert_eq!(count("disk-acute"), 12 + 8);
+        assert_eq!(count("disk-torus"), 12 + 5760);
     }
 
     /// The light's extent (a bounding sphere of its shape) clears every mesh's bounding box.

@@ -1,5 +1,5 @@
-//! Closed mesh generators for the built-in scenes: spheres, boxes, capped cylinders and
-//! two-sided quads, all closed two-manifolds with shared vertices and counter-clockwise
+//! Closed mesh generators for the built-in scenes: spheres, boxes, capped cylinders, tori,
+//! prisms and two-sided quads, all closed two-manifolds with shared vertices and counter-clockwise
 //! outward winding.
 //!
 //! Positions are computed in f64 and rounded once to f32 (as [`Mesh`] stores them), so the
@@ -150,6 +150,92 @@ pub fn cylinder(
     }
 }
 
+/// A torus around the +y axis through `center`: `rings` (≥ 3) segments around the axis at
+/// major radius `major`, `sides` (≥ 3) around the tube of radius `minor`; `2·rings·sides`
+/// triangles (genus 1: V − E + F = 0).
+///
+/// # Panics
+/// If `rings < 3` or `sides < 3`.
+pub fn torus(
+    name: &str,
+    center: Vec3,
+    major: f32,
+    minor: f32,
+    [rings, sides]: [u32; 2],
+    color: [f32; 3],
+) -> Mesh {
+    assert!(
+        rings >= 3 && sides >= 3,
+        "torus needs at least 3×3 segments"
+    );
+    let c = center.as_dvec3();
+    let (big, small) = (f64::from(major), f64::from(minor));
+    let mut positions = Vec::with_capacity((rings * sides) as usize);
+    for i in 0..rings {
+        let (su, cu) = (2.0 * PI * f64::from(i) / f64::from(rings)).sin_cos();
+        for j in 0..sides {
+            let (sv, cv) = (2.0 * PI * f64::from(j) / f64::from(sides)).sin_cos();
+            let r = big + small * cv;
+            positions.push(f32v(c + DVec3::new(r * cu, small * sv, -r * su)));
+        }
+    }
+    let at = |i: u32, j: u32| (i % rings) * sides + j % sides;
+    let mut triangles = Vec::with_capacity(2 * (rings * sides) as usize);
+    for i in 0..rings {
+        for j in 0..sides {
+            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            triangles.push([a, b, c]);
+            triangles.push([a, c, d]);
+        }
+    }
+    Mesh {
+        name: name.to_string(),
+        positions,
+        triangles,
+        color,
+    }
+}
+
+/// A prism: the convex polygon `base` (x, z points in order around it, either direction)
+/// extruded from y = `y[0]` to `y[1]`; `2·(n − 2) + 2·n` triangles for n corners, wound
+/// outward.
+///
+/// # Panics
+/// If `base` has fewer than 3 corners.
+pub fn prism(name: &str, base: &[[f32; 2]], y: [f32; 2], color: [f32; 3]) -> Mesh {
+    let n = base.len() as u32;
+    assert!(n >= 3, "a prism needs at least 3 base corners");
+    let mut positions: Vec<Vec3> = Vec::with_capacity(2 * base.len());
+    for level in y {
+        positions.extend(base.iter().map(|[x, z]| Vec3::new(*x, level, *z)));
+    }
+    let mut triangles = Vec::with_capacity(4 * base.len() - 4);
+    for k in 1..n - 1 {
+        triangles.push([0, k + 1, k]);
+        triangles.push([n, n + k, n + k + 1]);
+    }
+    for k in 0..n {
+        let k1 = (k + 1) % n;
+        triangles.push([k, k1, n + k1]);
+        triangles.push([k, n + k1, n + k]);
+    }
+    // Orient every triangle away from the centroid (the prism is convex).
+    let p: Vec<DVec3> = positions.iter().map(|v| v.as_dvec3()).collect();
+    let centroid = p.iter().sum::<DVec3>() / p.len() as f64;
+    for t in &mut triangles {
+        let [a, b, c] = t.map(|i| p[i as usize]);
+        if (b - a).cross(c - a).dot((a + b + c) / 3.0 - centroid) < 0.0 {
+            t.swap(1, 2);
+        }
+    }
+    Mesh {
+        name: name.to_string(),
+        positions,
+        triangles,
+        color,
+    }
+}
+
 /// A closed two-sided quadrilateral (a planar occluder of zero thickness): the 4 `corners`
 /// (in order around the quad; the front faces the side from which they appear
 /// counter-clockwise), front triangles (0,1,2), (0,2,3) on diagonal 0–2 and back triangles
@@ -266,6 +352,31 @@ mod tests {
                 assert!(n.dot(DVec3::new(centroid.x, 0.0, centroid.z)) > 0.0);
             }
         }
+    }
+
+    #[test]
+    fn torus_closed_outward() {
+        let m = torus("t", Vec3::new(0.0, 1.0, 0.0), 0.5, 0.15, [60, 48], C);
+        assert_eq!(m.triangles.len(), 5760);
+        let adj = adjacency::build(&m).unwrap();
+        assert_eq!(
+            m.positions.len() as i64 - adj.edges.len() as i64 + m.triangles.len() as i64,
+            0
+        );
+        // Pappus: 2π²·R·r², the inscribed polyhedron slightly less.
+        let full = 2.0 * PI * PI * 0.5 * 0.15 * 0.15;
+        let v = signed_volume6(&m) / 6.0;
+        assert!(v > 0.98 * full && v < full, "{v} vs {full}");
+    }
+
+    #[test]
+    fn prism_closed_outward() {
+        let base = [[0.9, 0.0], [-0.7, 0.2], [-0.7, -0.2]];
+        let m = prism("p", &base, [1.0, 1.5], C);
+        assert_eq!(m.triangles.len(), 8);
+        check_closed_outward(&m, 0.5 * 1.6 * 0.4 * 0.5, 1e-6);
+        let reversed: Vec<[f32; 2]> = base.iter().rev().copied().collect();
+        check_closed_outward(&prism("q", &reversed, [1.0, 1.5], C), 0.16, 1e-6);
     }
 
     #[test]

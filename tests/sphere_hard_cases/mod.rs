@@ -3,9 +3,18 @@
 //! umbra, the eye inside a shadow, overlapping boxes, zigzag silhouettes with high vertex
 //! degrees, contact between occluder and receiver, two lights, acute silhouette corners,
 //! silhouette edges nearly parallel to the light direction, geometry far from the origin —
-//! and the two scene helpers those tests share.
+//! and the scene and buffer helpers those tests share.
 
+use penumbra::methods::output::Visibility;
 use penumbra::scene::{builtin, LightShape, Scene};
+
+/// The values of a gray visibility buffer.
+pub fn gray(v: &Visibility) -> Vec<f32> {
+    match v {
+        Visibility::Gray(g) => g.clone(),
+        Visibility::Rgb(_) => panic!("gray expected"),
+    }
+}
 
 /// The built-in scene `name` at `size`×`size`.
 pub fn small(name: &str, size: u32) -> Scene {

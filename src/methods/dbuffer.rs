@@ -1,0 +1,925 @@
+//! `dbuffer`: umbra and penumbra volumes rendered into a D-buffer (*Soft shadows with correct
+//! boundaries from umbra and penumbra volumes*, CGI 2004) — the one method whose shadow
+//! *boundaries* come from two silhouettes of the area light instead of one silhouette seen
+//! from its center, for one circular disk light.
+//!
+//! # Passes
+//!
+//! 1. **Volumes** (§2.1, CPU): face classification against the whole disk, the umbra- and
+//!    penumbra-volume silhouettes, their quads extruded through the tangent points of the
+//!    circle, trimmed or closed with fans at the corners, and the silhouette faces that do not
+//!    face c appended to the umbra volume (§3.3) — [`crate::geometry::umbra_penumbra`], every
+//!    choice documented there.
+//! 2. **D-buffer** (§2.2, §3): one RGBA render target of `map_size`² texels
+//!    (`storage = f32|f16` per channel, [`RgbaTile`]) seen from the light center through the
+//!    light view ([`crate::gpu::light_view`]; fitted around the scene, depth format `depth`),
+//!    filled by three draws that each own some of its channels by colour masking
+//!    ([`ColorMask`]) and clear the depth buffer before they start. Every vertex goes through
+//!    the vertex program of §3.2, "the z-coordinate of the vertices is calculated as the
+//!    distance between the vertex and c" ([`LightView::distance_clip_point`], over the range
+//!    [0, [`DBufferRender::range`]]), and hands its distance |cX| to the fragment as a
+//!    varying; the rasterizer interpolates both linearly across the triangle (depth in window
+//!    space, varyings perspective-correctly, i.e. linearly in the triangle's plane), which is
+//!    the paper's "linearly distributed values instead of spherically distributed values"
+//!    artifact: on a plane the true distance is convex, so an interpolated one is too long
+//!    inside large triangles (reproduced, pinned in the tests).
+//!    * **R = |cx_o|** (`dbuffer-scene`): every mesh, back faces culled, depth LESS from 1:
+//!      the nearest surface, a distance shadow map ("in the case where x is not placed in the
+//!      umbra region |cx_o| and |cx| will be the same", §3.1, so receivers are drawn too).
+//!      The paper gives no bias; without one the lit side of every occluder shadows itself
+//!      wherever the texel's ray meets the surface farther than the receiver. We add the
+//!      shadow maps' polygon offset ([`PolygonOffset`], `bias` units and `slope_bias`, as
+//!      `penumbra-map`) to the fragment's depth and, in distance units (× range), to the
+//!      stored distance.
+//!    * **G = |cx_uv|, A = |cx_s|** (`dbuffer-umbra`): the umbra volume, both facings, depth
+//!      GREATER from 0 — §4: "choose the geometry with the greatest distance from the light
+//!      source. This can be done using depth test when rendering to the D-Buffer".
+//!    * **B = |cx_pv|, A = |cx_s|** (`dbuffer-penumbra`): the penumbra volume, the same.
+//!      The paper keeps one |cx_s| channel for both volumes ("generated simultaneously with
+//!      |cx_uv| and |cx_pv|"); where a texel's ray crosses both volumes (overlapping
+//!      occluders), the penumbra draw writes it last and the umbra branch reads the penumbra
+//!      edge's |cx_s| — one of the overlap artifacts (such texels are counted,
+//!      [`DBufferStats::shared_a_texels`]).
+//!
+//!    **|cx_s|** (eq. 2) is computed per vertex at its silhouette point e
+//!    ([`crate::geometry::umbra_penumbra`], "Output"), as printed:
+//!    `|cx_s| = (dir(c, x)·n)/(dir(c, e)·n)·dist(c, e)` with n the disk's normal. It is
+//!    dist(c, e) on the silhouette itself; elsewhere it is not the distance along the ray to
+//!    the silhouette's depth, h_e/(dir(c, x)·n), which the inverted ratio would give — the two
+//!    differ to first order in the angle between the directions. The inverted ratio changed
+//!    the RMSE vs `raycast` by at most 0.0017 on each of five disk scenes at 256² (measured
+//!    during development, not kept as an option), so the printed one stays. A vertex whose
+//!    ratio is not finite (e at the light's height) gets dist(c, e), counted.
+//!
+//!    **Distances** (`distances`): `interpolated` (default) is the paper's vertex program;
+//!    `exact` computes, per fragment, the distance along the texel's ray from c to the
+//!    triangle's plane and writes it as the fragment's depth too (for R, the polygon offset's
+//!    slope is then the change of that distance to the next texel), to measure what the
+//!    linear-interpolation artifact costs.
+//!
+//!    Clear values: R = range (nothing nearer), G = B = A = 0 ("no volume on this ray"; every
+//!    volume distance is positive).
+//! 3. **Screen** (§4): per pixel, the visible triangle's point x at the pixel center
+//!    ([`Frame::primary_ray_receivers`], as a forward pass's interpolated position), its
+//!    light-view texel, read with nearest filtering (float textures of the NV30 generation had
+//!    no filtering; [`LightView::nearest_texel`]), and the fragment program
+//!    [`screen_program`]:
+//!    * x is on the **umbra side** when the D-buffer's surface is nearer than x, |cx| > |cx_o|
+//!      (x is in the hard shadow of c), else on the **penumbra side**. Eq. 3 prints its first
+//!      (umbra-side) branch for |cx| < |cx_o|; with |cx_o| as §3.1 defines it that inequality
+//!      holds nowhere on a visible receiver, so we read it as the shadow-map test it stands
+//!      for (the umbra side is where the occluder lies between c and x);
+//!    * umbra side: no umbra volume on the ray (G = 0) or x before it (|cx| < |cx_uv|):
+//!      **umbra**, V = 0; else the first branch of eq. 3, t =
+//!      |cx_s|(|cx| − |cx_uv|) / (2|cx_uv|·D) with D = |cx| − |cx_s| (printed:
+//!      |cx_uv| − |cx_s|; below);
+//!    * penumbra side: no penumbra volume (B = 0) or x before it (|cx| < |cx_pv|): **lit**,
+//!      V = 1; else the second branch, t = 1 − |cx_s|(|cx| − |cx_pv|) / (2|cx_pv|·D), D =
+//!      |cx| − |cx_s| (printed: |cx_pv| − |cx_s|);
+//!    * V = 3t² − 2t³ (eq. 4, `falloff = smoothstep`) or √t (§6.2, `falloff = sqrt`).
+//!
+//!    **Eq. 3's denominator** (`eq3`). In the paper's 2D projection (Fig. 4), with
+//!    depths h (silhouette), z_v (volume crossing) and z (x) along the ray, the line from x
+//!    over the silhouette meets the light at (1 − 2t)·r from its center, which gives
+//!    t = h(z − z_v) / (2 z_v (z − h)) on the umbra side (mirrored on the other): this is the
+//!    printed eq. 3 with **(|cx| − |cx_s|)** where it prints (|cx_uv| − |cx_s|). The printed
+//!    form agrees at the volume (t = 0, with the same slope: it is the linearization there) but
+//!    contradicts the paper's own derivation of the second branch, "observing symmetry around
+//!    c where t = ½": on the ray through the silhouette (|cx_uv| = |cx_s|) the printed t is
+//!    s(d − s)/0, the corrected one ½ for every x. Rendered as printed, the rays through the
+//!    silhouette faces of §3.3 (whose |cx_uv| and |cx_s| are the same distances) divide by 0,
+//!    the inner penumbra next to c's hard-shadow line gets t > 1 (lit) and the outer penumbra
+//!    next to it t < 0 (black): bright and black rings the paper's figures do not show
+//!    (RMSE vs `raycast` 1.8–3.9 times the corrected formula's on the disk built-ins,
+//!    `docs/dbuffer.md`). So `eq3 = corrected` is the default and `eq3 = printed` reproduces
+//!    the printed arithmetic. With the corrected denominator t stays in [0, ½] on the umbra
+//!    side and [½, 1] on the other whenever z ≥ z_v ≥ h.
+//!    A denominator that is not positive (or a t that is not finite) is **degenerate**: t = ½
+//!    (the corrected formula's value at the silhouette), counted. t outside [0, 1] is counted
+//!    before it is clamped to [0, 1] (`saturate`), and those pixels are
+//!    [`super::output::MethodStats::clamped_pixels`]; V of a clamped t is in [0, 1].
+//!
+//!    The stencil buffer of §6.2 ("used to avoid overwriting umbra regions") is not needed: the
+//!    screen pass computes each pixel's V once, from the D-buffer, with nothing drawn over it.
+//!
+//! Lights: disks only (the paper's "one circular light source"); every other shape is rejected
+//! by the registry. Several disk lights: one D-buffer each, averaged
+//! ([`super::light_average`]). The paper's failure cases — concave and overlapping occluders,
+//! no umbra (§4 case 2: V too low, √t better), acute silhouette corners — are measured and
+//! pinned in `tests/dbuffer.rs`; the findings are in `docs/dbuffer.md`.
+
+use super::options::OptionReader;
+use super::output::{MethodOutput, PassStats, Visibility};
+use crate::error::InputError;
+use crate::frame::Frame;
+use crate::geometry::umbra_penumbra::{build_volumes, Disk, Extrusion, VolumeStats, VolumeVertex};
+use crate::gpu::buffers::{alloc_tiles, DepthTile};
+use crate::gpu::color::{ColorFormat, ColorMask, RgbaTile};
+use crate::gpu::counters::Counters;
+use crate::gpu::depth::{DepthFormat, DepthState, PolygonOffset};
+use crate::gpu::light_view::LightView;
+use crate::gpu::raster::{bin, draw, no_tile_culling, Fragment};
+use crate::gpu::setup::{setup_all_barycentric, CullMode};
+use crate::gpu::transform::ClipVertex;
+use crate::plan::BufferPlan;
+use crate::scene::LightShape;
+use glam::DVec3;
+use serde::Serialize;
+use std::time::Instant;
+
+/// The largest `map_size` (the RGBA f32 target of 4096² texels takes 256 MB).
+pub const MAX_MAP_SIZE: u32 = 4096;
+/// The default number of corner-fan triangles per full circle (`fan_segments`).
+pub const DEFAULT_FAN_SEGMENTS: u32 = 32;
+/// Relative margin of the sphere the volumes reach beyond the farthest mesh vertex, and of the
+/// distance range beyond that sphere.
+pub const BOUND_MARGIN: f64 = 0.01;
+
+/// V(t): 3t² − 2t³ (smoothstep, §4 eq. 4) or √t (§6.2, for small occluders).
+pub use super::Falloff;
+
+/// Eq. 3's denominator (module doc, pass 3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Eq3 {
+    /// (|cx| − |cx_s|): t = ½ at c's hard-shadow boundary, as §4 states.
+    Corrected,
+    /// (|cx_uv| − |cx_s|), as printed.
+    Printed,
+}
+
+/// How the D-buffer's fragments get their distances (module doc, pass 2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Distances {
+    /// The vertex distances interpolated across the triangle (the paper's).
+    Interpolated,
+    /// The distance along the texel's ray from c to the triangle's plane, computed per
+    /// fragment and written as its depth too (removes the "spherically distributed values"
+    /// artifact; |cx_s| stays interpolated).
+    Exact,
+}
+
+/// The settings of one `dbuffer` render (module doc).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct DBufferSettings {
+    /// Edge of the D-buffer in texels.
+    pub map_size: u32,
+    /// Depth format of the D-buffer's depth buffer.
+    pub depth: DepthFormat,
+    /// Storage format of the four distance channels (f32 or f16).
+    pub storage: ColorFormat,
+    /// The R channel's bias.
+    pub offset: PolygonOffset,
+    /// V(t).
+    pub falloff: Falloff,
+    /// Eq. 3's denominator.
+    pub eq3: Eq3,
+    /// Corner-fan triangles per full circle.
+    pub fan_segments: u32,
+    /// How fragments get their distances.
+    pub distances: Distances,
+}
+
+/// Read and check `[options.dbuffer]` (module doc) for `frame`.
+pub fn read_settings(frame: &Frame) -> Result<DBufferSettings, InputError> {
+    let scene = frame.scene;
+    let mut r = OptionReader::new(scene, "dbuffer");
+    let map_size = r.map_size(scene, MAX_MAP_SIZE)?;
+    let depth = r.depth_format("depth", frame.gpu.depth)?;
+    let storage = match r.choice("storage", &["f32", "f16"], "f32")? {
+        "f16" => ColorFormat::F16,
+        _ => ColorFormat::F32,
+    };
+    // The shadow maps' defaults (`penumbra-map`'s).
+    let offset = r.polygon_offset(
+        super::penumbra_map::DEFAULT_BIAS_UNITS,
+        super::penumbra_map::DEFAULT_SLOPE_BIAS,
+    )?;
+    let falloff = Falloff::read(&mut r, &["smoothstep", "sqrt"])?;
+    let eq3 = match r.choice("eq3", &["corrected", "printed"], "corrected")? {
+        "printed" => Eq3::Printed,
+        _ => Eq3::Corrected,
+    };
+    let fan_segments = r.uint("fan_segments", DEFAULT_FAN_SEGMENTS as u64, 4..=1024)? as u32;
+    let distances = match r.choice("distances", &["interpolated", "exact"], "interpolated")? {
+        "exact" => Distances::Exact,
+        _ => Distances::Interpolated,
+    };
+    r.finish()?;
+    Ok(DBufferSettings {
+        map_size,
+        depth,
+        storage,
+        offset,
+        falloff,
+        eq3,
+        fan_segments,
+        distances,
+    })
+}
+
+/// Eq. 2 at a vertex `x` with silhouette point `e` for the disk normal `n` seen from `c`:
+/// `(dir(c, x)·n)/(dir(c, e)·n)·dist(c, e)` (module doc); `None` when it is not finite.
+pub fn silhouette_distance(c: DVec3, n: DVec3, x: DVec3, e: DVec3) -> Option<f64> {
+    let dist = (e - c).length();
+    let s = (x - c).normalize().dot(n) / (e - c).normalize().dot(n) * dist;
+    s.is_finite().then_some(s)
+}
+
+/// Which side of c's hard shadow x is on (module doc, pass 3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Side {
+    /// |cx| > |cx_o|: the first branch of eq. 3, with |cx_uv|.
+    Umbra,
+    /// Otherwise: the second branch, with |cx_pv|.
+    Penumbra,
+}
+
+/// Eq. 3: t of a receiver at distance `d` from c, with the volume distance `v` (|cx_uv| on the
+/// umbra side, |cx_pv| on the other) and `s` = |cx_s|; `None` when degenerate (module doc).
+pub fn parameter_t(eq: Eq3, side: Side, d: f64, v: f64, s: f64) -> Option<f64> {
+    let den = 2.0
+        * v
+        * match eq {
+            Eq3::Corrected => d - s,
+            Eq3::Printed => v - s,
+        };
+    let q = s * (d - v) / den;
+    if !(den > 0.0 && q.is_finite()) {
+        return None;
+    }
+    Some(match side {
+        Side::Umbra => q,
+        Side::Penumbra => 1.0 - q,
+    })
+}
+
+/// The region the screen pass puts a receiver in (module doc, pass 3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Region {
+    /// V = 0.
+    Umbra,
+    /// The first branch of eq. 3.
+    InnerPenumbra,
+    /// The second branch of eq. 3.
+    OuterPenumbra,
+    /// V = 1.
+    Lit,
+}
+
+/// What the screen program computed for one receiver.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Shade {
+    /// The region.
+    pub region: Region,
+    /// t before the clamp (`None` outside the penumbra regions and where degenerate).
+    pub t: Option<f64>,
+    /// Whether eq. 3 was degenerate (t = ½ used).
+    pub degenerate: bool,
+    /// The visibility (in [0, 1]: computed from t clamped to [0, 1]).
+    pub v: f64,
+}
+
+/// The fragment program of the screen pass (module doc, pass 3): the receiver at distance `d`
+/// from c over the D-buffer texel `[|cx_o|, |cx_uv|, |cx_pv|, |cx_s|]`.
+pub fn screen_program(d: f64, texel: [f32; 4], s: &DBufferSettings) -> Shade {
+    let [o, uv, pv, cs] = texel.map(f64::from);
+    let (side, v) = if d > o {
+        (Side::Umbra, uv)
+    } else {
+        (Side::Penumbra, pv)
+    };
+    if v <= 0.0 || d < v {
+        let (region, v) = match side {
+            Side::Umbra => (Region::Umbra, 0.0),
+            Side::Penumbra => (Region::Lit, 1.0),
+        };
+        return Shade {
+            region,
+            t: None,
+            degenerate: false,
+            v,
+        };
+    }
+    let region = match side {
+        Side::Umbra => Region::InnerPenumbra,
+        Side::Penumbra => Region::OuterPenumbra,
+    };
+    let t = parameter_t(s.eq3, side, d, v, cs);
+    Shade {
+        region,
+        t,
+        degenerate: t.is_none(),
+        v: s.falloff.apply(t.unwrap_or(0.5).clamp(0.0, 1.0)),
+    }
+}
+
+/// What the D-buffer draws did (module doc, pass 2).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct DBufferStats {
+    /// Fragments of the scene draw.
+    pub scene_fragments: u64,
+    /// Of them, written (R).
+    pub r_writes: u64,
+    /// Fragments of the umbra-volume draw.
+    pub umbra_fragments: u64,
+    /// Of them, written (G and A).
+    pub g_writes: u64,
+    /// Fragments of the penumbra-volume draw.
+    pub penumbra_fragments: u64,
+    /// Of them, written (B and A).
+    pub b_writes: u64,
+    /// Writes of the shared A channel (both volume draws).
+    pub a_writes: u64,
+    /// Volume vertices whose eq. 2 ratio was not finite (dist(c, e) used).
+    pub s_not_finite: u64,
+    /// Texels holding both an umbra and a penumbra distance: their A is the penumbra draw's.
+    pub shared_a_texels: u64,
+}
+
+/// What the screen pass found (module doc, pass 3).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+pub struct ScreenStats {
+    /// Receiver pixels shaded.
+    pub receivers: u64,
+    /// Receivers not in front of the light (w ≤ 0 in the light view): lit, no lookup.
+    pub behind_light: u64,
+    /// Umbra (V = 0).
+    pub umbra: u64,
+    /// Umbra because the ray has no umbra-volume distance (G = 0).
+    pub umbra_without_volume: u64,
+    /// First branch of eq. 3.
+    pub inner_penumbra: u64,
+    /// Second branch of eq. 3.
+    pub outer_penumbra: u64,
+    /// Lit (V = 1).
+    pub lit: u64,
+    /// Degenerate eq. 3 (t = ½ used).
+    pub degenerate_t: u64,
+    /// t outside [0, 1] before the clamp (the clamped pixels).
+    pub t_out_of_range: u64,
+}
+
+field_sum!(DBufferStats {
+    scene_fragments,
+    r_writes,
+    umbra_fragments,
+    g_writes,
+    penumbra_fragments,
+    b_writes,
+    a_writes,
+    s_not_finite,
+    shared_a_texels
+});
+field_sum!(ScreenStats {
+    receivers,
+    behind_light,
+    umbra,
+    umbra_without_volume,
+    inner_penumbra,
+    outer_penumbra,
+    lit,
+    degenerate_t,
+    t_out_of_range
+});
+
+/// Per-tile storage of the D-buffer.
+struct DTile {
+    color: RgbaTile,
+    depth: DepthTile,
+    stats: DBufferStats,
+}
+
+/// The result of the passes.
+#[derive(Debug, Clone)]
+pub struct DBufferRender {
+    /// Visibility per pixel, row-major; background 1.
+    pub visibility: Visibility,
+    /// The light view the D-buffer was rendered in.
+    pub view: LightView,
+    /// The distance range [0, range] of the D-buffer's depth.
+    pub range: f64,
+    /// The D-buffer (R = |cx_o|, G = |cx_uv|, B = |cx_pv|, A = |cx_s|), tile-major in
+    /// `view.tiling`.
+    pub dbuffer: Vec<RgbaTile>,
+    /// What building the volumes found.
+    pub volumes: VolumeStats,
+    /// What the D-buffer draws did.
+    pub program: DBufferStats,
+    /// What the screen pass found.
+    pub screen: ScreenStats,
+    /// Per pixel (row-major), what the screen program computed; `None` for background and
+    /// receivers behind the light.
+    pub shades: Vec<Option<Shade>>,
+    /// The passes after the scene pass: volumes, the three D-buffer draws, screen.
+    pub passes: Vec<PassStats>,
+}
+
+/// One D-buffer draw (module doc, pass 2).
+#[derive(Debug, Clone, Copy)]
+enum DrawKind {
+    /// The scene into R, LESS, with the R bias.
+    Scene(PolygonOffset),
+    /// A volume into the channels of the mask, GREATER.
+    Volume(ColorMask),
+}
+
+/// The triangles of one D-buffer draw: clip coordinates, per-vertex `[distance, |cx_s|]`
+/// (the vertex program's outputs) and the world plane `(unit normal, offset)` of each.
+#[derive(Debug, Clone, Default)]
+struct DrawInput {
+    prims: Vec<[ClipVertex; 3]>,
+    values: Vec<[[f64; 2]; 3]>,
+    planes: Vec<(DVec3, f64)>,
+}
+
+impl DrawInput {
+    /// Append the triangle with world corners `w`, clip corners and vertex values.
+    fn push(&mut self, w: [DVec3; 3], clip: [ClipVertex; 3], values: [[f64; 2]; 3]) {
+        let n = (w[1] - w[0]).cross(w[2] - w[0]).normalize_or_zero();
+        self.prims.push(clip);
+        self.values.push(values);
+        self.planes.push((n, n.dot(w[0])));
+    }
+}
+
+/// The distance from c along the ray through the center of texel (x, y) of `view` to the
+/// plane `(n, k)`; `None` when the ray does not meet it in front of c.
+fn ray_distance(view: &LightView, x: u32, y: u32, (n, k): (DVec3, f64)) -> Option<f64> {
+    let c = view.center;
+    let dir = (view.proj.unproject(x, y, 0.5) - c).normalize();
+    let d = (k - n.dot(c)) / n.dot(dir);
+    (d.is_finite() && d > 0.0).then_some(d)
+}
+
+/// Run one D-buffer draw of `input` into `tiles` (module doc, pass 2).
+fn draw_dbuffer(
+    view: &LightView,
+    range: f64,
+    distances: Distances,
+    tiles: &mut [DTile],
+    input: &DrawInput,
+    kind: DrawKind,
+) -> Counters {
+    let cull = match kind {
+        DrawKind::Scene(_) => CullMode::Back,
+        DrawKind::Volume(_) => CullMode::None,
+    };
+    let (tris, mut counters) = setup_all_barycentric(&input.prims, cull, &view.tiling);
+    let bins = bin(&view.tiling, &tris);
+    let format = view.depth;
+    counters += draw(
+        &view.tiling,
+        tiles,
+        &tris,
+        &bins,
+        no_tile_culling,
+        |_, tile, tri, f, c| {
+            c.fragments_shaded += 1;
+            let prim = tri.prim as usize;
+            let v = input.values[prim];
+            let at = |k: usize| {
+                tri.interpolate(f.x, f.y, v.map(|x| x[k]))
+                    .expect("D-buffer triangles are set up with barycentrics")
+            };
+            let (d, f) = match distances {
+                Distances::Interpolated => (at(0), f),
+                Distances::Exact => match ray_distance(view, f.x, f.y, input.planes[prim]) {
+                    Some(d) => (
+                        d,
+                        Fragment {
+                            z: (d / range) as f32,
+                            ..f
+                        },
+                    ),
+                    None => (at(0), f),
+                },
+            };
+            match kind {
+                DrawKind::Scene(offset) => {
+                    tile.stats.scene_fragments += 1;
+                    let m = match distances {
+                        Distances::Interpolated => tri.max_depth_slope(),
+                        // The slope of the depth this fragment writes: the exact distance's
+                        // change to the next texel in x and in y.
+                        Distances::Exact => [(1, 0), (0, 1)]
+                            .map(|(dx, dy)| {
+                                let plane = input.planes[prim];
+                                ray_distance(view, f.x + dx, f.y + dy, plane)
+                                    .map_or(0.0, |n| (n - d).abs() / range)
+                            })
+                            .into_iter()
+                            .fold(0.0, f64::max),
+                    };
+                    let z_max = tri.z_range[1];
+                    let z = offset.apply(format, f.z, m, z_max);
+                    if tile
+                        .depth
+                        .test_and_write(&DepthState::LESS_WRITE, &Fragment { z, ..f }, c)
+                    {
+                        let r = d + range * offset.amount(format, m, z_max);
+                        let mask = ColorMask([true, false, false, false]);
+                        tile.color
+                            .write_masked(f.local, [r, 0.0, 0.0, 0.0], mask, c);
+                        tile.stats.r_writes += 1;
+                    }
+                }
+                DrawKind::Volume(mask) => {
+                    let umbra = mask.0[1];
+                    if umbra {
+                        tile.stats.umbra_fragments += 1;
+                    } else {
+                        tile.stats.penumbra_fragments += 1;
+                    }
+                    if tile.depth.test_and_write(&DepthState::GREATER_WRITE, &f, c) {
+                        tile.color
+                            .write_masked(f.local, [0.0, d, d, at(1)], mask, c);
+                        if umbra {
+                            tile.stats.g_writes += 1;
+                        } else {
+                            tile.stats.b_writes += 1;
+                        }
+                        tile.stats.a_writes += 1;
+                    }
+                }
+            }
+        },
+    );
+    counters
+}
+
+/// The D-buffer draw of the volume triangles `tris`: the vertex program of §3.2 with eq. 2;
+/// counts the vertices whose ratio is not finite.
+fn volume_input(
+    view: &LightView,
+    range: f64,
+    disk: &Disk,
+    tris: &[[VolumeVertex; 3]],
+    not_finite: &mut u64,
+) -> DrawInput {
+    let c = disk.center;
+    let mut input = DrawInput::default();
+    for t in tris {
+        let values = t.map(|x| {
+            let s = silhouette_distance(c, disk.normal, x.position, x.silhouette);
+            *not_finite += s.is_none() as u64;
+            [
+                (x.position - c).length(),
+                s.unwrap_or((x.silhouette - c).length()),
+            ]
+        });
+        let clip = t.map(|x| view.distance_clip_point(x.position, range));
+        input.push(t.map(|x| x.position), clip, values);
+    }
+    input
+}
+
+/// Render `dbuffer` with `s` on `frame` (one disk light).
+pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, InputError> {
+    let scene = frame.scene;
+    let light = scene.light();
+    let LightShape::Disk { radius, normal } = light.shape else {
+        return Err(InputError::at(
+            &scene.source,
+            scene.light_object(0, "light"),
+            "the D-buffer method needs a disk light",
+        ));
+    };
+    let view = super::fit_light_view(frame, "dbuffer", s.map_size, s.depth, "D-buffers")?;
+    let disk = Disk::new(light.center, normal, radius);
+    let c = disk.center;
+    let farthest = scene
+        .meshes
+        .iter()
+        .flat_map(|m| &m.positions)
+        .map(|p| (p.as_dvec3() - c).length())
+        .fold(0.0, f64::max);
+    let bound = farthest * (1.0 + BOUND_MARGIN);
+    let range = bound * (1.0 + BOUND_MARGIN);
+
+    // Pass 1: the volumes (CPU).
+    let t = Instant::now();
+    let meshes: Vec<_> = scene.meshes.iter().zip(&frame.adjacency).collect();
+    let ex = Extrusion {
+        bound,
+        fan_segments: s.fan_segments,
+    };
+    let volumes = build_volumes(&meshes, &disk, &ex).map_err(|(i, e)| {
+        InputError::at(
+            &scene.source,
+            format!("meshes[{i}] ({})", scene.meshes[i].name),
+            e,
+        )
+    })?;
+    let pass_volumes = PassStats::since("volumes", t, Counters::default());
+
+    // Pass 2: the D-buffer, three draws.
+    let mut tiles = alloc_tiles(&view.tiling, |_, len| DTile {
+        color: RgbaTile::cleared(s.storage, [range, 0.0, 0.0, 0.0], len),
+        depth: DepthTile::cleared(view.depth, len),
+        stats: DBufferStats::default(),
+    });
+    let t = Instant::now();
+    let mut scene_input = DrawInput::default();
+    for m in &scene.meshes {
+        let world: Vec<DVec3> = m.positions.iter().map(|p| p.as_dvec3()).collect();
+        let clip: Vec<ClipVertex> = world
+            .iter()
+            .map(|p| view.distance_clip_point(*p, range))
+            .collect();
+        for tri in &m.triangles {
+            let k = tri.map(|i| i as usize);
+            let w = k.map(|i| world[i]);
+            scene_input.push(w, k.map(|i| clip[i]), w.map(|p| [(p - c).length(), 0.0]));
+        }
+    }
+    let c1 = draw_dbuffer(
+        &view,
+        range,
+        s.distances,
+        &mut tiles,
+        &scene_input,
+        DrawKind::Scene(s.offset),
+    );
+    let pass_scene = PassStats::since("dbuffer-scene", t, c1);
+    let mut not_finite = 0;
+    let mut volume_pass = |name: &str, tris: &[[VolumeVertex; 3]], mask: [bool; 4]| {
+        let t = Instant::now();
+        for tile in tiles.iter_mut() {
+            tile.depth = DepthTile::cleared_to(view.depth, 0.0, tile.depth.values.len());
+        }
+        let input = volume_input(&view, range, &disk, tris, &mut not_finite);
+        let kind = DrawKind::Volume(ColorMask(mask));
+        let counters = draw_dbuffer(&view, range, s.distances, &mut tiles, &input, kind);
+        PassStats::since(name, t, counters)
+    };
+    let pass_umbra = volume_pass("dbuffer-umbra", &volumes.umbra, [false, true, false, true]);
+    let pass_penumbra = volume_pass(
+        "dbuffer-penumbra",
+        &volumes.penumbra,
+        [false, false, true, true],
+    );
+    let mut program = DBufferStats {
+        s_not_finite: not_finite,
+        ..Default::default()
+    };
+    let mut dbuffer = Vec::with_capacity(tiles.len());
+    for tile in tiles {
+        program += tile.stats;
+        program.shared_a_texels += tile
+            .color
+            .values
+            .iter()
+            .filter(|v| v[1] != 0 && v[2] != 0)
+            .count() as u64;
+        dbuffer.push(tile.color);
+    }
+
+    // Pass 3: the screen.
+    let t = Instant::now();
+    let (visibility, shades, screen, c3) = screen_pass(frame, &view, &dbuffer, c, s);
+    let pass_screen = PassStats::since("screen", t, c3);
+
+    Ok(DBufferRender {
+        visibility,
+        view,
+        range,
+        dbuffer,
+        volumes: volumes.stats,
+        program,
+        screen,
+        shades,
+        passes: vec![
+            pass_volumes,
+            pass_scene,
+            pass_umbra,
+            pass_penumbra,
+            pass_screen,
+        ],
+    })
+}
+
+/// Pass 3 (module doc): visibility per pixel, the shades, the screen stats, the counters.
+fn screen_pass(
+    frame: &Frame,
+    view: &LightView,
+    dbuffer: &[RgbaTile],
+    c: DVec3,
+    s: &DBufferSettings,
+) -> (Visibility, Vec<Option<Shade>>, ScreenStats, Counters) {
+    let receivers = frame.primary_ray_receivers();
+    let width = frame.scene.width as usize;
+    let texel_bytes = 4 * s.storage.bytes();
+    let (pixels, stats, counters) =
+        super::shade_receivers(&receivers, width, |_, r, st: &mut ScreenStats, cn| {
+            let Some(r) = r else {
+                return (1.0, None);
+            };
+            st.receivers += 1;
+            cn.fragments_shaded += 1;
+            let Some([x, y, _]) = view.window(r.point) else {
+                st.behind_light += 1;
+                return (1.0, None);
+            };
+            let (tile, local) = view.nearest_texel(x, y);
+            cn.color_read_bytes += texel_bytes;
+            let texel = dbuffer[tile].texel(local);
+            let shade = screen_program((r.point.as_dvec3() - c).length(), texel, s);
+            match shade.region {
+                Region::Umbra => {
+                    st.umbra += 1;
+                    st.umbra_without_volume += (texel[1] <= 0.0) as u64;
+                }
+                Region::InnerPenumbra => st.inner_penumbra += 1,
+                Region::OuterPenumbra => st.outer_penumbra += 1,
+                Region::Lit => st.lit += 1,
+            }
+            st.degenerate_t += shade.degenerate as u64;
+            st.t_out_of_range += shade.t.is_some_and(|t| !(0.0..=1.0).contains(&t)) as u64;
+            (shade.v as f32, Some(shade))
+        });
+    let (values, shades) = pixels.into_iter().unzip();
+    (Visibility::Gray(values), shades, stats, counters)
+}
+
+/// Run `dbuffer` on a rendered frame (one light: [`super::run`] averages several).
+pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
+    let start = Instant::now();
+    let s = read_settings(frame)?;
+    let r = render(frame, &s)?;
+    let n = s.map_size;
+    let buffers = vec![
+        BufferPlan::depth(&frame.gpu),
+        BufferPlan::color_target(
+            format!("D-buffer RGBA {n}x{n} (R |cx_o|, G |cx_uv|, B |cx_pv|, A |cx_s|)"),
+            s.storage,
+            4,
+        ),
+        BufferPlan::depth_target(format!("D-buffer depth {n}x{n}"), s.depth),
+    ];
+    let mut stats = super::stats_after_scene_pass(
+        "dbuffer",
+        frame,
+        start,
+        &r.passes,
+        buffers,
+        serde_json::json!({
+            "settings": s,
+            "light_view": {
+                "axis": r.view.axis.to_array(),
+                "distance_range": r.range,
+            },
+            "volumes": r.volumes,
+            "dbuffer": r.program,
+            "channel_writes": {
+                "R": r.program.r_writes,
+                "G": r.program.g_writes,
+                "B": r.program.b_writes,
+                "A": r.program.a_writes,
+            },
+            "screen": r.screen,
+            "gpu": frame.gpu,
+        }),
+    );
+    stats.clamped_pixels = r.screen.t_out_of_range;
+    Ok(MethodOutput {
+        visibility: r.visibility,
+        raw_images: vec![],
+        stats,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The visible fraction of the 2D light [−1, 1] (radius 1 at depth 0) from x = (X, z)
+    /// behind an occluder covering lateral positions ≤ σ at depth h, as the fraction t of the
+    /// light's diameter (assumption 1 in 2D).
+    fn exact_2d(sigma: f64, h: f64, x: f64, z: f64) -> f64 {
+        // The line from x over the silhouette (σ, h) meets the light at ℓ.
+        let l = (sigma * z - x * h) / (z - h);
+        ((1.0 - l) / 2.0).clamp(0.0, 1.0)
+    }
+
+    /// The depth at which the ray from c = (0, 0) through (x, z) crosses the line from the
+    /// light point (p, 0) through the silhouette (σ, h).
+    fn crossing(sigma: f64, h: f64, p: f64, x: f64, z: f64) -> f64 {
+        // Ray: lateral = u·depth, u = x/z; line: lateral = p + (σ − p)·depth/h.
+        let u = x / z;
+        p / (u - (sigma - p) / h)
+    }
+
+    #[test]
+    fn corrected_equation_3_is_the_2d_visible_fraction_and_printed_is_its_linearization() {
+        // Occluder lateral ≤ 1 at depth 2: the hard shadow of c is lateral < z/2, the umbra
+        // lateral < 1 (the line from the light end +1 over the silhouette), the penumbra
+        // lateral < z − 1 (from the end −1).
+        let (sigma, h) = (1.0, 2.0);
+        // Inner penumbra: the ray crosses the umbra line (from the light end +1) at z_uv.
+        for (x, z) in [(2.0, 5.0), (2.4, 5.0), (1.3, 3.0), (1.1, 3.9)] {
+            let zuv = crossing(sigma, h, 1.0, x, z);
+            assert!(zuv > h && zuv < z, "{x} {z} {zuv}");
+            let scale = (x * x + z * z).sqrt() / z; // distances along the ray ∝ depths
+            let [d, v, s] = [z, zuv, h].map(|k| k * scale);
+            let exact = parameter_t(Eq3::Corrected, Side::Umbra, d, v, s).unwrap();
+            assert!((exact - exact_2d(sigma, h, x, z)).abs() < 1e-12, "{x} {z}");
+            assert!((0.0..=0.5).contains(&exact));
+            let printed = parameter_t(Eq3::Printed, Side::Umbra, d, v, s).unwrap();
+            assert!(printed >= exact, "{printed} {exact}");
+            // Same value (0) and slope at the volume: a step ε off it differs by O(ε²).
+            let eps = 1e-6 * v;
+            let e = parameter_t(Eq3::Corrected, Side::Umbra, v + eps, v, s).unwrap();
+            let p = parameter_t(Eq3::Printed, Side::Umbra, v + eps, v, s).unwrap();
+            assert!(e > 0.0 && (e - p).abs() < 1e-4 * e, "{e} {p}");
+        }
+        // Outer penumbra: mirrored, crossing the penumbra line from the light end −1.
+        for (x, z) in [(3.0, 5.0), (3.9, 5.0), (1.7, 3.0)] {
+            let zpv = crossing(sigma, h, -1.0, x, z);
+            assert!(zpv > h && zpv < z, "{zpv}");
+            let exact = parameter_t(Eq3::Corrected, Side::Penumbra, z, zpv, h).unwrap();
+            assert!((exact - exact_2d(sigma, h, x, z)).abs() < 1e-12);
+            assert!((0.5..=1.0).contains(&exact));
+        }
+    }
+
+    #[test]
+    fn degenerate_denominators_are_not_divided() {
+        for eq in [Eq3::Printed, Eq3::Corrected] {
+            // |cx_uv| = |cx_s| (a silhouette face): printed divides by 0.
+            let t = parameter_t(eq, Side::Umbra, 3.0, 2.0, 2.0);
+            match eq {
+                Eq3::Printed => assert_eq!(t, None),
+                Eq3::Corrected => assert_eq!(t, Some(0.5)),
+            }
+            assert_eq!(parameter_t(eq, Side::Umbra, 3.0, 0.0, 1.0), None);
+        }
+        // §4's "symmetry around c where t = ½": on the ray through the silhouette
+        // (|cx_uv| = |cx_s|) the corrected t is ½ wherever x is, on both sides.
+        for d in [2.5, 4.0, 9.0] {
+            assert_eq!(
+                parameter_t(Eq3::Corrected, Side::Umbra, d, 2.0, 2.0),
+                Some(0.5)
+            );
+            assert_eq!(
+                parameter_t(Eq3::Corrected, Side::Penumbra, d, 2.0, 2.0),
+                Some(0.5)
+            );
+        }
+    }
+
+    #[test]
+    fn screen_program_regions() {
+        let s = DBufferSettings {
+            map_size: 8,
+            depth: DepthFormat::D24,
+            storage: ColorFormat::F32,
+            offset: PolygonOffset::NONE,
+            falloff: Falloff::Smoothstep,
+            eq3: Eq3::Corrected,
+            fan_segments: 32,
+            distances: Distances::Interpolated,
+        };
+        // (|cx|, texel, region, V range): nothing nearer and no penumbra volume, before the
+        // penumbra volume, beyond it; behind an occluder before the umbra volume's end, without
+        // an umbra volume, beyond it.
+        let cases: [(f64, [f32; 4], Region, [f64; 2]); 6] = [
+            (5.0, [5.0, 0.0, 0.0, 0.0], Region::Lit, [1.0, 1.0]),
+            (3.0, [3.0, 0.0, 4.0, 2.0], Region::Lit, [1.0, 1.0]),
+            (5.0, [5.0, 0.0, 4.0, 2.0], Region::OuterPenumbra, [0.5, 1.0]),
+            (3.0, [2.0, 4.0, 0.0, 2.0], Region::Umbra, [0.0, 0.0]),
+            (3.0, [2.0, 0.0, 0.0, 0.0], Region::Umbra, [0.0, 0.0]),
+            (5.0, [2.0, 4.0, 0.0, 2.0], Region::InnerPenumbra, [0.0, 0.5]),
+        ];
+        for (d, texel, region, [lo, hi]) in cases {
+            let shade = screen_program(d, texel, &s);
+            assert_eq!(shade.region, region, "{d} {texel:?}");
+            assert!((lo..=hi).contains(&shade.v), "{d} {texel:?}: {}", shade.v);
+        }
+        let inner = screen_program(5.0, [2.0, 4.0, 0.0, 2.0], &s);
+        // √t is brighter than smoothstep for t < ½.
+        let sqrt = DBufferSettings {
+            falloff: Falloff::Sqrt,
+            ..s
+        };
+        assert!(screen_program(5.0, [2.0, 4.0, 0.0, 2.0], &sqrt).v > inner.v);
+    }
+
+    #[test]
+    fn equation_2_is_the_silhouette_distance_on_the_silhouette() {
+        let (c, n) = (DVec3::new(0.0, 4.0, 0.0), DVec3::NEG_Y);
+        let e = DVec3::new(1.0, 2.0, 0.5);
+        let s = silhouette_distance(c, n, e, e).unwrap();
+        assert!((s - (e - c).length()).abs() < 1e-12);
+        // Elsewhere, as printed: cos(x)/cos(e)·dist (the plane through e parallel to the
+        // light would be at 2/cos(x) along the ray).
+        let x = DVec3::new(3.0, -1.0, 0.0);
+        let (cx, ce) = ((x - c).normalize().dot(n), (e - c).normalize().dot(n));
+        let printed = silhouette_distance(c, n, x, e).unwrap();
+        assert!((printed - cx / ce * (e - c).length()).abs() < 1e-12);
+        // At the light's height the ratio is not finite.
+        assert_eq!(
+            silhouette_distance(c, n, x, DVec3::new(1.0, 4.0, 0.0)),
+            None
+        );
+    }
+}
