@@ -357,10 +357,29 @@ fn front_back(e: &LoopEdge, c: DVec3, r: f64) -> (DVec3, DVec3) {
     (nf, nb)
 }
 
-fn slerp(p: DVec3, q: DVec3, t: f64) -> DVec3 {
+/// How close to a half turn (radians) two quad normals may be before [`slerp`] stops using the
+/// great circle through them: there the slerp formula divides a vanishing sum by a vanishing
+/// sine (0/0 at the half turn itself, NaN normals and wedges without faces before this rule,
+/// found by fuzzing: a silhouette that runs out to a spike and straight back).
+const HALF_TURN_TOL: f64 = 1e-6;
+
+/// The unit vector `t` of the way from the unit vector `p` to the unit vector `q` along the
+/// great circle through them (spherical linear interpolation). When `p` and `q` are opposite
+/// within [`HALF_TURN_TOL`], no great circle is defined by them: the arc then turns from `p`
+/// toward `via` (the incoming edge's direction, perpendicular to `p`), the side the short arc
+/// takes at every other convex corner (`q · via > 0`), so the corner wedges sweep around the
+/// outside of the corner.
+fn slerp(p: DVec3, q: DVec3, t: f64, via: DVec3) -> DVec3 {
     let ang = p.dot(q).clamp(-1.0, 1.0).acos();
     if ang < 1e-9 {
         return p;
+    }
+    if std::f64::consts::PI - ang < HALF_TURN_TOL {
+        let u = (via - p * p.dot(via))
+            .try_normalize()
+            .unwrap_or_else(|| p.any_orthonormal_vector());
+        let (sin, cos) = (t * ang).sin_cos();
+        return p * cos + u * sin;
     }
     ((p * ((1.0 - t) * ang).sin() + q * (t * ang).sin()) / ang.sin()).normalize()
 }
@@ -400,7 +419,7 @@ fn loop_wedges(lp: &[DVec3], o: &WedgeOptions, set: &mut WedgeSet) {
         if o.extra_corner_wedges {
             let k = extra_wedge_count(e.n, next.n, e.dir);
             for j in 1..=k {
-                let n = slerp(e.n, next.n, j as f64 / (k + 1) as f64);
+                let n = slerp(e.n, next.n, j as f64 / (k + 1) as f64, e.dir);
                 let v = e.b;
                 let dir = n.cross(v - c).normalize_or_zero();
                 edges.push(LoopEdge {
@@ -871,6 +890,27 @@ impl ScreenWedge {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Opposite quad normals (a silhouette spike) have no great circle: the corner normals turn
+    /// from the first toward the incoming edge direction, finite and of unit length (the slerp
+    /// formula gave NaN at t = ½).
+    #[test]
+    fn slerp_of_opposite_normals_turns_toward_the_edge() {
+        let (n, dir) = (DVec3::Z, DVec3::X);
+        for k in 0..=10 {
+            let t = k as f64 / 10.0;
+            let m = slerp(n, -n, t, dir);
+            let expected = DVec3::new(
+                (t * std::f64::consts::PI).sin(),
+                0.0,
+                (t * std::f64::consts::PI).cos(),
+            );
+            assert!((m - expected).length() < 1e-15, "t {t}: {m}");
+        }
+        // Short of the half turn the great circle is used as before.
+        let q = DVec3::new(0.6, 0.0, -0.8);
+        assert!((slerp(n, q, 1.0, dir) - q).length() < 1e-15);
+    }
 
     #[test]
     fn extra_wedges_for_sixty_degree_corner() {

@@ -28,6 +28,7 @@
 //!   same pixels and depths and every receiver point falls in exactly one half.
 
 use glam::DVec3;
+use std::cmp::Ordering;
 
 /// A half-space `normal · x ≤ offset`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -201,9 +202,29 @@ fn newell_normal(f: &[DVec3]) -> DVec3 {
     n
 }
 
+/// The order of `f64::partial_cmp`, with NaN after every number and equal to NaN: a total
+/// preorder, so a sort cannot panic whatever reaches it, and for NaN-free values exactly
+/// `partial_cmp` (−0 and +0 stay equal and keep their order in a stable sort), so results do
+/// not change where there is no NaN. (`total_cmp` would order −0 before +0, which moves the
+/// first vertex of a cut polygon and with it the rasterized bits.) No NaN reaches the sorts
+/// from a validated scene — its numbers are finite f32, so distances and crossings computed
+/// from them in f64 are finite, and the `tight_wedge` fuzz target checks that every vertex is —
+/// but a sort must not be where a broken guarantee turns into a panic.
+fn float_order(a: f64, b: f64) -> Ordering {
+    a.partial_cmp(&b)
+        .unwrap_or_else(|| a.is_nan().cmp(&b.is_nan()))
+}
+
+/// Lexicographic [`float_order`] on `(x, y, z)`.
+fn point_order(a: &DVec3, b: &DVec3) -> Ordering {
+    float_order(a.x, b.x)
+        .then_with(|| float_order(a.y, b.y))
+        .then_with(|| float_order(a.z, b.z))
+}
+
 /// Deduplicate coplanar points and order them counter-clockwise around `normal`.
 fn order_in_plane(mut pts: Vec<DVec3>, normal: DVec3) -> Vec<DVec3> {
-    pts.sort_by(|a, b| (a.x, a.y, a.z).partial_cmp(&(b.x, b.y, b.z)).unwrap());
+    pts.sort_by(point_order);
     pts.dedup();
     if pts.len() < 3 {
         return pts;
@@ -218,7 +239,7 @@ fn order_in_plane(mut pts: Vec<DVec3>, normal: DVec3) -> Vec<DVec3> {
             (d.dot(b).atan2(d.dot(t)), p)
         })
         .collect();
-    keyed.sort_by(|x, y| x.0.partial_cmp(&y.0).unwrap());
+    keyed.sort_by(|x, y| float_order(x.0, y.0));
     keyed.into_iter().map(|(_, p)| p).collect()
 }
 
@@ -236,7 +257,10 @@ pub fn adjusted_edge(center: DVec3, e0: DVec3, e1: DVec3) -> [DVec3; 2] {
 /// The facet half-spaces of the convex hull of the two end pyramids of edge `e0 e1` for a
 /// light with the given corners (module doc, "Construction"). `center` is the light center
 /// (for the edge adjustment). May be fewer than needed to bound the wedge when the edge
-/// crosses the light (the wedge is then everything on one side, §4.1).
+/// crosses the light (the wedge is then everything on one side, §4.1), and planes the
+/// generators do not lie clearly on one side of (within a relative 10⁻⁹: the edge in the
+/// light's plane, or a light too small for that tolerance seen from the edge) are left out,
+/// so the wedge may be larger than the hull but cuts into it by no more than that tolerance.
 pub fn wedge_halfspaces(center: DVec3, corners: &[DVec3], e0: DVec3, e1: DVec3) -> Vec<HalfSpace> {
     let apex = adjusted_edge(center, e0, e1);
     let dirs: Vec<DVec3> = apex
@@ -270,6 +294,15 @@ pub fn wedge_halfspaces(center: DVec3, corners: &[DVec3], e0: DVec3, e1: DVec3) 
             let dir_vals = dirs.iter().map(|d| n.dot(*d) / scale);
             let apex_vals = apex.iter().map(|p| n.dot(*p - a) / scale.max(edge_len));
             let vals: Vec<f64> = dir_vals.chain(apex_vals).collect();
+            // A plane every generator lies on within eps separates nothing it can be sure of:
+            // the generators may lie on both sides (a light whose angular size seen from the
+            // edge is below eps). Keeping it, and the same plane found again with the opposite
+            // normal, cut the wedge to nothing (found by fuzzing: a light of radius 0.003 at
+            // 10⁹ from the edge lost its whole penumbra). Leaving it out can only make the
+            // wedge larger.
+            if vals.iter().all(|v| v.abs() <= eps) {
+                continue;
+            }
             let sign = if vals.iter().all(|v| *v <= eps) {
                 1.0
             } else if vals.iter().all(|v| *v >= -eps) {
@@ -354,7 +387,7 @@ pub fn bounding_planes(half: &ConvexPolyhedron, planes: &[HalfSpace]) -> Vec<Hal
                 .filter(|v| h.distance(**v).abs() <= 1e-9 * size)
                 .copied()
                 .collect();
-            on.sort_by(|a, b| (a.x, a.y, a.z).partial_cmp(&(b.x, b.y, b.z)).unwrap());
+            on.sort_by(point_order);
             on.dedup();
             on.len() >= 3
         })
@@ -432,6 +465,41 @@ mod tests {
         };
         assert!(inner.contains(pin, 1e-12) && !inner.contains(pout, 1e-12));
         assert!(outer.contains(pout, 1e-12) && !outer.contains(pin, 1e-12));
+    }
+
+    /// A NaN vertex (no validated scene makes one, but nothing may panic on it) is sorted after
+    /// every number instead of panicking a sort: splitting and bounding-plane selection finish.
+    #[test]
+    fn nan_vertices_do_not_panic_the_sorts() {
+        let mut poly = ConvexPolyhedron::aabb(DVec3::splat(-1.0), DVec3::ONE);
+        poly.faces[0][1] = DVec3::new(f64::NAN, 0.0, 0.0);
+        poly.faces[2][0] = DVec3::new(0.0, f64::NAN, 1.0);
+        let plane = HalfSpace {
+            normal: DVec3::X,
+            offset: 0.0,
+        };
+        let (inside, outside, _) = poly.split(&plane);
+        assert!(!inside.is_empty() && !outside.is_empty());
+        let ordered = order_in_plane(
+            vec![
+                DVec3::new(f64::NAN, 0.0, 0.0),
+                DVec3::X,
+                DVec3::Y,
+                DVec3::ONE,
+            ],
+            DVec3::Z,
+        );
+        assert_eq!(ordered.len(), 4);
+        let face_plane = HalfSpace {
+            normal: DVec3::X,
+            offset: 1.0,
+        };
+        assert_eq!(
+            bounding_planes(&poly, &[plane, face_plane]),
+            vec![face_plane]
+        );
+        assert_eq!(float_order(f64::NAN, 1.0), Ordering::Greater);
+        assert_eq!(float_order(-0.0, 0.0), Ordering::Equal);
     }
 
     #[test]
