@@ -19,8 +19,8 @@ use penumbra::geometry::shadow_volume::{shadow_volume_triangles, Capping};
 use penumbra::geometry::silhouette::{light_facing, possible_silhouettes};
 use penumbra::geometry::ssv_wedge::{SsvWedge, WedgeLight, WedgeVertex};
 use penumbra::geometry::tight_wedge::{
-    bounding_planes, wedge_clip_box, wedge_halfspaces, wedge_halves_and_planes, whole_wedge,
-    HalfSpace,
+    adjusted_edge, bounding_planes, wedge_clip_box, wedge_halfspaces, wedge_halves_and_planes,
+    whole_wedge, HalfSpace,
 };
 use penumbra::gpu::counters::Counters;
 use penumbra::gpu::raster::{bin, draw, no_tile_culling};
@@ -367,12 +367,19 @@ const MAX_RECEIVERS: u8 = 8;
 const UNIT_SLACK: f64 = 1e-12;
 
 /// How far two f64 computations of one coverage (the same edge clipped another way or in the
-/// other direction) may differ by rounding.
+/// other direction) may differ by rounding, on top of [`ROUNDING_GROWTH`] × the machine epsilon
+/// × the condition of the projection ([`rect_condition`], [`sphere_condition`]).
 const COVERAGE_TOL: f64 = 1e-9;
 
+/// How many machine epsilons of rounding, times the condition of the projection, two
+/// computations of one coverage may differ by: a few roundings per clip step, four clip steps
+/// and a sum of areas.
+const ROUNDING_GROWTH: f64 = 256.0;
+
 /// Margin (relative to the largest coordinate involved) within which a point counts as on a
-/// wedge's boundary, where plane distances computed in f64 may have either sign.
-const REL_MARGIN: f64 = 1e-9;
+/// wedge's boundary, where plane distances computed in f64 may have either sign: 10× the
+/// tolerance within which `wedge_halfspaces` accepts a plane generators lie outside of.
+const REL_MARGIN: f64 = 1e-8;
 
 /// Smallest sine of the angle between the hard shadow quad's plane and the direction from the
 /// light center to the receiver for which two ways of computing the coverage are compared.
@@ -538,6 +545,64 @@ fn quad_plane_sine(c: DVec3, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
     }
 }
 
+/// How much projecting the edge `e0 e1` from `p` onto the rectangle `l` amplifies rounding:
+/// [`edge_coverage_exact`] clips homogeneous light-plane points whose coordinates for an end
+/// `e` are `S = s_e·h_p − s_p·h_e` (T likewise) and `W = h_p − h_e` (its ray: `W = −h_e`; where
+/// the slab cuts the ray: `W = 0`), each computed with an error of ε times the size of its
+/// terms, and interpolates between them, which carries that error over to the smallest of
+/// them. The condition is the largest terms over the smallest such coordinate (|S, T| or |W|).
+/// Infinite when an end is at `p`'s level, in the light's plane, or projects onto the light
+/// center.
+fn rect_condition(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
+    let lp = l.local(p);
+    let (mut terms, mut smallest) = (0.0f64, f64::INFINITY);
+    for e in [e0, e1] {
+        let le = l.local(e);
+        let s = le.x * lp.z - lp.x * le.z;
+        let t = le.y * lp.z - lp.y * le.z;
+        terms = terms
+            .max((le.x.abs() + le.y.abs()) * lp.z.abs() + (lp.x.abs() + lp.y.abs()) * le.z.abs())
+            .max(lp.z.abs() + le.z.abs());
+        smallest = smallest
+            .min(s.abs().max(t.abs()))
+            .min((lp.z - le.z).abs())
+            .min(le.z.abs());
+    }
+    terms / smallest
+}
+
+/// How much the light space of [`clip_to_light_cone`] amplifies rounding for the edge `e0 e1`
+/// seen from `p` by the sphere (`center`, `radius`): an end's offset from the center in radii,
+/// over its height above `p`'s level as a fraction of the light's (the projection divides by
+/// it). Infinite when an end is at `p`'s level.
+fn sphere_condition(center: DVec3, radius: f64, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
+    let w = center - p;
+    let dist = w.length();
+    [e0, e1]
+        .iter()
+        .map(|e| (1.0 + (*e - center).length() / radius) / ((*e - p).dot(w) / dist / dist).abs())
+        .fold(1.0, f64::max)
+}
+
+/// [`rect_condition`] or [`sphere_condition`] for `light`.
+fn condition(light: &WedgeLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
+    match light {
+        WedgeLight::Rect(l) => rect_condition(l, p, e0, e1),
+        WedgeLight::Sphere { center, radius } => sphere_condition(*center, *radius, p, e0, e1),
+    }
+}
+
+/// The rounding error of a light-space coordinate or coverage computed through a projection
+/// of condition `cond`.
+fn rounding(cond: f64) -> f64 {
+    ROUNDING_GROWTH * f64::EPSILON * cond
+}
+
+/// The tolerance between two computations of one coverage with projection condition `cond`.
+fn coverage_tol(cond: f64) -> f64 {
+    COVERAGE_TOL + rounding(cond)
+}
+
 /// Whether `n` is finite and of unit length (to rounding).
 fn is_unit(n: DVec3) -> bool {
     n.is_finite() && (n.length() - 1.0).abs() <= 1e-12
@@ -606,6 +671,49 @@ impl EdgeInput {
     fn magnitude(&self, p: DVec3) -> f64 {
         light_magnitude(&self.shape).max(magnitude([&self.e0, &self.e1, &p]))
     }
+
+    /// The margin within which a point of magnitude up to `m` counts as on the boundary of a
+    /// wedge of the edge: [`REL_MARGIN`] of `m`, plus what rounding can move the wedge's planes
+    /// by (fuzz/README.md, "Findings"):
+    /// - both papers' wedges turn about the adjusted edge ([`adjusted_edge`]), whose moved end
+    ///   is computed from the light center with an error of ε·(|c| + d_far); over the adjusted
+    ///   edge's length that turns the wedge by up to ε·(|c| + d_far)/length (a light 10³⁸ away
+    ///   turns a zero-length edge into a 31-unit one);
+    /// - a wedge is about as thin as the light's angular size α seen from the edge, and planes
+    ///   and faces found from points that close together (cross products of generators, Newell
+    ///   normals of sliver faces of a clipped polyhedron) are off by ε/α (a light 10⁻¹⁰ rad wide
+    ///   gave faces misplaced by 10⁻⁷);
+    /// - Paper III's wedge is built in a frame around the edge whose axis to the light center
+    ///   is the center's offset from the edge's line, found from an end of the edge with an
+    ///   error of ε·d_far: off by ε·d_far / (the center's distance from the line) (an edge
+    ///   whose line passed 5·10⁻¹⁰ from the center of a light 7·10⁴ away got a wedge turned
+    ///   by 90°).
+    ///
+    /// Infinite for an edge that adjusts to a point.
+    fn wedge_margin(&self, m: f64) -> f64 {
+        let c = self.shape.center();
+        let [a, b] = adjusted_edge(c, self.e0, self.e1);
+        let d_far = (self.e0 - c).length().max((self.e1 - c).length());
+        let turn = (magnitude([&c]) + d_far) / (b - a).length();
+        let angle = self.light_radius() / d_far;
+        let line = (c - self.e0)
+            .cross((self.e1 - self.e0).normalize_or_zero())
+            .length();
+        let rounding = 64.0 * f64::EPSILON * (turn + 1.0 / angle + d_far / line);
+        if rounding.is_finite() {
+            m * (REL_MARGIN + rounding)
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// The radius of the light's bounding sphere around its center.
+    fn light_radius(&self) -> f64 {
+        match self.shape {
+            WedgeLight::Rect(l) => (l.u + l.v).length().max((l.u - l.v).length()),
+            WedgeLight::Sphere { radius, .. } => radius,
+        }
+    }
 }
 
 /// The `coverage` path: for a rectangle or a sphere light, an edge and receivers (see
@@ -639,9 +747,9 @@ pub fn coverage(data: &[u8]) {
 
 /// Checks the coverage of the rectangle `l` by the edge `e0 e1` seen from `p`:
 /// - [`edge_coverage_exact`] is finite, in [−1, 1], signed as [`quad_side`], and, with `p` off
-///   the quad's plane ([`MIN_QUAD_PLANE_SINE`]), negated (to rounding) when the edge is
-///   reversed;
-/// - [`projected_edge_in_light`] gives points in the light square whose
+///   the quad's plane ([`MIN_QUAD_PLANE_SINE`]), negated (to rounding, [`coverage_tol`]) when
+///   the edge is reversed;
+/// - [`projected_edge_in_light`] gives points in the light square (to rounding) whose
 ///   [`segment_coverage`] and coverage-texture lookups (every filter, grey and RGB) are in
 ///   [0, 1]; where the edge lies strictly between the light's plane and `p` (Paper III §3.3:
 ///   the texture's function is the coverage there) and `p` is off the quad's plane
@@ -667,9 +775,11 @@ fn rect_coverage(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) {
         at()
     );
     let off_plane = quad_plane_sine(l.center, p, e0, e1) >= MIN_QUAD_PLANE_SINE;
+    let cond = rect_condition(l, p, e0, e1);
+    let tol = coverage_tol(cond);
     let reversed = edge_coverage_exact(l, p, e1, e0);
     assert!(
-        !off_plane || (c + reversed).abs() <= COVERAGE_TOL,
+        !off_plane || (c + reversed).abs() <= tol,
         "coverage {c}, reversed {reversed}: {}",
         at()
     );
@@ -686,7 +796,7 @@ fn rect_coverage(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) {
         Some([a, b]) => {
             for q in [a, b] {
                 assert!(
-                    q.is_finite() && q.abs().max_element() <= 1.0 + UNIT_SLACK,
+                    q.is_finite() && q.abs().max_element() <= 1.0 + UNIT_SLACK + rounding(cond),
                     "projected point {q} outside the light: {}",
                     at()
                 );
@@ -695,7 +805,7 @@ fn rect_coverage(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) {
             assert!((0.0..=1.0 + UNIT_SLACK).contains(&f), "{f}: {}", at());
             if between(1.0) {
                 assert!(
-                    (f - c.abs()).abs() <= COVERAGE_TOL,
+                    (f - c.abs()).abs() <= tol,
                     "segment coverage {f}, exact {c}: {}",
                     at()
                 );
@@ -716,11 +826,7 @@ fn rect_coverage(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) {
         }
         None => {
             if between(1.0) {
-                assert!(
-                    c.abs() <= COVERAGE_TOL,
-                    "no projection, coverage {c}: {}",
-                    at()
-                );
+                assert!(c.abs() <= tol, "no projection, coverage {c}: {}", at());
             }
         }
     }
@@ -748,7 +854,7 @@ fn rect_coverage(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) {
     if between(1.0 - NEAR_FRACTION) {
         let parts = total / PART_COUNT as f64;
         assert!(
-            (parts - c.abs()).abs() <= COVERAGE_TOL,
+            (parts - c.abs()).abs() <= tol,
             "parts {parts}, exact {c}: {}",
             at()
         );
@@ -763,7 +869,8 @@ fn rect_coverage(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) {
 /// Checks the coverage of the disk the sphere (`center`, `radius`) shows `p` by the edge
 /// `e0 e1`: [`sphere_edge_coverage_exact`] is finite, in [−1, 1], signed as [`quad_side`] and,
 /// with `p` off the quad's plane, negated (to rounding) when the edge is reversed;
-/// [`clip_to_light_cone`]'s chord lies in the unit disk.
+/// [`clip_to_light_cone`]'s chord lies in the unit disk (to the square root of the rounding:
+/// its ends are roots of a quadratic, double where the edge's line touches the cone).
 fn sphere_coverage(center: DVec3, radius: f64, p: DVec3, e0: DVec3, e1: DVec3) {
     let at = || format!("p {p}, edge {e0} {e1}, sphere {center} r {radius}");
     let c = sphere_edge_coverage_exact(center, radius, p, e0, e1);
@@ -779,16 +886,18 @@ fn sphere_coverage(center: DVec3, radius: f64, p: DVec3, e0: DVec3, e1: DVec3) {
         at()
     );
     let off_plane = quad_plane_sine(center, p, e0, e1) >= MIN_QUAD_PLANE_SINE;
+    let cond = sphere_condition(center, radius, p, e0, e1);
+    let tol = coverage_tol(cond);
     let reversed = sphere_edge_coverage_exact(center, radius, p, e1, e0);
     assert!(
-        !off_plane || (c + reversed).abs() <= COVERAGE_TOL,
+        !off_plane || (c + reversed).abs() <= tol,
         "coverage {c}, reversed {reversed}: {}",
         at()
     );
     if let Some([a, b]) = clip_to_light_cone(center, radius, p, e0, e1) {
         for q in [a, b] {
             assert!(
-                q.is_finite() && q.length() <= 1.0 + UNIT_SLACK,
+                q.is_finite() && q.length() <= 1.0 + UNIT_SLACK + rounding(cond).sqrt(),
                 "chord point {q} outside the disk: {}",
                 at()
             );
@@ -823,8 +932,8 @@ fn coverage_textures() -> &'static [Arc<CoverageTexture>; 2] {
 /// a sphere light (see [`EdgeInput`]). When it is built: its planes and vertices are finite
 /// with unit normals and directions; and for an edge apart from the light, it holds every
 /// penumbra receiver (within the rounding margin) and outside it (beyond the margin) the
-/// edge's exact coverage is 0 — what `ssv` relies on when it adds coverage only inside wedges
-/// (Paper III §3.2.2).
+/// edge's exact coverage is 0 (to rounding, [`coverage_tol`]) — what `ssv` relies on when it
+/// adds coverage only inside wedges (Paper III §3.2.2).
 pub fn ssv_wedge(data: &[u8]) {
     let mut r = Bytes(data);
     let Some(input) = EdgeInput::decode(&mut r) else {
@@ -854,7 +963,7 @@ pub fn ssv_wedge(data: &[u8]) {
         return;
     }
     for rcv in &input.receivers {
-        let margin = REL_MARGIN * input.magnitude(rcv.p);
+        let margin = input.wedge_margin(input.magnitude(rcv.p));
         if rcv.penumbra {
             assert!(
                 w.contains_within(rcv.p, margin),
@@ -866,7 +975,7 @@ pub fn ssv_wedge(data: &[u8]) {
         if !w.contains_within(rcv.p, margin) {
             let c = exact_coverage(&input.shape, rcv.p, e0, e1);
             assert!(
-                c.abs() <= COVERAGE_TOL,
+                c.abs() <= coverage_tol(condition(&input.shape, rcv.p, e0, e1)),
                 "coverage {c} at {} outside the wedge: {}",
                 rcv.p,
                 at()
@@ -886,8 +995,9 @@ pub fn ssv_wedge(data: &[u8]) {
 /// - for an edge apart from the light, inside the box (beyond the margin): every penumbra
 ///   receiver is in the whole wedge and, when the hard shadow quad has a plane (the edge's line
 ///   misses the light center; else both halves are empty and so is the coverage), in one of
-///   its halves; outside the wedge or both halves the edge's exact coverage is 0 (an empty
-///   wedge included: `ssv-optimized` and `wedge-blending` then draw nothing for the edge);
+///   its halves; outside the wedge or both halves the edge's exact coverage is 0 to rounding
+///   (an empty wedge included: `ssv-optimized` and `wedge-blending` then draw nothing for the
+///   edge);
 /// - a point well inside the inner (outer) half is on the umbra (lit) side of the hard shadow
 ///   quad ([`quad_side`] ≤ 0, ≥ 0);
 /// - the split's parts lie on their side of the plane, share the cut polygon as described, and
@@ -950,6 +1060,7 @@ pub fn tight_wedge(data: &[u8]) {
     }
     let box_magnitude = magnitude([&lo, &hi]).max(magnitude(&corners));
     let margin = REL_MARGIN * box_magnitude;
+    let wedge_margin = input.wedge_margin(box_magnitude);
     let quad_plane = (a - c).cross(b - c) != DVec3::ZERO;
     for rcv in &input.receivers {
         let p = rcv.p;
@@ -968,13 +1079,14 @@ pub fn tight_wedge(data: &[u8]) {
                 at()
             );
         }
-        if !(input.apart && p.cmpge(lo + margin).all() && p.cmple(hi - margin).all()) {
+        let inside_box = p.cmpge(lo + wedge_margin).all() && p.cmple(hi - wedge_margin).all();
+        if !(input.apart && inside_box) {
             continue;
         }
-        let in_halves = inner.contains(p, margin) || outer.contains(p, margin);
+        let in_halves = inner.contains(p, wedge_margin) || outer.contains(p, wedge_margin);
         if rcv.penumbra {
             assert!(
-                whole.contains(p, margin),
+                whole.contains(p, wedge_margin),
                 "penumbra point {p} outside the wedge {whole:?}: {}",
                 at()
             );
@@ -984,10 +1096,10 @@ pub fn tight_wedge(data: &[u8]) {
                 at()
             );
         }
-        if !whole.contains(p, margin) || !in_halves {
+        if !whole.contains(p, wedge_margin) || !in_halves {
             let cov = exact_coverage(&input.shape, p, a, b);
             assert!(
-                cov.abs() <= COVERAGE_TOL,
+                cov.abs() <= coverage_tol(condition(&input.shape, p, a, b)),
                 "coverage {cov} at {p} outside the wedge or its halves: {}",
                 at()
             );

@@ -254,13 +254,19 @@ pub fn adjusted_edge(center: DVec3, e0: DVec3, e1: DVec3) -> [DVec3; 2] {
     }
 }
 
+/// Smallest sine of the angle between the two vectors whose cross product is a candidate facet
+/// normal in [`wedge_halfspaces`]: the normal of nearly parallel vectors is off by about
+/// ε / sine, which must stay well below the 10⁻⁹ tolerance of the facet test.
+const MIN_CANDIDATE_SINE: f64 = 1e-6;
+
 /// The facet half-spaces of the convex hull of the two end pyramids of edge `e0 e1` for a
 /// light with the given corners (module doc, "Construction"). `center` is the light center
 /// (for the edge adjustment). May be fewer than needed to bound the wedge when the edge
-/// crosses the light (the wedge is then everything on one side, §4.1), and planes the
-/// generators do not lie clearly on one side of (within a relative 10⁻⁹: the edge in the
-/// light's plane, or a light too small for that tolerance seen from the edge) are left out,
-/// so the wedge may be larger than the hull but cuts into it by no more than that tolerance.
+/// crosses the light (the wedge is then everything on one side, §4.1). Candidate planes that
+/// rounding leaves undetermined are left out — spanned by nearly parallel generators
+/// ([`MIN_CANDIDATE_SINE`]), or with every generator within the relative 10⁻⁹ tolerance of the
+/// plane (the edge in the light's plane, or a light too small seen from the edge) — so the
+/// wedge may be larger than the hull but cuts into it by no more than that tolerance.
 pub fn wedge_halfspaces(center: DVec3, corners: &[DVec3], e0: DVec3, e1: DVec3) -> Vec<HalfSpace> {
     let apex = adjusted_edge(center, e0, e1);
     let dirs: Vec<DVec3> = apex
@@ -272,21 +278,26 @@ pub fn wedge_halfspaces(center: DVec3, corners: &[DVec3], e0: DVec3, e1: DVec3) 
         .map(|d| d.length())
         .fold(0.0, f64::max)
         .max(1e-300);
+    // Each candidate normal u × v with |u|·|v|, to tell how well it is determined.
     let mut candidates = Vec::new();
+    let edge = apex[1] - apex[0];
     for d in &dirs {
-        candidates.push((apex[1] - apex[0]).cross(*d));
+        candidates.push((edge.cross(*d), edge.length() * d.length()));
     }
     for i in 0..dirs.len() {
         for j in i + 1..dirs.len() {
-            candidates.push(dirs[i].cross(dirs[j]));
+            candidates.push((dirs[i].cross(dirs[j]), dirs[i].length() * dirs[j].length()));
         }
     }
-    let edge_len = (apex[1] - apex[0]).length();
+    let edge_len = edge.length();
     let eps = 1e-9;
     let mut out: Vec<HalfSpace> = Vec::new();
-    for n in candidates {
+    for (n, lengths) in candidates {
         let len = n.length();
-        if len <= 1e-12 * scale * scale.max(edge_len) {
+        // Nearly parallel u and v give a normal off by about ε / sin(u, v): beyond
+        // MIN_CANDIDATE_SINE that error could exceed eps and let a plane through the hull
+        // (found by fuzzing: a light 5·10⁻⁹ rad wide seen from the edge got an empty wedge).
+        if len <= 1e-12 * scale * scale.max(edge_len) || len <= MIN_CANDIDATE_SINE * lengths {
             continue;
         }
         let n = n / len;
@@ -341,11 +352,20 @@ pub fn quad_inner_halfspace(c: DVec3, a: DVec3, b: DVec3) -> HalfSpace {
 }
 
 /// The box wedges are clipped to (module doc, "Finite wedges"): the scene's bounds enlarged
-/// by 1% of their diagonal plus 10⁻³.
+/// by 1% of their diagonal plus 10⁻³. The diagonal is the f32 one the goldens pin, or the f64
+/// one where that overflows: a scene may span more than the f32 range (found by fuzzing: an
+/// infinite box, whose clipped wedges had infinite and NaN vertices).
 pub fn wedge_clip_box(scene: &crate::scene::Scene) -> (DVec3, DVec3) {
     let (lo, hi) = scene.bounds();
-    let margin = (hi - lo).length() as f64 * 0.01 + 1e-3;
-    (lo.as_dvec3() - margin, hi.as_dvec3() + margin)
+    let diagonal = (hi - lo).length();
+    let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
+    let diagonal = if diagonal.is_finite() {
+        diagonal as f64
+    } else {
+        (hi - lo).length()
+    };
+    let margin = diagonal * 0.01 + 1e-3;
+    (lo - margin, hi + margin)
 }
 
 /// The inner (umbra side) and outer halves of the wedge of silhouette edge `a → b` for a light
