@@ -290,7 +290,6 @@ pub fn wedge_halfspaces(center: DVec3, corners: &[DVec3], e0: DVec3, e1: DVec3) 
         }
     }
     let edge_len = edge.length();
-    let eps = 1e-9;
     let mut out: Vec<HalfSpace> = Vec::new();
     for (n, lengths) in candidates {
         let len = n.length();
@@ -301,9 +300,19 @@ pub fn wedge_halfspaces(center: DVec3, corners: &[DVec3], e0: DVec3, e1: DVec3) 
             continue;
         }
         let n = n / len;
+        // Generators on a facet are on its computed plane to within the normal's error, about
+        // ε / sin(u, v) relative: the tolerance of the facet test (at most 10⁻⁹). A looser one
+        // lets near-facets cut into a hull thinner than it (found by fuzzing: two such planes
+        // of opposite sides left nothing of the wedge of a light 3·10⁻¹⁰ rad wide).
+        let eps = (64.0 * f64::EPSILON * lengths / len).min(1e-9);
         for a in apex {
             let dir_vals = dirs.iter().map(|d| n.dot(*d) / scale);
-            let apex_vals = apex.iter().map(|p| n.dot(*p - a) / scale.max(edge_len));
+            // The apexes' side is measured against the edge's length: against the light's
+            // distance, a plane could cut off a whole apex within the tolerance when the light
+            // is 10⁹ edge lengths away (found by fuzzing: an empty wedge).
+            let apex_vals = apex
+                .iter()
+                .map(|p| n.dot(*p - a) / edge_len.max(f64::MIN_POSITIVE));
             let vals: Vec<f64> = dir_vals.chain(apex_vals).collect();
             // A plane every generator lies on within eps separates nothing it can be sure of:
             // the generators may lie on both sides (a light whose angular size seen from the
