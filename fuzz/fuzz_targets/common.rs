@@ -554,7 +554,7 @@ fn quad_plane_sine(c: DVec3, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
 /// the slab cuts the ray: `W = 0`), each computed with an error of ε times the size of its
 /// terms, and interpolates between them, which carries that error over to the smallest of
 /// them. The condition is the largest terms over the smallest such coordinate (|S, T| or |W|,
-/// or `h_p`, the slab's thickness). Infinite when `p` or an end is in the light's plane, an end
+/// or `h_p`, the slab's thickness). Infinite (or NaN) when `p` or an end is in the light's plane, an end
 /// is at `p`'s level or projects onto the light center.
 fn rect_condition(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
     let lp = l.local(p);
@@ -572,24 +572,24 @@ fn rect_condition(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
             .min(le.z.abs())
             .min(lp.z.abs());
     }
-    if smallest > 0.0 {
-        terms / smallest
-    } else {
-        f64::INFINITY
-    }
+    terms / smallest
 }
 
 /// How much the light space of [`clip_to_light_cone`] amplifies rounding for the edge `e0 e1`
 /// seen from `p` by the sphere (`center`, `radius`): an end's offset from the center in radii,
 /// over its height above `p`'s level as a fraction of the light's (the projection divides by
-/// it). Infinite when an end is at `p`'s level.
+/// it), and 1 / the sine of the angle the edge subtends at `p` (seen end-on, the edge's line
+/// runs through the cone's apex and the cone's quadratic degenerates). Infinite when an end is
+/// at `p`'s level or `p` is on the edge's line.
 fn sphere_condition(center: DVec3, radius: f64, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
     let w = center - p;
     let dist = w.length();
+    let (a, b) = (e0 - p, e1 - p);
+    let end_on = a.length() * b.length() / a.cross(b).length();
     [e0, e1]
         .iter()
         .map(|e| (1.0 + (*e - center).length() / radius) / ((*e - p).dot(w) / dist / dist).abs())
-        .fold(1.0, f64::max)
+        .fold(end_on, f64::max)
 }
 
 /// [`rect_condition`] or [`sphere_condition`] for `light`.
@@ -600,10 +600,18 @@ fn condition(light: &WedgeLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
     }
 }
 
+/// Largest projection condition for which results are compared at all: beyond it (ε·cond
+/// above 2·10⁻⁶) rounding may leave nothing of the answer.
+const MAX_CONDITION: f64 = 1e10;
+
 /// The rounding error of a light-space coordinate or coverage computed through a projection
-/// of condition `cond`.
+/// of condition `cond`; infinite beyond [`MAX_CONDITION`] (or for a NaN condition).
 fn rounding(cond: f64) -> f64 {
-    ROUNDING_GROWTH * f64::EPSILON * cond
+    if cond <= MAX_CONDITION {
+        ROUNDING_GROWTH * f64::EPSILON * cond
+    } else {
+        f64::INFINITY
+    }
 }
 
 /// The tolerance between two computations of one coverage with projection condition `cond`.
@@ -1007,8 +1015,8 @@ pub fn ssv_wedge(data: &[u8]) {
 ///   its halves; outside the wedge or both halves the edge's exact coverage is 0 to rounding
 ///   (an empty wedge included: `ssv-optimized` and `wedge-blending` then draw nothing for the
 ///   edge);
-/// - a point well inside the inner (outer) half is on the umbra (lit) side of the hard shadow
-///   quad ([`quad_side`] ≤ 0, ≥ 0);
+/// - for an edge apart from the light whose quad has a plane, a point well inside the inner
+///   (outer) half is on the umbra (lit) side of the hard shadow quad ([`quad_side`] ≤ 0, ≥ 0);
 /// - the split's parts lie on their side of the plane, share the cut polygon as described, and
 ///   a point well inside the wedge is in one of them.
 pub fn tight_wedge(data: &[u8]) {
@@ -1074,6 +1082,9 @@ pub fn tight_wedge(data: &[u8]) {
     for rcv in &input.receivers {
         let p = rcv.p;
         let side = quad_side(c, p, a, b);
+        if !input.apart || !quad_plane {
+            continue;
+        }
         if inner.contains(p, -margin) {
             assert!(
                 side <= 0.0,
@@ -1089,7 +1100,7 @@ pub fn tight_wedge(data: &[u8]) {
             );
         }
         let inside_box = p.cmpge(lo + wedge_margin).all() && p.cmple(hi - wedge_margin).all();
-        if !(input.apart && inside_box) {
+        if !inside_box {
             continue;
         }
         let in_halves = inner.contains(p, wedge_margin) || outer.contains(p, wedge_margin);

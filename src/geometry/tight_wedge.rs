@@ -172,7 +172,8 @@ impl ConvexPolyhedron {
     /// slivers clipping leaves where a cutting plane runs along an edge or through a vertex,
     /// whose vertices coincide or line up to rounding — have no meaningful plane and are
     /// skipped: a face counts when its Newell normal (twice its area) exceeds 10⁻¹² of the
-    /// polyhedron's squared size.
+    /// polyhedron's squared size. A polyhedron with no face that counts is flat (a sliver part
+    /// of a split, found by fuzzing) and contains nothing.
     pub fn contains(&self, x: DVec3, eps: f64) -> bool {
         let Some(origin) = self.vertices().next().copied() else {
             return false;
@@ -181,10 +182,19 @@ impl ConvexPolyhedron {
             .vertices()
             .map(|v| (*v - origin).length_squared())
             .fold(0.0, f64::max);
-        self.faces.iter().all(|f| {
+        let mut counted = false;
+        for f in &self.faces {
             let n = newell_normal(f);
-            n.length() <= 1e-12 * size2 || n.dot(x - f[0]) <= eps * n.length()
-        })
+            if n.length() <= 1e-12 * size2 {
+                continue;
+            }
+            // Negated so that a NaN distance counts as outside.
+            if !(n.dot(x - f[0]) <= eps * n.length()) {
+                return false;
+            }
+            counted = true;
+        }
+        counted
     }
 }
 
@@ -529,6 +539,23 @@ mod tests {
         );
         assert_eq!(float_order(f64::NAN, 1.0), Ordering::Greater);
         assert_eq!(float_order(-0.0, 0.0), Ordering::Equal);
+    }
+
+    /// A polyhedron whose faces all have no area (a split leaves one on the far side of a plane
+    /// that grazes a face: its vertices line up to rounding) contains nothing; before, with
+    /// every face skipped, it contained every point.
+    #[test]
+    fn polyhedron_of_slivers_contains_nothing() {
+        let line = vec![DVec3::ZERO, DVec3::Z, DVec3::Z * 2.0];
+        let mut back = line.clone();
+        back.reverse();
+        let slivers = ConvexPolyhedron {
+            faces: vec![line, back],
+        };
+        assert!(!slivers.contains(DVec3::new(-5.0, 0.5, 0.5), 1e-9));
+        assert!(!slivers.contains(DVec3::Z, 1e-9));
+        let cube = ConvexPolyhedron::aabb(DVec3::ZERO, DVec3::ONE);
+        assert!(cube.contains(DVec3::splat(0.5), 0.0));
     }
 
     #[test]
