@@ -384,6 +384,12 @@ const ROUNDING_GROWTH: f64 = 256.0;
 /// tolerance within which `wedge_halfspaces` accepts a plane generators lie outside of.
 const REL_MARGIN: f64 = 1e-8;
 
+/// Narrowest light (radians, seen from the edge's far end) whose wedges are checked to hold
+/// the penumbra and all coverage. Narrower, the penumbra is thinner than 10⁻¹⁰ of its distance,
+/// far below the f32 spacing of any receiver, and Paper IV's construction can lose the part of
+/// the wedge near the edge (fuzz/README.md, "Findings": a light 1.5·10⁻¹² rad wide).
+const MIN_LIGHT_ANGLE: f64 = 1e-10;
+
 /// Smallest sine of the angle between the hard shadow quad's plane and the direction from the
 /// light center to the receiver for which two ways of computing the coverage are compared.
 /// Closer to the plane, the signed coverage jumps by 1 across it (the quad's projection runs
@@ -705,7 +711,8 @@ impl EdgeInput {
     ///   whose line passed 5·10⁻¹⁰ from the center of a light 7·10⁴ away got a wedge turned
     ///   by 90°).
     ///
-    /// Infinite for an edge that adjusts to a point.
+    /// Infinite for an edge that adjusts to a point, and for a light narrower than
+    /// [`MIN_LIGHT_ANGLE`] seen from the edge.
     fn wedge_margin(&self, m: f64) -> f64 {
         let c = self.shape.center();
         let [a, b] = adjusted_edge(c, self.e0, self.e1);
@@ -716,7 +723,7 @@ impl EdgeInput {
             .cross((self.e1 - self.e0).normalize_or_zero())
             .length();
         let rounding = 64.0 * f64::EPSILON * (turn + 1.0 / angle + d_far / line);
-        if rounding.is_finite() {
+        if rounding.is_finite() && angle >= MIN_LIGHT_ANGLE {
             m * (REL_MARGIN + rounding)
         } else {
             f64::INFINITY

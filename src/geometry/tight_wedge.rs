@@ -558,6 +558,32 @@ mod tests {
         assert!(cube.contains(DVec3::splat(0.5), 0.0));
     }
 
+    /// A light too small for the facet tolerance seen from the edge (0.003 wide, 1.2·10⁹
+    /// away: 2.5·10⁻¹² rad) still gets a wedge that holds the edge and its penumbra: candidate
+    /// planes that every generator lies on within the tolerance no longer cut it to nothing.
+    #[test]
+    fn wedge_of_a_light_below_the_facet_tolerance_is_not_empty() {
+        let c = DVec3::new(0.0, 0.75, 1_185_546_240.0);
+        let h = 0.0029296875;
+        let corners: Vec<DVec3> = (0..8)
+            .map(|i| {
+                let s = |b: usize| if i & b == 0 { -h } else { h };
+                c + DVec3::new(s(1), s(2), s(4))
+            })
+            .collect();
+        let a = DVec3::new(0.0, 0.75, -7.25);
+        let b = DVec3::new(2.7939677238464355e-9, 14_614_528_000.0, 0.75);
+        let (lo, hi) = (
+            DVec3::new(-146_625_361.921, -146_625_361.921, -146_625_369.171),
+            DVec3::new(146_625_362.671, 14_761_153_361.921, 1_332_171_601.921),
+        );
+        let w = whole_wedge(c, &corners, a, b, lo, hi);
+        let penumbra = DVec3::new(1.183327506570255e-9, 6_189_682_447.491177, -3.8617647058823525);
+        for x in [a, a.lerp(b, 0.5), penumbra] {
+            assert!(w.contains(x, 1e-3), "{x}");
+        }
+    }
+
     #[test]
     fn adjusted_edge_is_equidistant() {
         let c = DVec3::ZERO;
