@@ -121,6 +121,31 @@ fn raster_corpus() {
     replay("raster", common::raster);
 }
 
+/// `pw_wedges`: Paper I/II wedges of validated meshes under a sphere light, light intensities,
+/// and the wedges' rasterization.
+#[test]
+fn pw_wedges_corpus() {
+    replay("pw_wedges", common::pw_wedges);
+}
+
+/// `ssv_wedge`: Paper III wedges hold the penumbra and all coverage of their edge.
+#[test]
+fn ssv_wedge_corpus() {
+    replay("ssv_wedge", common::ssv_wedge);
+}
+
+/// `tight_wedge`: Paper IV tight wedges, their halves and polyhedron splits.
+#[test]
+fn tight_wedge_corpus() {
+    replay("tight_wedge", common::tight_wedge);
+}
+
+/// `coverage`: exact, projected, radial-part, texture and table coverage of one edge.
+#[test]
+fn coverage_corpus() {
+    replay("coverage", common::coverage);
+}
+
 /// The shipped scenes really reach validation in the fuzz scene directory (so the seed
 /// corpus exercises more than "cannot read OBJ"): the shipped good scenes parse.
 #[test]

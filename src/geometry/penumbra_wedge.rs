@@ -362,24 +362,57 @@ struct LoopEdge {
     extra: bool,
 }
 
+/// The normals of the front and back planes of edge `e` (module doc, "Construction"): the
+/// edge direction crossed with the offset of `f` (of `b'`) from the edge's start, or from its
+/// end where that offset is parallel to the edge in f64. Such an edge runs from a vertex so far
+/// away that the light's offset from it vanishes in rounding (found by fuzzing: an edge from a
+/// vertex 10¹⁷ away got NaN front and back planes). Measuring from the end nearer the light
+/// throughout would also keep such planes accurate, but moves two-lights/pw2002 by one LI step
+/// at 89 pixels, so it is not done here (fuzz/README.md, "Findings").
 fn front_back(e: &LoopEdge, c: DVec3, r: f64) -> (DVec3, DVec3) {
+    let normal = |x: DVec3| {
+        e.dir
+            .cross(x - e.a)
+            .try_normalize()
+            .or_else(|| e.dir.cross(x - e.b).try_normalize())
+            .unwrap_or(DVec3::ZERO)
+    };
     let f = c - e.n * r;
     let bp = c + e.n * r;
-    let mut nf = e.dir.cross(f - e.a).normalize_or_zero();
+    let mut nf = normal(f);
     if nf.dot(e.n) < 0.0 {
         nf = -nf;
     }
-    let mut nb = e.dir.cross(bp - e.a).normalize_or_zero();
+    let mut nb = normal(bp);
     if nb.dot(e.n) > 0.0 {
         nb = -nb;
     }
     (nf, nb)
 }
 
-fn slerp(p: DVec3, q: DVec3, t: f64) -> DVec3 {
+/// How close to a half turn (radians) two quad normals may be before [`slerp`] stops using the
+/// great circle through them: there the slerp formula divides a vanishing sum by a vanishing
+/// sine (0/0 at the half turn itself, NaN normals and wedges without faces before this rule,
+/// found by fuzzing: a silhouette that runs out to a spike and straight back).
+const HALF_TURN_TOL: f64 = 1e-6;
+
+/// The unit vector `t` of the way from the unit vector `p` to the unit vector `q` along the
+/// great circle through them (spherical linear interpolation). When `p` and `q` are opposite
+/// within [`HALF_TURN_TOL`], no great circle is defined by them: the arc then turns from `p`
+/// toward `via` (the incoming edge's direction, perpendicular to `p`), the side the short arc
+/// takes at every other convex corner (`q · via > 0`), so the corner wedges sweep around the
+/// outside of the corner.
+fn slerp(p: DVec3, q: DVec3, t: f64, via: DVec3) -> DVec3 {
     let ang = p.dot(q).clamp(-1.0, 1.0).acos();
     if ang < 1e-9 {
         return p;
+    }
+    if std::f64::consts::PI - ang < HALF_TURN_TOL {
+        let u = (via - p * p.dot(via))
+            .try_normalize()
+            .unwrap_or_else(|| p.any_orthonormal_vector());
+        let (sin, cos) = (t * ang).sin_cos();
+        return p * cos + u * sin;
     }
     ((p * ((1.0 - t) * ang).sin() + q * (t * ang).sin()) / ang.sin()).normalize()
 }
@@ -419,7 +452,7 @@ fn loop_wedges(lp: &[DVec3], o: &WedgeOptions, set: &mut WedgeSet) {
         if o.extra_corner_wedges {
             let k = extra_wedge_count(e.n, next.n, e.dir);
             for j in 1..=k {
-                let n = slerp(e.n, next.n, j as f64 / (k + 1) as f64);
+                let n = slerp(e.n, next.n, j as f64 / (k + 1) as f64, e.dir);
                 let v = e.b;
                 let dir = n.cross(v - c).normalize_or_zero();
                 edges.push(LoopEdge {
@@ -541,10 +574,16 @@ fn side_plane(
     let (nf2, nb2) = fb[(j + 1) % k];
     let df = nf1.cross(nf2);
     let db = nb1.cross(nb2);
-    let mut navg = (e1.n + e2.n).normalize_or_zero();
-    if navg == DVec3::ZERO {
-        navg = e1.n;
-    }
+    // Opposite quad normals (a silhouette spike, within HALF_TURN_TOL of a half turn) have no
+    // average: their sum is rounding noise, which gave a side plane through the light ray with
+    // a zero normal (NaN, found by fuzzing). The first edge's normal makes the side plane
+    // perpendicular to the edge at the spike's tip.
+    let sum = e1.n + e2.n;
+    let navg = if sum.length() > HALF_TURN_TOL {
+        sum.normalize()
+    } else {
+        e1.n
+    };
     let away = |l: DVec3| {
         let l = l.normalize_or_zero();
         if l.dot(v - c) < 0.0 {
@@ -574,7 +613,14 @@ fn side_plane(
     {
         (front_ray.normalize(), away(df))
     } else {
-        let normal = ray.cross(navg).normalize_or_zero();
+        // navg is perpendicular to the light ray where both edges end at v; where edges were
+        // dropped between them (zero length or along the ray) it need not be, and a plane
+        // through the ray is still needed.
+        let normal = ray
+            .cross(navg)
+            .try_normalize()
+            .or_else(|| ray.cross(e1.n).try_normalize())
+            .unwrap_or_else(|| ray.any_orthonormal_vector());
         (
             normal,
             away(away(normal.cross(nf1)) + away(normal.cross(nf2))),
@@ -890,6 +936,27 @@ impl ScreenWedge {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Opposite quad normals (a silhouette spike) have no great circle: the corner normals turn
+    /// from the first toward the incoming edge direction, finite and of unit length (the slerp
+    /// formula gave NaN at t = ½).
+    #[test]
+    fn slerp_of_opposite_normals_turns_toward_the_edge() {
+        let (n, dir) = (DVec3::Z, DVec3::X);
+        for k in 0..=10 {
+            let t = k as f64 / 10.0;
+            let m = slerp(n, -n, t, dir);
+            let expected = DVec3::new(
+                (t * std::f64::consts::PI).sin(),
+                0.0,
+                (t * std::f64::consts::PI).cos(),
+            );
+            assert!((m - expected).length() < 1e-15, "t {t}: {m}");
+        }
+        // Short of the half turn the great circle is used as before.
+        let q = DVec3::new(0.6, 0.0, -0.8);
+        assert!((slerp(n, q, 1.0, dir) - q).length() < 1e-15);
+    }
 
     #[test]
     fn extra_wedges_for_sixty_degree_corner() {

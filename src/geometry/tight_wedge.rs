@@ -28,6 +28,7 @@
 //!   same pixels and depths and every receiver point falls in exactly one half.
 
 use glam::DVec3;
+use std::cmp::Ordering;
 
 /// A half-space `normal · x ≤ offset`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -171,7 +172,8 @@ impl ConvexPolyhedron {
     /// slivers clipping leaves where a cutting plane runs along an edge or through a vertex,
     /// whose vertices coincide or line up to rounding — have no meaningful plane and are
     /// skipped: a face counts when its Newell normal (twice its area) exceeds 10⁻¹² of the
-    /// polyhedron's squared size.
+    /// polyhedron's squared size. A polyhedron with no face that counts is flat (a sliver part
+    /// of a split, found by fuzzing) and contains nothing.
     pub fn contains(&self, x: DVec3, eps: f64) -> bool {
         let Some(origin) = self.vertices().next().copied() else {
             return false;
@@ -180,10 +182,19 @@ impl ConvexPolyhedron {
             .vertices()
             .map(|v| (*v - origin).length_squared())
             .fold(0.0, f64::max);
-        self.faces.iter().all(|f| {
+        let mut counted = false;
+        for f in &self.faces {
             let n = newell_normal(f);
-            n.length() <= 1e-12 * size2 || n.dot(x - f[0]) <= eps * n.length()
-        })
+            if n.length() <= 1e-12 * size2 {
+                continue;
+            }
+            // Negated so that a NaN distance counts as outside.
+            if !(n.dot(x - f[0]) <= eps * n.length()) {
+                return false;
+            }
+            counted = true;
+        }
+        counted
     }
 }
 
@@ -201,9 +212,29 @@ fn newell_normal(f: &[DVec3]) -> DVec3 {
     n
 }
 
+/// The order of `f64::partial_cmp`, with NaN after every number and equal to NaN: a total
+/// preorder, so a sort cannot panic whatever reaches it, and for NaN-free values exactly
+/// `partial_cmp` (−0 and +0 stay equal and keep their order in a stable sort), so results do
+/// not change where there is no NaN. (`total_cmp` would order −0 before +0, which moves the
+/// first vertex of a cut polygon and with it the rasterized bits.) No NaN reaches the sorts
+/// from a validated scene — its numbers are finite f32, so distances and crossings computed
+/// from them in f64 are finite, and the `tight_wedge` fuzz target checks that every vertex is —
+/// but a sort must not be where a broken guarantee turns into a panic.
+fn float_order(a: f64, b: f64) -> Ordering {
+    a.partial_cmp(&b)
+        .unwrap_or_else(|| a.is_nan().cmp(&b.is_nan()))
+}
+
+/// Lexicographic [`float_order`] on `(x, y, z)`.
+fn point_order(a: &DVec3, b: &DVec3) -> Ordering {
+    float_order(a.x, b.x)
+        .then_with(|| float_order(a.y, b.y))
+        .then_with(|| float_order(a.z, b.z))
+}
+
 /// Deduplicate coplanar points and order them counter-clockwise around `normal`.
 fn order_in_plane(mut pts: Vec<DVec3>, normal: DVec3) -> Vec<DVec3> {
-    pts.sort_by(|a, b| (a.x, a.y, a.z).partial_cmp(&(b.x, b.y, b.z)).unwrap());
+    pts.sort_by(point_order);
     pts.dedup();
     if pts.len() < 3 {
         return pts;
@@ -218,7 +249,7 @@ fn order_in_plane(mut pts: Vec<DVec3>, normal: DVec3) -> Vec<DVec3> {
             (d.dot(b).atan2(d.dot(t)), p)
         })
         .collect();
-    keyed.sort_by(|x, y| x.0.partial_cmp(&y.0).unwrap());
+    keyed.sort_by(|x, y| float_order(x.0, y.0));
     keyed.into_iter().map(|(_, p)| p).collect()
 }
 
@@ -233,10 +264,19 @@ pub fn adjusted_edge(center: DVec3, e0: DVec3, e1: DVec3) -> [DVec3; 2] {
     }
 }
 
+/// Smallest sine of the angle between the two vectors whose cross product is a candidate facet
+/// normal in [`wedge_halfspaces`]: the normal of nearly parallel vectors is off by about
+/// ε / sine, which must stay well below the 10⁻⁹ tolerance of the facet test.
+const MIN_CANDIDATE_SINE: f64 = 1e-6;
+
 /// The facet half-spaces of the convex hull of the two end pyramids of edge `e0 e1` for a
 /// light with the given corners (module doc, "Construction"). `center` is the light center
 /// (for the edge adjustment). May be fewer than needed to bound the wedge when the edge
-/// crosses the light (the wedge is then everything on one side, §4.1).
+/// crosses the light (the wedge is then everything on one side, §4.1). Candidate planes that
+/// rounding leaves undetermined are left out — spanned by nearly parallel generators
+/// ([`MIN_CANDIDATE_SINE`]), or with every generator within the relative 10⁻⁹ tolerance of the
+/// plane (the edge in the light's plane, or a light too small seen from the edge) — so the
+/// wedge may be larger than the hull but cuts into it by no more than that tolerance.
 pub fn wedge_halfspaces(center: DVec3, corners: &[DVec3], e0: DVec3, e1: DVec3) -> Vec<HalfSpace> {
     let apex = adjusted_edge(center, e0, e1);
     let dirs: Vec<DVec3> = apex
@@ -248,28 +288,51 @@ pub fn wedge_halfspaces(center: DVec3, corners: &[DVec3], e0: DVec3, e1: DVec3) 
         .map(|d| d.length())
         .fold(0.0, f64::max)
         .max(1e-300);
+    // Each candidate normal u × v with |u|·|v|, to tell how well it is determined.
     let mut candidates = Vec::new();
+    let edge = apex[1] - apex[0];
     for d in &dirs {
-        candidates.push((apex[1] - apex[0]).cross(*d));
+        candidates.push((edge.cross(*d), edge.length() * d.length()));
     }
     for i in 0..dirs.len() {
         for j in i + 1..dirs.len() {
-            candidates.push(dirs[i].cross(dirs[j]));
+            candidates.push((dirs[i].cross(dirs[j]), dirs[i].length() * dirs[j].length()));
         }
     }
-    let edge_len = (apex[1] - apex[0]).length();
-    let eps = 1e-9;
+    let edge_len = edge.length();
     let mut out: Vec<HalfSpace> = Vec::new();
-    for n in candidates {
+    for (n, lengths) in candidates {
         let len = n.length();
-        if len <= 1e-12 * scale * scale.max(edge_len) {
+        // Nearly parallel u and v give a normal off by about ε / sin(u, v): beyond
+        // MIN_CANDIDATE_SINE that error could exceed eps and let a plane through the hull
+        // (found by fuzzing: a light 5·10⁻⁹ rad wide seen from the edge got an empty wedge).
+        if len <= 1e-12 * scale * scale.max(edge_len) || len <= MIN_CANDIDATE_SINE * lengths {
             continue;
         }
         let n = n / len;
+        // Generators on a facet are on its computed plane to within the normal's error, about
+        // ε / sin(u, v) relative: the tolerance of the facet test (at most 10⁻⁹). A looser one
+        // lets near-facets cut into a hull thinner than it (found by fuzzing: two such planes
+        // of opposite sides left nothing of the wedge of a light 3·10⁻¹⁰ rad wide).
+        let eps = (64.0 * f64::EPSILON * lengths / len).min(1e-9);
         for a in apex {
             let dir_vals = dirs.iter().map(|d| n.dot(*d) / scale);
-            let apex_vals = apex.iter().map(|p| n.dot(*p - a) / scale.max(edge_len));
+            // The apexes' side is measured against the edge's length: against the light's
+            // distance, a plane could cut off a whole apex within the tolerance when the light
+            // is 10⁹ edge lengths away (found by fuzzing: an empty wedge).
+            let apex_vals = apex
+                .iter()
+                .map(|p| n.dot(*p - a) / edge_len.max(f64::MIN_POSITIVE));
             let vals: Vec<f64> = dir_vals.chain(apex_vals).collect();
+            // A plane every generator lies on within eps separates nothing it can be sure of:
+            // the generators may lie on both sides (a light whose angular size seen from the
+            // edge is below eps). Keeping it, and the same plane found again with the opposite
+            // normal, cut the wedge to nothing (found by fuzzing: a light of radius 0.003 at
+            // 10⁹ from the edge lost its whole penumbra). Leaving it out can only make the
+            // wedge larger.
+            if vals.iter().all(|v| v.abs() <= eps) {
+                continue;
+            }
             let sign = if vals.iter().all(|v| *v <= eps) {
                 1.0
             } else if vals.iter().all(|v| *v >= -eps) {
@@ -308,11 +371,20 @@ pub fn quad_inner_halfspace(c: DVec3, a: DVec3, b: DVec3) -> HalfSpace {
 }
 
 /// The box wedges are clipped to (module doc, "Finite wedges"): the scene's bounds enlarged
-/// by 1% of their diagonal plus 10⁻³.
+/// by 1% of their diagonal plus 10⁻³. The diagonal is the f32 one the goldens pin, or the f64
+/// one where that overflows: a scene may span more than the f32 range (found by fuzzing: an
+/// infinite box, whose clipped wedges had infinite and NaN vertices).
 pub fn wedge_clip_box(scene: &crate::scene::Scene) -> (DVec3, DVec3) {
     let (lo, hi) = scene.bounds();
-    let margin = (hi - lo).length() as f64 * 0.01 + 1e-3;
-    (lo.as_dvec3() - margin, hi.as_dvec3() + margin)
+    let diagonal = (hi - lo).length();
+    let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
+    let diagonal = if diagonal.is_finite() {
+        diagonal as f64
+    } else {
+        (hi - lo).length()
+    };
+    let margin = diagonal * 0.01 + 1e-3;
+    (lo - margin, hi + margin)
 }
 
 /// The inner (umbra side) and outer halves of the wedge of silhouette edge `a → b` for a light
@@ -354,7 +426,7 @@ pub fn bounding_planes(half: &ConvexPolyhedron, planes: &[HalfSpace]) -> Vec<Hal
                 .filter(|v| h.distance(**v).abs() <= 1e-9 * size)
                 .copied()
                 .collect();
-            on.sort_by(|a, b| (a.x, a.y, a.z).partial_cmp(&(b.x, b.y, b.z)).unwrap());
+            on.sort_by(point_order);
             on.dedup();
             on.len() >= 3
         })
@@ -432,6 +504,84 @@ mod tests {
         };
         assert!(inner.contains(pin, 1e-12) && !inner.contains(pout, 1e-12));
         assert!(outer.contains(pout, 1e-12) && !outer.contains(pin, 1e-12));
+    }
+
+    /// A NaN vertex (no validated scene makes one, but nothing may panic on it) is sorted after
+    /// every number instead of panicking a sort: splitting and bounding-plane selection finish.
+    #[test]
+    fn nan_vertices_do_not_panic_the_sorts() {
+        let mut poly = ConvexPolyhedron::aabb(DVec3::splat(-1.0), DVec3::ONE);
+        poly.faces[0][1] = DVec3::new(f64::NAN, 0.0, 0.0);
+        poly.faces[2][0] = DVec3::new(0.0, f64::NAN, 1.0);
+        let plane = HalfSpace {
+            normal: DVec3::X,
+            offset: 0.0,
+        };
+        let (inside, outside, _) = poly.split(&plane);
+        assert!(!inside.is_empty() && !outside.is_empty());
+        let ordered = order_in_plane(
+            vec![
+                DVec3::new(f64::NAN, 0.0, 0.0),
+                DVec3::X,
+                DVec3::Y,
+                DVec3::ONE,
+            ],
+            DVec3::Z,
+        );
+        assert_eq!(ordered.len(), 4);
+        let face_plane = HalfSpace {
+            normal: DVec3::X,
+            offset: 1.0,
+        };
+        assert_eq!(
+            bounding_planes(&poly, &[plane, face_plane]),
+            vec![face_plane]
+        );
+        assert_eq!(float_order(f64::NAN, 1.0), Ordering::Greater);
+        assert_eq!(float_order(-0.0, 0.0), Ordering::Equal);
+    }
+
+    /// A polyhedron whose faces all have no area (a split leaves one on the far side of a plane
+    /// that grazes a face: its vertices line up to rounding) contains nothing; before, with
+    /// every face skipped, it contained every point.
+    #[test]
+    fn polyhedron_of_slivers_contains_nothing() {
+        let line = vec![DVec3::ZERO, DVec3::Z, DVec3::Z * 2.0];
+        let mut back = line.clone();
+        back.reverse();
+        let slivers = ConvexPolyhedron {
+            faces: vec![line, back],
+        };
+        assert!(!slivers.contains(DVec3::new(-5.0, 0.5, 0.5), 1e-9));
+        assert!(!slivers.contains(DVec3::Z, 1e-9));
+        let cube = ConvexPolyhedron::aabb(DVec3::ZERO, DVec3::ONE);
+        assert!(cube.contains(DVec3::splat(0.5), 0.0));
+    }
+
+    /// A light too small for the facet tolerance seen from the edge (0.003 wide, 1.2·10⁹
+    /// away: 2.5·10⁻¹² rad) still gets a wedge that holds the edge and its penumbra: candidate
+    /// planes that every generator lies on within the tolerance no longer cut it to nothing.
+    #[test]
+    fn wedge_of_a_light_below_the_facet_tolerance_is_not_empty() {
+        let c = DVec3::new(0.0, 0.75, 1_185_546_240.0);
+        let h = 0.0029296875;
+        let corners: Vec<DVec3> = (0..8)
+            .map(|i| {
+                let s = |b: usize| if i & b == 0 { -h } else { h };
+                c + DVec3::new(s(1), s(2), s(4))
+            })
+            .collect();
+        let a = DVec3::new(0.0, 0.75, -7.25);
+        let b = DVec3::new(2.7939677238464355e-9, 14_614_528_000.0, 0.75);
+        let (lo, hi) = (
+            DVec3::new(-146_625_361.921, -146_625_361.921, -146_625_369.171),
+            DVec3::new(146_625_362.671, 14_761_153_361.921, 1_332_171_601.921),
+        );
+        let w = whole_wedge(c, &corners, a, b, lo, hi);
+        let penumbra = DVec3::new(1.183327506570255e-9, 6_189_682_447.491177, -3.8617647058823525);
+        for x in [a, a.lerp(b, 0.5), penumbra] {
+            assert!(w.contains(x, 1e-3), "{x}");
+        }
     }
 
     #[test]

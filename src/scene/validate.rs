@@ -309,8 +309,11 @@ fn validate_camera(c: &Camera) -> Result<(), (&'static str, String)> {
     Ok(())
 }
 
-/// Light checks; the error is (object, message).
-fn validate_light(l: &Light) -> Result<(), (&'static str, String)> {
+/// The checks of one light on its own (module doc: finite numbers, positive size, a usable
+/// texture), as [`validate`] runs them; the error is the field it names (`light.radius`, …)
+/// and the message. Public so that code building lights outside a scene (the fuzz targets of
+/// wedge construction and coverage) can feed exactly the lights a validated scene holds.
+pub fn validate_light(l: &Light) -> Result<(), (&'static str, String)> {
     let v3 = fmt_f32v;
     if !l.center.is_finite() {
         return Err(("light.center", format!("{} is not finite", v3(l.center))));
