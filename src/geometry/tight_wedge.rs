@@ -188,8 +188,12 @@ impl ConvexPolyhedron {
             if n.length() <= 1e-12 * size2 {
                 continue;
             }
-            // Negated so that a NaN distance counts as outside.
-            if !(n.dot(x - f[0]) <= eps * n.length()) {
+            // A NaN distance is unordered, so it counts as outside.
+            let inside = n.dot(x - f[0]).partial_cmp(&(eps * n.length()));
+            if !matches!(
+                inside,
+                Some(std::cmp::Ordering::Less | std::cmp::Ordering::Equal)
+            ) {
                 return false;
             }
             counted = true;
@@ -578,7 +582,11 @@ mod tests {
             DVec3::new(146_625_362.671, 14_761_153_361.921, 1_332_171_601.921),
         );
         let w = whole_wedge(c, &corners, a, b, lo, hi);
-        let penumbra = DVec3::new(1.183327506570255e-9, 6_189_682_447.491177, -3.8617647058823525);
+        let penumbra = DVec3::new(
+            1.183327506570255e-9,
+            6_189_682_447.491177,
+            -3.8617647058823525,
+        );
         for x in [a, a.lerp(b, 0.5), penumbra] {
             assert!(w.contains(x, 1e-3), "{x}");
         }
