@@ -160,9 +160,11 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
             .map_err(|e| bad(format!("cannot start {n} worker threads: {e}")))?;
     }
     match cli.cmd {
-        // The default scene, then its sphere-light twin so that the sphere-only methods
-        // (penumbra wedges) appear in a table too. The twin skips nsample, the slowest method,
-        // to keep the default run short; raycast is the reference of both tables.
+        // The default scene, then its companions so that the methods its rectangular light
+        // cannot run appear in a table too: the sphere-light twin (penumbra wedges,
+        // penumbra maps) and a disk-light scene (the D-buffer). The companions skip nsample,
+        // the slowest method, to keep the default run short; raycast is every table's
+        // reference.
         None => {
             render(&RenderArgs {
                 scene: builtin::DEFAULT.into(),
@@ -173,21 +175,24 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
                 opts: vec![],
                 max_memory: None,
             })?;
-            let twin = builtin::load("cube-of-spheres-sphere").ok_or("missing built-in twin")?;
-            let methods = penumbra::methods::ALL
-                .iter()
-                .filter(|m| **m != "nsample" && penumbra::methods::supports_scene(m, &twin))
-                .map(|m| m.to_string())
-                .collect();
-            render(&RenderArgs {
-                scene: "cube-of-spheres-sphere".into(),
-                methods: Some(methods),
-                width: None,
-                height: None,
-                out: "out/cube-of-spheres-sphere".into(),
-                opts: vec![],
-                max_memory: None,
-            })
+            for name in builtin::DEFAULT_COMPANIONS {
+                let scene = builtin::load(name).ok_or("missing built-in companion scene")?;
+                let methods = penumbra::methods::ALL
+                    .iter()
+                    .filter(|m| **m != "nsample" && penumbra::methods::supports_scene(m, &scene))
+                    .map(|m| m.to_string())
+                    .collect();
+                render(&RenderArgs {
+                    scene: name.to_string(),
+                    methods: Some(methods),
+                    width: None,
+                    height: None,
+                    out: format!("out/{name}").into(),
+                    opts: vec![],
+                    max_memory: None,
+                })?;
+            }
+            Ok(())
         }
         Some(Cmd::Experiment {
             name,

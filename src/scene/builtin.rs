@@ -31,6 +31,12 @@ use glam::{DVec3, Mat4, Vec3};
 /// The scene `penumbra render` uses when none is given.
 pub const DEFAULT: &str = "cube-of-spheres";
 
+/// The scenes the default run (`cargo run --release`) renders after [`DEFAULT`], each into
+/// `out/<name>`: [`DEFAULT`]'s sphere-light twin, for the methods that take only spheres
+/// (Papers I–II, Wyman & Hansen 2003), and the disk-light pair's block, for the D-buffer
+/// (CGI 2004).
+pub const DEFAULT_COMPANIONS: &[&str] = &["cube-of-spheres-sphere", "disk-block"];
+
 /// Names of the built-in scenes, in the order `penumbra list` prints them.
 const NAMES: &[&str] = &[
     "cube-of-spheres",
