@@ -228,7 +228,7 @@ impl<'s> Frame<'s> {
     pub fn near_plane_radius(&self) -> f64 {
         let cam = &self.scene.camera;
         let near = self.proj.near;
-        let half_h = near * (cam.vfov_deg.to_radians() * 0.5).tan();
+        let half_h = near * libm::tan(cam.vfov_deg.to_radians() * 0.5);
         let half_w = half_h * self.scene.width as f64 / self.scene.height as f64;
         (near * near + half_h * half_h + half_w * half_w).sqrt()
     }

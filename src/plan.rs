@@ -51,7 +51,7 @@ pub fn near_plane_points(scene: &Scene, near: f64) -> Vec<DVec3> {
     let fwd = (cam.target - cam.eye).normalize();
     let right = fwd.cross(cam.up).normalize();
     let up = right.cross(fwd);
-    let half_h = near * (cam.vfov_deg.to_radians() * 0.5).tan();
+    let half_h = near * libm::tan(cam.vfov_deg.to_radians() * 0.5);
     let half_w = half_h * scene.width as f64 / scene.height as f64;
     let mut pts = vec![cam.eye];
     for i in 0..NEAR_GRID {

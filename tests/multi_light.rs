@@ -117,7 +117,7 @@ fn shared_li_buffer_scales_by_255_over_n_and_overlapping_umbrae_of_one_light_cut
     let err = |v: &[f32]| {
         (v.iter()
             .zip(&reference)
-            .map(|(x, r)| ((x - r) as f64).powi(2))
+            .map(|(x, r)| ((x - r) as f64) * ((x - r) as f64))
             .sum::<f64>()
             / v.len() as f64)
             .sqrt()

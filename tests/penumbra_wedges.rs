@@ -574,7 +574,7 @@ fn solid_angle(a: glam::DVec3, b: glam::DVec3, c: glam::DVec3) -> f64 {
     let (la, lb, lc) = (a.length(), b.length(), c.length());
     let num = a.dot(b.cross(c));
     let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
-    2.0 * num.atan2(den)
+    2.0 * libm::atan2(num, den)
 }
 
 /// The winding number of the face polygons of `w` around `p`: 1 inside, 0 outside for a closed,
@@ -630,8 +630,8 @@ fn every_wedge_is_bounded_and_closed_by_its_faces() {
             let (c, r) = (ws.wedge.center, ws.wedge.radius);
             for (i, w) in set.wedges.iter().enumerate() {
                 let u = w.b - c;
-                let cone = FRONT_LINE_CONE * (r / u.length()).asin();
-                let off = (w.far_front[1] - w.b).normalize().dot(u.normalize()).acos();
+                let cone = FRONT_LINE_CONE * libm::asin(r / u.length());
+                let off = libm::acos((w.far_front[1] - w.b).normalize().dot(u.normalize()));
                 if off > cone * (1.0 + 1e-9) {
                     failures.push(format!(
                         "{name} wedge {i}: front line {off} rad off the ray"

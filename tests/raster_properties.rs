@@ -47,7 +47,7 @@ fn strictly_inside(q: &[[f32; 2]; 4], i: u32, j: u32) -> Option<bool> {
         let b = q[(k + 1) % 4];
         let (ax, ay, bx, by) = (a[0] as f64, a[1] as f64, b[0] as f64, b[1] as f64);
         let e = (bx - ax) * (y - ay) - (by - ay) * (x - ax);
-        let len = ((bx - ax).powi(2) + (by - ay).powi(2)).sqrt();
+        let len = libm::hypot(bx - ax, by - ay);
         if (e / len).abs() < 4.0 / W as f64 {
             near_edge = true; // within snapping distance of an outer edge: either answer is fine
         }
@@ -77,7 +77,10 @@ fn convex_quad() -> impl Strategy<Value = [[f32; 2]; 4]> {
             let mut q = [[0.0; 2]; 4];
             for k in 0..4 {
                 let ang = (k as f32 + jit[k] * 0.8) * std::f32::consts::FRAC_PI_2;
-                q[k] = [cx + r * rad[k] * ang.cos(), cy + r * rad[k] * ang.sin()];
+                q[k] = [
+                    cx + r * rad[k] * libm::cosf(ang),
+                    cy + r * rad[k] * libm::sinf(ang),
+                ];
             }
             q
         })
@@ -140,7 +143,14 @@ fn triangle_fan_around_a_vertex_is_watertight() {
     for k in 0..12 {
         let a0 = k as f32 / 12.0 * std::f32::consts::TAU;
         let a1 = (k + 1) as f32 / 12.0 * std::f32::consts::TAU;
-        let p = |a: f32| ClipVertex([c[0] + 0.9 * a.cos(), c[1] + 0.9 * a.sin(), 0.0, 1.0]);
+        let p = |a: f32| {
+            ClipVertex([
+                c[0] + 0.9 * libm::cosf(a),
+                c[1] + 0.9 * libm::sinf(a),
+                0.0,
+                1.0,
+            ])
+        };
         tris.push([ClipVertex([c[0], c[1], 0.0, 1.0]), p(a0), p(a1)]);
     }
     let counts = hits(&tris, 8);

@@ -145,7 +145,7 @@ proptest! {
         let poly: Vec<DVec2> = (0..sides)
             .map(|k| {
                 let a = (k as f64 + phase) / sides as f64 * std::f64::consts::TAU;
-                DVec2::new(offset.0 + radius * a.cos(), offset.1 + radius * a.sin())
+                DVec2::new(offset.0 + radius * libm::cos(a), offset.1 + radius * libm::sin(a))
             })
             .collect();
         let pw = l.world(DVec3::new(p.0, p.1, p.2));

@@ -258,7 +258,7 @@ proptest! {
         let world: Vec<DVec3> = (0..sides)
             .map(|k| {
                 let a = (k as f64 + phase) / sides as f64 * std::f64::consts::TAU;
-                DVec3::new(offset.0 + radius * a.cos(), offset.1 + radius * a.sin(), h)
+                DVec3::new(offset.0 + radius * libm::cos(a), offset.1 + radius * libm::sin(a), h)
             })
             .collect();
         let mut sum = 0.0;

@@ -197,7 +197,7 @@ fn push_cone(
     let r = light.cone_radius(z);
     let base = |i: u32| {
         let a = std::f64::consts::TAU * (i % segments) as f64 / segments as f64;
-        center + (basis[0] * a.cos() + basis[1] * a.sin()) * r
+        center + (basis[0] * libm::cos(a) + basis[1] * libm::sin(a)) * r
     };
     for i in 0..segments {
         g.triangles.push(PenumbraTriangle {

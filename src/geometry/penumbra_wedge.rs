@@ -403,7 +403,7 @@ const HALF_TURN_TOL: f64 = 1e-6;
 /// takes at every other convex corner (`q · via > 0`), so the corner wedges sweep around the
 /// outside of the corner.
 fn slerp(p: DVec3, q: DVec3, t: f64, via: DVec3) -> DVec3 {
-    let ang = p.dot(q).clamp(-1.0, 1.0).acos();
+    let ang = libm::acos(p.dot(q).clamp(-1.0, 1.0));
     if ang < 1e-9 {
         return p;
     }
@@ -411,16 +411,16 @@ fn slerp(p: DVec3, q: DVec3, t: f64, via: DVec3) -> DVec3 {
         let u = (via - p * p.dot(via))
             .try_normalize()
             .unwrap_or_else(|| p.any_orthonormal_vector());
-        let (sin, cos) = (t * ang).sin_cos();
+        let (sin, cos) = libm::sincos(t * ang);
         return p * cos + u * sin;
     }
-    ((p * ((1.0 - t) * ang).sin() + q * (t * ang).sin()) / ang.sin()).normalize()
+    ((p * libm::sin((1.0 - t) * ang) + q * libm::sin(t * ang)) / libm::sin(ang)).normalize()
 }
 
 /// Number of extra wedges at the corner between edges with quad normals n1 → n2 (`dir1` is the
 /// incoming edge direction): 0 unless convex and acute.
 pub fn extra_wedge_count(n1: DVec3, n2: DVec3, dir1: DVec3) -> usize {
-    let turn = n1.dot(n2).clamp(-1.0, 1.0).acos();
+    let turn = libm::acos(n1.dot(n2).clamp(-1.0, 1.0));
     let convex = n2.dot(dir1) > 0.0;
     if !convex || turn <= ACUTE_TURN {
         return 0;
@@ -596,9 +596,10 @@ fn side_plane(
     let paper = df.cross(db);
     let front_ray = away(df).cross(ray);
     let near_ray = away(df).dot(ray)
-        >= (FRONT_LINE_CONE * (o.radius / (v - c).length()).min(1.0).asin())
-            .min(std::f64::consts::FRAC_PI_2)
-            .cos();
+        >= libm::cos(
+            (FRONT_LINE_CONE * libm::asin((o.radius / (v - c).length()).min(1.0)))
+                .min(std::f64::consts::FRAC_PI_2),
+        );
     let (normal, line) = if level == SideLevel::Paper
         && near_ray
         && df.length() > DEGENERATE
@@ -749,8 +750,8 @@ fn wedge_faces(planes: &[Plane; 5], canon: &[DVec3], far: f64) -> Vec<(FaceKind,
         let w = pl.n.cross(u);
         let mut sorted = on;
         sorted.sort_by(|x, y| {
-            let ax = (*x - centroid).dot(w).atan2((*x - centroid).dot(u));
-            let ay = (*y - centroid).dot(w).atan2((*y - centroid).dot(u));
+            let ax = libm::atan2((*x - centroid).dot(w), (*x - centroid).dot(u));
+            let ay = libm::atan2((*y - centroid).dot(w), (*y - centroid).dot(u));
             ax.total_cmp(&ay)
         });
         faces.push((kind, sorted));
@@ -947,9 +948,9 @@ mod tests {
             let t = k as f64 / 10.0;
             let m = slerp(n, -n, t, dir);
             let expected = DVec3::new(
-                (t * std::f64::consts::PI).sin(),
+                libm::sin(t * std::f64::consts::PI),
                 0.0,
-                (t * std::f64::consts::PI).cos(),
+                libm::cos(t * std::f64::consts::PI),
             );
             assert!((m - expected).length() < 1e-15, "t {t}: {m}");
         }
@@ -962,10 +963,10 @@ mod tests {
     fn extra_wedges_for_sixty_degree_corner() {
         // Equilateral triangle corner: the outward normal turns by 120° (convex).
         let n1 = DVec3::new(0.0, -1.0, 0.0);
-        let (sn, cs) = 120f64.to_radians().sin_cos();
+        let (sn, cs) = libm::sincos(120f64.to_radians());
         let n2 = DVec3::new(sn, -cs, 0.0);
         let dir1 = DVec3::X;
-        assert!((n1.dot(n2).acos().to_degrees() - 120.0).abs() < 1e-9);
+        assert!((libm::acos(n1.dot(n2)).to_degrees() - 120.0).abs() < 1e-9);
         assert_eq!(extra_wedge_count(n1, n2, dir1), 6);
         // Concave corner (normal turns the other way): none.
         assert_eq!(extra_wedge_count(n1, DVec3::new(-n2.x, n2.y, 0.0), dir1), 0);

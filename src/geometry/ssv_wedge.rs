@@ -102,8 +102,8 @@ fn tangent_angles(m: DVec2, radius: f64) -> Option<(f64, f64)> {
     if d.is_nan() || d <= radius {
         return None;
     }
-    let half = (radius / d).asin();
-    let phi = m.y.atan2(m.x);
+    let half = libm::asin(radius / d);
+    let phi = libm::atan2(m.y, m.x);
     Some((phi - half, phi + half))
 }
 
@@ -254,7 +254,7 @@ fn reject(x: DVec3, d: DVec3) -> DVec3 {
 /// The corners with the smallest and largest angle around the origin measured from the
 /// positive x axis, when they span less than half a turn (and none is at the origin).
 fn angular_extremes(q: [DVec2; 4]) -> Option<(DVec2, DVec2)> {
-    let ang: Vec<f64> = q.iter().map(|p| p.y.atan2(p.x)).collect();
+    let ang: Vec<f64> = q.iter().map(|p| libm::atan2(p.y, p.x)).collect();
     let (mut lo, mut hi) = (0, 0);
     for i in 1..4 {
         if ang[i] < ang[lo] {

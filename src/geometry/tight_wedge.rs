@@ -250,7 +250,7 @@ fn order_in_plane(mut pts: Vec<DVec3>, normal: DVec3) -> Vec<DVec3> {
         .into_iter()
         .map(|p| {
             let d = p - center;
-            (d.dot(b).atan2(d.dot(t)), p)
+            (libm::atan2(d.dot(b), d.dot(t)), p)
         })
         .collect();
     keyed.sort_by(|x, y| float_order(x.0, y.0));

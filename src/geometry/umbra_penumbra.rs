@@ -226,14 +226,14 @@ impl Disk {
 
     /// The rim point at angle `theta` in the plane basis.
     pub fn rim_point(&self, theta: f64) -> DVec3 {
-        let (s, c) = theta.sin_cos();
+        let (s, c) = libm::sincos(theta);
         self.center + self.radius * (c * self.basis[0] + s * self.basis[1])
     }
 
     /// The angle of (the projection of) `p` around the center in the plane basis.
     pub fn angle_of(&self, p: DVec3) -> f64 {
         let d = p - self.center;
-        d.dot(self.basis[1]).atan2(d.dot(self.basis[0]))
+        libm::atan2(d.dot(self.basis[1]), d.dot(self.basis[0]))
     }
 
     /// The tangent points of the circle from the point where the line through `v1` and `v2`

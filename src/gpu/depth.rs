@@ -94,7 +94,7 @@ impl DepthFormat {
             DepthFormat::D32F => {
                 let z = z_max.clamp(f32::MIN_POSITIVE, 1.0);
                 let e = ((z.to_bits() >> 23) & 0xff) as i32 - 127;
-                2f64.powi(e - 23)
+                libm::ldexp(1.0, e - 23)
             }
         }
     }
@@ -263,7 +263,7 @@ mod tests {
         // D32F: r = 2^(e − 23) of the largest depth, e = −1 for z in [0.5, 1).
         assert_eq!(
             DepthFormat::D32F.resolvable_difference(0.75),
-            2f64.powi(-24)
+            libm::ldexp(1.0, -24)
         );
     }
 

@@ -162,7 +162,7 @@ impl LightView {
                 let v = p.as_dvec3() - c;
                 let d = v.dot(axis);
                 let (x, y) = (v.dot(right), v.dot(true_up));
-                let angle = x.hypot(y).atan2(d);
+                let angle = libm::atan2(libm::hypot(x, y), d);
                 if angle > max_angle {
                     if worst
                         .as_ref()
@@ -404,7 +404,7 @@ mod tests {
         let mut dirs: Vec<DVec3> = (0..12)
             .map(|k| {
                 let a = k as f64 / 12.0 * std::f64::consts::TAU;
-                axis * t.cos() + (u * a.cos() + v * a.sin()) * t.sin()
+                axis * libm::cos(t) + (u * libm::cos(a) + v * libm::sin(a)) * libm::sin(t)
             })
             .collect();
         dirs.insert(0, (axis + u * 0.1).normalize());

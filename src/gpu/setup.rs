@@ -510,7 +510,7 @@ mod tests {
                     let off = (x - cam.eye) - ray * along;
                     // Vertices are snapped to 1/256 pixel: allow that much of a pixel's
                     // footprint at the point's distance.
-                    let pixel = 2.0 * (30f64).to_radians().tan() * along / 32.0;
+                    let pixel = 2.0 * libm::tan((30f64).to_radians()) * along / 32.0;
                     assert!(off.length() < pixel / 256.0, "({i}, {j}): {off:?}");
                     let y = t.interpolate(i, j, [1.0, 2.0, 3.0]).unwrap();
                     assert!((y - (b[0] + 2.0 * b[1] + 3.0 * b[2])).abs() < 1e-15);

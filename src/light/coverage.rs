@@ -428,7 +428,7 @@ pub fn sector_minus_triangle(a: DVec2, b: DVec2, shape: AreaShape, sector: f64) 
 /// [`sector_minus_triangle`] with the exact sector: f64 `atan2` of the two points and
 /// [`AreaShape::sector_fraction`].
 pub fn exact_sector_minus_triangle(a: DVec2, b: DVec2, shape: AreaShape) -> f64 {
-    let sector = shape.sector_fraction(a.y.atan2(a.x), b.y.atan2(b.x));
+    let sector = shape.sector_fraction(libm::atan2(a.y, a.x), libm::atan2(b.y, b.x));
     sector_minus_triangle(a, b, shape, sector)
 }
 
@@ -594,7 +594,7 @@ mod tests {
         let edge = |z: f64| (DVec3::new(-5.0, 0.125, z), DVec3::new(5.0, 0.125, z));
         let (e0, e1) = edge(1.5);
         let c = sphere_edge_coverage_exact(DVec3::ZERO, 0.5, p, e0, e1);
-        let expected = (0.5f64.acos() - 0.5 * 0.75f64.sqrt()) / PI;
+        let expected = (libm::acos(0.5f64) - 0.5 * 0.75f64.sqrt()) / PI;
         assert!((c.abs() - expected).abs() < 1e-12, "{c} vs {expected}");
         let reversed = sphere_edge_coverage_exact(DVec3::ZERO, 0.5, p, e1, e0);
         assert!((reversed + c).abs() < 1e-15, "{reversed} vs {c}");

@@ -161,7 +161,7 @@ impl Atan2CubeMap {
                         let s = (i as f64 + 0.5) / n as f64;
                         let t = (j as f64 + 0.5) / n as f64;
                         let d = face_direction(f, s, t);
-                        texels.push(unorm(coord_of(d[1].atan2(d[0])), 16));
+                        texels.push(unorm(coord_of(libm::atan2(d[1], d[0])), 16));
                     }
                 }
                 UnormTexture2D {
@@ -220,7 +220,7 @@ impl AreaShape {
             // the area from that axis to θ is tan(θ − kπ/2)/2; each quarter turn holds 1 of 4.
             AreaShape::Square => {
                 let k = (theta / FRAC_PI_2).round();
-                (k + (theta - k * FRAC_PI_2).tan() * 0.5) / 4.0
+                (k + libm::tan(theta - k * FRAC_PI_2) * 0.5) / 4.0
             }
             AreaShape::Disk => theta / TAU,
         }
@@ -364,7 +364,7 @@ mod tests {
         let mut worst = 0.0f64;
         for k in 0..3600 {
             let th = -PI + (k as f64 + 0.25) * TAU / 3600.0;
-            let (y, x) = (th.sin() * 0.7, th.cos() * 0.7);
+            let (y, x) = (libm::sin(th) * 0.7, libm::cos(th) * 0.7);
             let mut e = (map.atan2(y, x) - th).abs();
             e = e.min(TAU - e);
             worst = worst.max(e);
@@ -378,7 +378,7 @@ mod tests {
     fn atan2_map_on_the_face_diagonals() {
         let map = Atan2CubeMap::get();
         for (y, x) in [(-0.2, 0.2), (0.2, 0.2), (0.2, -0.2), (-0.2, -0.2)] {
-            let e = (map.atan2(y, x) - f64::atan2(y, x)).abs();
+            let e = (map.atan2(y, x) - libm::atan2(y, x)).abs();
             assert!(e <= 1.0 / 128.0, "({y}, {x}): {e}");
         }
     }

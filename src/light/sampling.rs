@@ -273,7 +273,7 @@ fn concentric_disk(s: f64, t: f64) -> (f64, f64) {
     } else {
         (t, 2.0 * FRAC_PI_4 - FRAC_PI_4 * (s / t))
     };
-    (r * phi.cos(), r * phi.sin())
+    (r * libm::cos(phi), r * libm::sin(phi))
 }
 
 /// A right-handed orthonormal basis `(b1, b2)` with `b1 × b2 = n̂` for the direction `n`

@@ -903,9 +903,9 @@ mod tests {
             for j in 0..slices {
                 let phi = std::f32::consts::TAU * j as f32 / slices as f32;
                 let dir = Vec3::new(
-                    theta.sin() * phi.cos(),
-                    theta.cos(),
-                    theta.sin() * phi.sin(),
+                    libm::sinf(theta) * libm::cosf(phi),
+                    libm::cosf(theta),
+                    libm::sinf(theta) * libm::sinf(phi),
                 );
                 positions.push(center + dir * radius);
             }
@@ -1162,11 +1162,11 @@ mod tests {
             });
         }
         for i in 0..64 {
-            let (a, b) = (i as f32 * 0.7, (i as f32 * 0.37).sin());
+            let (a, b) = (i as f32 * 0.7, libm::sinf(i as f32 * 0.37));
             let n = Vec3::new(
-                a.cos() * (1.0 - b * b).sqrt(),
+                libm::cosf(a) * (1.0 - b * b).sqrt(),
                 b,
-                a.sin() * (1.0 - b * b).sqrt(),
+                libm::sinf(a) * (1.0 - b * b).sqrt(),
             );
             out.push(Receiver {
                 point: center + n * radius,

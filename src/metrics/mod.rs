@@ -408,8 +408,12 @@ mod tests {
 
     #[test]
     fn deterministic_order_matches_sequential_sum() {
-        let a: Vec<f32> = (0..1000).map(|i| (i as f32 * 0.37).sin().abs()).collect();
-        let b: Vec<f32> = (0..1000).map(|i| (i as f32 * 0.11).cos().abs()).collect();
+        let a: Vec<f32> = (0..1000)
+            .map(|i| libm::sinf(i as f32 * 0.37).abs())
+            .collect();
+        let b: Vec<f32> = (0..1000)
+            .map(|i| libm::cosf(i as f32 * 0.11).abs())
+            .collect();
         let mut sq = 0.0f64;
         for (x, y) in a.iter().zip(&b) {
             let d = f64::from(*x) - f64::from(*y);

@@ -45,7 +45,7 @@ pub fn linear_to_srgb8(x: f32) -> u8 {
     let y = if x <= 0.003_130_8 {
         12.92 * x
     } else {
-        1.055 * x.powf(1.0 / 2.4) - 0.055
+        1.055 * libm::pow(x, 1.0 / 2.4) - 0.055
     };
     (y * 255.0).round_ties_even().clamp(0.0, 255.0) as u8
 }

@@ -477,7 +477,7 @@ fn pw_fractal() -> Scene {
                 .map(|i| {
                     // A central massif so that peaks shadow the valleys around them.
                     let (u, v) = (i as f64 / m as f64 - 0.5, j as f64 / m as f64 - 0.5);
-                    let massif = 0.9 * (-(u * u + v * v) / 0.05).exp();
+                    let massif = 0.9 * libm::exp(-(u * u + v * v) / 0.05);
                     0.3 + h[j * n / m][i * n / m].max(-0.25) + massif
                 })
                 .collect()

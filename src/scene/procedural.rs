@@ -37,10 +37,10 @@ pub fn uv_sphere(
     let mut positions = vec![f32v(c + DVec3::new(0.0, r, 0.0))];
     for i in 1..stacks {
         let phi = PI * f64::from(i) / f64::from(stacks);
-        let (sp, cp) = phi.sin_cos();
+        let (sp, cp) = libm::sincos(phi);
         for j in 0..slices {
             let theta = 2.0 * PI * f64::from(j) / f64::from(slices);
-            let (st, ct) = theta.sin_cos();
+            let (st, ct) = libm::sincos(theta);
             positions.push(f32v(c + r * DVec3::new(sp * ct, cp, -sp * st)));
         }
     }
@@ -125,7 +125,7 @@ pub fn cylinder(
     for level in [0.0, h] {
         for j in 0..segments {
             let theta = 2.0 * PI * f64::from(j) / f64::from(segments);
-            let (st, ct) = theta.sin_cos();
+            let (st, ct) = libm::sincos(theta);
             positions.push(f32v(c + DVec3::new(r * ct, level, -r * st)));
         }
     }
@@ -172,9 +172,9 @@ pub fn torus(
     let (big, small) = (f64::from(major), f64::from(minor));
     let mut positions = Vec::with_capacity((rings * sides) as usize);
     for i in 0..rings {
-        let (su, cu) = (2.0 * PI * f64::from(i) / f64::from(rings)).sin_cos();
+        let (su, cu) = libm::sincos(2.0 * PI * f64::from(i) / f64::from(rings));
         for j in 0..sides {
-            let (sv, cv) = (2.0 * PI * f64::from(j) / f64::from(sides)).sin_cos();
+            let (sv, cv) = libm::sincos(2.0 * PI * f64::from(j) / f64::from(sides));
             let r = big + small * cv;
             positions.push(f32v(c + DVec3::new(r * cu, small * sv, -r * su)));
         }
@@ -341,7 +341,7 @@ mod tests {
         let m = cylinder("c", Vec3::new(0.0, 1.0, 0.0), 0.5, 2.0, 24, C);
         assert_eq!(m.triangles.len(), 96);
         // Inscribed 24-gon prism: area = n/2 r² sin(2π/n).
-        let area = 12.0 * 0.25 * (2.0 * PI / 24.0).sin();
+        let area = 12.0 * 0.25 * libm::sin(2.0 * PI / 24.0);
         check_closed_outward(&m, area * 2.0, 1e-6);
         // Every side face points away from the axis.
         for t in &m.triangles[..] {
