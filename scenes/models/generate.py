@@ -103,6 +103,82 @@ def star_prism(points=5, outer=0.6, inner=0.25, height=0.2):
     return verts, tris
 
 
+def prism():
+    # A right-triangle prism: the triangle (0, 0), (1, 0), (1, 1) in x, z, extruded over
+    # y in [0, 1]. Its corner at the origin is 45°; scaling z by tan(a) makes it a (scenes/hard
+    # acute-corners-sphere.toml scales it to 5° and 1°).
+    tri = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0)]
+    verts = [(x, 0.0, z) for x, z in tri] + [(x, 1.0, z) for x, z in tri]
+    # The triangle is clockwise seen from +y (x right, z toward the viewer), so the bottom cap
+    # (seen from -y) is (0, 1, 2) and the top cap (3, 5, 4).
+    tris = [(0, 1, 2), (3, 5, 4)]
+    for i in range(3):
+        j = (i + 1) % 3
+        tris += [(i, 3 + i, 3 + j), (i, 3 + j, j)]
+    return verts, tris
+
+
+def crown(ring=10, radius=0.5, wave=0.25, tip=0.1):
+    # A flat double cone along z whose waist zigzags: `ring` waist vertices around the z axis
+    # at alternating z = +wave, -wave, beyond the tips (0, 0, ±tip). Seen from a light roughly
+    # perpendicular to the axis, the triangles around each tip alternate between facing the
+    # light and facing away, so up to `ring` - 2 silhouette edges meet at a tip (Paper V:
+    # silhouette vertices of degree > 2); the degree falls as the axis turns toward the light.
+    # Each tip's fan and the other's project onto the same triangles along z, the front one
+    # above the back one, so the solid does not intersect itself.
+    verts = []
+    for i in range(ring):
+        a = 2 * math.pi * i / ring
+        verts.append((radius * math.cos(a), radius * math.sin(a), wave if i % 2 == 0 else -wave))
+    front, back = ring, ring + 1
+    verts += [(0.0, 0.0, tip), (0.0, 0.0, -tip)]
+    tris = []
+    for i in range(ring):
+        j = (i + 1) % ring
+        tris += [(front, i, j), (back, j, i)]
+    return verts, tris
+
+
+def sliver_box(sliver=1e-6):
+    # The unit cube with two T-junctions closed by degenerate triangles, both on edges of the
+    # top face (y = 0.5): the front edge (z = 0.5) gets its midpoint as a vertex of the top
+    # face, and the filler triangle (both corners, midpoint) has zero area with three distinct
+    # indices; the back edge (z = -0.5) gets a vertex `sliver` above its midpoint, and its
+    # filler is a sliver of height `sliver`. Closed and consistently wound, as any mesh.
+    verts, _ = cube()
+    # cube(): vertex i at ((i & 1) - 0.5, ((i >> 1) & 1) - 0.5, ((i >> 2) & 1) - 0.5).
+    # Top face y = 0.5: 2 (-x, -z), 3 (+x, -z), 7 (+x, +z), 6 (-x, +z).
+    mid_front = len(verts)
+    verts.append((0.0, 0.5, 0.5))
+    mid_back = len(verts)
+    verts.append((0.0, 0.5 + sliver, -0.5))
+    quads = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (0, 4, 6, 2), (1, 3, 7, 5)]
+    tris = [t for q in quads for t in ((q[0], q[1], q[2]), (q[0], q[2], q[3]))]
+    # Top face, counter-clockwise seen from +y: 6, 7, 3, 2 with the midpoints on 6-7 and 3-2.
+    top = [6, mid_front, 7, 3, mid_back, 2]
+    tris += [(mid_front, 7, 3), (mid_front, 3, mid_back), (mid_front, mid_back, 2),
+             (mid_front, 2, 6)]
+    # The fillers close the front edge 6-7 and the back edge 3-2 against the side faces
+    # (4, 5, 7, 6) and (0, 2, 3, 1), which use those edges directly.
+    tris += [(6, 7, mid_front), (3, 2, mid_back)]
+    assert all(v in {i for t in tris for i in t} for v in top)
+    return verts, tris
+
+
+def stack(plates=256, size=1.0, thickness=0.001, spacing=0.002):
+    # `plates` disjoint thin boxes (size x thickness x size) stacked along +y from y = 0, one
+    # every `spacing`: a point under the stack lies in all their shadow volumes, 256 = 2^8 of
+    # them, so an 8-bit wrapping stencil counts 0 there (scenes/hard/stack-256-*.toml).
+    verts, tris = [], []
+    cv, ct = cube()
+    for k in range(plates):
+        base = len(verts)
+        y0 = k * spacing
+        verts += [(x * size, y0 + (y + 0.5) * thickness, z * size) for x, y, z in cv]
+        tris += [(a + base, b + base, c + base) for a, b, c in ct]
+    return verts, tris
+
+
 def png_rgb(path, w, h, pixel):
     raw = b"".join(b"\x00" + bytes(c for x in range(w) for c in pixel(x, y)) for y in range(h))
     chunk = lambda t, d: struct.pack(">I", len(d)) + t + d + struct.pack(">I", zlib.crc32(t + d))
@@ -127,4 +203,8 @@ if __name__ == "__main__":
     write("tetra.obj", *tetra(), "regular tetrahedron, edge 1, base on y = 0")
     write("torus.obj", *torus(), "torus R 0.6 r 0.2 around +y, 24 x 12")
     write("star.obj", *star_prism(), "five-pointed star prism, outer 0.6, inner 0.25, height 0.2")
+    write("prism.obj", *prism(), "right-triangle prism, legs 1 in x and z, height 1 in y")
+    write("crown.obj", *crown(), "double cone along z, tips ±0.1, zigzag waist of 10, r 0.5, z ±0.25")
+    write("sliver-box.obj", *sliver_box(), "unit cube, a zero-area and a 1e-6 sliver triangle on top")
+    write("stack.obj", *stack(), "256 plates 1 x 0.001 x 1 stacked 0.002 apart along y")
     png_rgb(os.path.join(HERE, "..", "textures", "fire.png"), 8, 8, fire)
