@@ -227,10 +227,8 @@ impl<'s> Frame<'s> {
     /// draw it as [`FULL_SCREEN`]).
     pub fn near_plane_radius(&self) -> f64 {
         let cam = &self.scene.camera;
-        let near = self.proj.near;
-        let half_h = near * libm::tan(cam.vfov_deg.to_radians() * 0.5);
-        let half_w = half_h * self.scene.width as f64 / self.scene.height as f64;
-        (near * near + half_h * half_h + half_w * half_w).sqrt()
+        let (tan_x, tan_y) = cam.view_half_tangents(self.scene.width, self.scene.height);
+        self.proj.near * (1.0 + tan_x * tan_x + tan_y * tan_y).sqrt()
     }
 
     /// Number of pixels.

@@ -47,21 +47,32 @@ pub fn representative_light_points(scene: &Scene) -> Vec<Vec3> {
 /// edges included), in world space: the points where the near plane can meet a shadow volume
 /// ([`eye_in_shadow`]) or geometry ([`crate::frame::Frame::render`]).
 pub fn near_plane_points(scene: &Scene, near: f64) -> Vec<DVec3> {
-    let cam = &scene.camera;
-    let fwd = (cam.target - cam.eye).normalize();
-    let right = fwd.cross(cam.up).normalize();
-    let up = right.cross(fwd);
-    let half_h = near * libm::tan(cam.vfov_deg.to_radians() * 0.5);
-    let half_w = half_h * scene.width as f64 / scene.height as f64;
-    let mut pts = vec![cam.eye];
+    let at = near_plane_map(scene, near);
+    let mut pts = vec![scene.camera.eye];
     for i in 0..NEAR_GRID {
         for j in 0..NEAR_GRID {
             let s = i as f64 / (NEAR_GRID - 1) as f64 * 2.0 - 1.0;
             let t = j as f64 / (NEAR_GRID - 1) as f64 * 2.0 - 1.0;
-            pts.push(cam.eye + fwd * near + right * (s * half_w) + up * (t * half_h));
+            pts.push(at(s, t));
         }
     }
     pts
+}
+
+/// The point of the near-plane rectangle at distance `near` with coordinates (s, t) ∈ [−1, 1]²
+/// (s to the right, t up), in world space.
+fn near_plane_map(scene: &Scene, near: f64) -> impl Fn(f64, f64) -> DVec3 {
+    let cam = &scene.camera;
+    let fwd = (cam.target - cam.eye).normalize();
+    let right = fwd.cross(cam.up).normalize();
+    let up = right.cross(fwd);
+    let (tan_x, tan_y) = cam.view_half_tangents(scene.width, scene.height);
+    let (center, right, up) = (
+        cam.eye + fwd * near,
+        right * (near * tan_x),
+        up * (near * tan_y),
+    );
+    move |s, t| center + right * s + up * t
 }
 
 /// Whether the eye or the near-plane rectangle lies (partly) in the hard shadow of any of
@@ -82,15 +93,8 @@ pub fn eye_in_shadow(scene: &Scene, near: f64, lights: &[Vec3]) -> bool {
 
 /// The four corners of the near-plane rectangle at distance `near`, in order around it.
 fn near_rect(scene: &Scene, near: f64) -> [DVec3; 4] {
-    let cam = &scene.camera;
-    let fwd = (cam.target - cam.eye).normalize();
-    let right = fwd.cross(cam.up).normalize();
-    let up = right.cross(fwd);
-    let half_h = near * (cam.vfov_deg.to_radians() * 0.5).tan();
-    let half_w = half_h * scene.width as f64 / scene.height as f64;
-    let c = cam.eye + fwd * near;
-    [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
-        .map(|(s, t)| c + right * (s * half_w) + up * (t * half_h))
+    let at = near_plane_map(scene, near);
+    [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(s, t)| at(s, t))
 }
 
 /// Whether a part of the near-plane rectangle of positive area lies in the hard shadow of one

@@ -52,8 +52,7 @@ pub fn default_near(scene: &Scene) -> f64 {
 pub fn nearest_visible_depth(scene: &Scene) -> Option<f64> {
     let camera = &scene.camera;
     let view = DMat4::look_at_rh(camera.eye, camera.target, camera.up);
-    let tan_y = libm::tan(camera.vfov_deg.to_radians() * 0.5);
-    let tan_x = tan_y * scene.width as f64 / scene.height as f64;
+    let (tan_x, tan_y) = camera.view_half_tangents(scene.width, scene.height);
     // Inside ≥ 0; view space looks down −z, so the depth is −z.
     let planes: [fn(DVec3, f64, f64) -> f64; 5] = [
         |v, _, _| -v.z,
@@ -125,7 +124,7 @@ impl Projection {
     /// The projection of `camera` for a `width`×`height` image with near plane `near`.
     pub fn new(camera: &Camera, width: u32, height: u32, near: f64) -> Self {
         let view = DMat4::look_at_rh(camera.eye, camera.target, camera.up);
-        let f = 1.0 / libm::tan(camera.vfov_deg.to_radians() * 0.5);
+        let f = 1.0 / camera.view_half_tangents(width, height).1;
         let a = width as f64 / height as f64;
         // Column-major: columns of P.
         let proj = DMat4::from_cols(

@@ -39,6 +39,15 @@ pub struct Camera {
     pub near: Option<f64>,
 }
 
+impl Camera {
+    /// tan of half the horizontal and half the vertical field of view of a `width`×`height`
+    /// image: the view pyramid's half extents at distance 1 (the projection's 1/f and a/f).
+    pub fn view_half_tangents(&self, width: u32, height: u32) -> (f64, f64) {
+        let tan_y = libm::tan(self.vfov_deg.to_radians() * 0.5);
+        (tan_y * width as f64 / height as f64, tan_y)
+    }
+}
+
 /// An RGB texture with linear f32 texels in [0, 1], row 0 at the top (used by textured lights).
 #[derive(Debug, Clone, PartialEq)]
 pub struct RgbTexture {
