@@ -262,6 +262,17 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
             Ok(())
         }
         Some(Cmd::Golden { bless, root }) => {
+            // Outside the repository there is nothing to check, and blessing would write a
+            // whole golden tree into the current directory.
+            if !root.join("..").join("scenes").is_dir() || !root.is_dir() {
+                return Err(InputError::new(
+                    root.display().to_string(),
+                    "not the golden directory of a penumbra repository (golden/ next to \
+                     scenes/): run `penumbra golden` from the repository's root, or pass \
+                     --root PATH/TO/golden",
+                )
+                .into());
+            }
             let report = penumbra::golden::run_cases(&root, bless)?;
             print!("{report}");
             Ok(())

@@ -697,3 +697,32 @@ fn a_run_with_the_reference_writes_error_maps_and_metrics() {
     assert!(!out.join("raycast").join("error.png").exists());
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+/// `penumbra golden` outside the repository refuses (exit 2, one line naming the directory)
+/// and writes nothing where it was run: before, `--bless` wrote a whole golden tree into the
+/// current directory and then failed.
+#[test]
+fn golden_outside_the_repository_refuses_and_writes_nothing() {
+    let dir = fresh_out("golden-elsewhere");
+    std::fs::create_dir_all(&dir).unwrap();
+    for args in [&["golden"][..], &["golden", "--bless"][..]] {
+        let output = Command::new(env!("CARGO_BIN_EXE_penumbra"))
+            .args(args)
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{args:?}: {stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(
+            stderr.contains("golden: not the golden directory of a penumbra repository"),
+            "{stderr}"
+        );
+        assert!(
+            entries(&dir).is_empty(),
+            "{args:?} wrote {:?}",
+            entries(&dir)
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -510,6 +510,7 @@ pub fn run_cases(root: &Path, bless_all: bool) -> Result<String, String> {
     };
     let mut report = String::new();
     let mut failures = Vec::new();
+    let (mut cases_changed, mut files_changed) = (0, 0);
     for group in groups() {
         let rendered = match render_group(&base, &group) {
             Ok(r) => r,
@@ -521,18 +522,33 @@ pub fn run_cases(root: &Path, bless_all: bool) -> Result<String, String> {
         for (case, output) in rendered {
             let (scene, method) = (case.scene_dir(), case.method_dir());
             let result = if bless_all {
-                bless(root, scene, &method, &output).map(drop)
+                bless(root, scene, &method, &output).map(|changed| {
+                    if changed.is_empty() {
+                        "unchanged".to_string()
+                    } else {
+                        cases_changed += 1;
+                        files_changed += changed.len();
+                        let names: Vec<String> = changed
+                            .iter()
+                            .filter_map(|p| p.file_name().map(|f| f.to_string_lossy().into()))
+                            .collect();
+                        format!("re-blessed ({})", names.join(", "))
+                    }
+                })
             } else {
-                check(root, scene, &method, case.size, case.size, &output)
+                check(root, scene, &method, case.size, case.size, &output).map(|()| "ok".into())
             };
             match result {
-                Ok(()) => {
-                    let verb = if bless_all { "blessed" } else { "ok" };
-                    report += &format!("{verb} {scene}/{method}\n");
-                }
+                Ok(verb) => report += &format!("{verb} {scene}/{method}\n"),
                 Err(e) => failures.push(format!("{scene}/{method}: {e}")),
             }
         }
+    }
+    if bless_all {
+        report += &match files_changed {
+            0 => "nothing changed\n".to_string(),
+            n => format!("{n} files re-blessed in {cases_changed} goldens\n"),
+        };
     }
     if failures.is_empty() {
         Ok(report)

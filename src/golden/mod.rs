@@ -159,7 +159,8 @@ fn existing_golden_files(dir: &Path) -> Result<Vec<String>, String> {
 }
 
 /// Rewrites the goldens of `scene`/`method` under `root` from `out` and returns the paths
-/// written. The size is taken from `out.stats.width`/`height` (and must match the buffers).
+/// it changed: files whose bytes differ or that did not exist are written (nothing else), and
+/// removed stale files are listed too. The size is taken from `out.stats.width`/`height` (and must match the buffers).
 /// Golden files of that method that `out` no longer produces (`*.pfm`, `*.png`, `*.json`) are
 /// removed.
 pub fn bless(
@@ -183,16 +184,29 @@ fn bless_sized(
     check_component("method", method)?;
     let dir = golden_dir(root, scene, method);
     let files = golden_files(out, width, height)?;
-    write_files_all_or_nothing(&dir, &files)
-        .map_err(|e| format!("golden: writing {}: {e}", dir.display()))?;
-    for stale in existing_golden_files(&dir)? {
-        if !files.iter().any(|(f, _)| *f == stale) {
-            let p = dir.join(&stale);
-            std::fs::remove_file(&p)
-                .map_err(|e| format!("golden: removing stale {}: {e}", p.display()))?;
-        }
+    let stale: Vec<String> = existing_golden_files(&dir)?
+        .into_iter()
+        .filter(|name| !files.iter().any(|(f, _)| f == name))
+        .collect();
+    let changed: Vec<(String, Vec<u8>)> = files
+        .into_iter()
+        .filter(|(name, bytes)| std::fs::read(dir.join(name)).ok().as_ref() != Some(bytes))
+        .collect();
+    if !changed.is_empty() {
+        write_files_all_or_nothing(&dir, &changed)
+            .map_err(|e| format!("golden: writing {}: {e}", dir.display()))?;
     }
-    Ok(files.into_iter().map(|(f, _)| dir.join(f)).collect())
+    for name in &stale {
+        let p = dir.join(name);
+        std::fs::remove_file(&p)
+            .map_err(|e| format!("golden: removing stale {}: {e}", p.display()))?;
+    }
+    Ok(changed
+        .into_iter()
+        .map(|(f, _)| f)
+        .chain(stale)
+        .map(|f| dir.join(f))
+        .collect())
 }
 
 /// Checks `out` (a `width×height` render of `scene` by `method`) against the goldens under
@@ -211,8 +225,8 @@ pub fn check(
     out: &MethodOutput,
 ) -> Result<(), String> {
     if bless_requested() {
-        let written = bless_sized(root, scene, method, width, height, out)?;
-        for p in written {
+        let changed = bless_sized(root, scene, method, width, height, out)?;
+        for p in changed {
             eprintln!("blessed {}", p.display());
         }
         return Ok(());
@@ -715,6 +729,31 @@ mod tests {
         bless(&root, "scene", "hard-sv", &no_raw).unwrap();
         assert!(!root.join("scene/hard-sv/stencil.png").exists());
         run(&root, &fails, &no_raw).unwrap();
+        std::fs::remove_dir_all(&base).unwrap();
+    }
+
+    /// `bless` writes and reports only what changed, so `golden --bless` can say "nothing
+    /// changed" or name the re-blessed files.
+    #[test]
+    fn bless_reports_only_changed_files() {
+        let (base, root, _) = roots("changed");
+        let out = base_out();
+        let dir = root.join("scene/hard-sv");
+        let first = bless(&root, "scene", "hard-sv", &out).unwrap();
+        assert_eq!(first.len(), 3, "{first:?}");
+        assert!(bless(&root, "scene", "hard-sv", &out).unwrap().is_empty());
+        let mut one_pixel = out.clone();
+        one_pixel.raw_images[0].values[2] = 255;
+        assert_eq!(
+            bless(&root, "scene", "hard-sv", &one_pixel).unwrap(),
+            vec![dir.join("stencil.png")]
+        );
+        let no_raw = output(vec![0.0, 0.25, 0.5, 0.75, 1.0, 0.125], None);
+        assert_eq!(
+            bless(&root, "scene", "hard-sv", &no_raw).unwrap(),
+            vec![dir.join("stencil.png")],
+            "the removed stale file is a change"
+        );
         std::fs::remove_dir_all(&base).unwrap();
     }
 
