@@ -1,4 +1,4 @@
-//! The `penumbra` command line: `render`, `list`, `golden`. With no arguments it renders the
+//! The `penumbra` command line: `render`, `list`, `experiment`, `golden`. With no arguments it renders the
 //! built-in default scene with every available method into `out/` and prints the error/time
 //! table. Bad input prints one line naming the file and the problem and exits with code 2,
 //! before any output is written.
@@ -31,22 +31,9 @@ enum Cmd {
     Render(RenderArgs),
     /// Print the built-in scenes and the methods, one per line.
     List,
-    /// Run an experiment: `tile-size SCENE` (Paper II §7, sphere light) or
-    /// `wedge-blending [SCENE]` (Forest et al. 2006: error and time of the overlap
-    /// correction; default scenes cube-of-spheres and forest-spheres).
-    Experiment {
-        /// The experiment: `tile-size` or `wedge-blending`.
-        #[arg(value_parser = ["tile-size", "wedge-blending"])]
-        name: String,
-        /// Scene file or built-in name (required for tile-size).
-        scene: Option<String>,
-        /// Output directory for the CSV files, plots and summary.
-        #[arg(long, default_value = "out/experiment")]
-        out: PathBuf,
-        /// Image side for wedge-blending (errors at SIZE², times at SIZE² and (2·SIZE)²).
-        #[arg(long, default_value_t = 256)]
-        size: u32,
-    },
+    /// Run an experiment, or merge the shards of an accuracy–time sweep.
+    #[command(subcommand)]
+    Experiment(ExperimentCmd),
     /// Check (or with --bless rewrite) the golden outputs under golden/.
     Golden {
         /// Rewrite the goldens instead of checking them.
@@ -55,6 +42,58 @@ enum Cmd {
         /// Golden root directory.
         #[arg(long, default_value = "golden")]
         root: PathBuf,
+    },
+}
+
+#[derive(Subcommand, Debug)]
+enum ExperimentCmd {
+    /// Paper II §7: pw-restructured's memory traffic per tile size (sphere light).
+    TileSize {
+        /// Scene file or built-in name (sphere light).
+        scene: String,
+        /// Output directory for the CSV file, plot and summary.
+        #[arg(long, default_value = "out/experiment")]
+        out: PathBuf,
+    },
+    /// Forest et al. 2006: error and time of the overlap correction (default scenes
+    /// cube-of-spheres and forest-spheres).
+    WedgeBlending {
+        /// Scene file or built-in name (one rect light).
+        scene: Option<String>,
+        /// Output directory for the CSV files and summary.
+        #[arg(long, default_value = "out/experiment")]
+        out: PathBuf,
+        /// Image side (errors at SIZE², times at SIZE² and (2·SIZE)²).
+        #[arg(long, default_value_t = 256)]
+        size: u32,
+    },
+    /// Error against a 1024-sample raycast reference and time of every method and knob
+    /// setting that applies to each scene, with a Pareto plot per scene.
+    AccuracyTime {
+        /// Scene files or built-in names.
+        #[arg(required = true)]
+        scenes: Vec<String>,
+        /// Output directory.
+        #[arg(long, default_value = penumbra::experiment::accuracy_time::DEFAULT_OUT)]
+        out: PathBuf,
+        /// Render at SIZE×SIZE instead of each scene's own size.
+        #[arg(long)]
+        size: Option<u32>,
+        /// Measure only slice I of N (1-based, e.g. 2/4): the items k with k mod N = I − 1.
+        #[arg(long)]
+        shard: Option<String>,
+        /// Timed runs per configuration (their median, min and max are reported).
+        #[arg(long, default_value_t = penumbra::experiment::accuracy_time::TIMING_RUNS)]
+        runs: usize,
+    },
+    /// Join the outputs of accuracy-time shards into what an unsharded run writes.
+    Merge {
+        /// The shards' output directories.
+        #[arg(required = true)]
+        dirs: Vec<PathBuf>,
+        /// Output directory.
+        #[arg(long, default_value = penumbra::experiment::accuracy_time::DEFAULT_OUT)]
+        out: PathBuf,
     },
 }
 
@@ -148,6 +187,124 @@ fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
+/// A scene argument, loaded and validated.
+fn load_scene(arg: &str) -> Result<Scene, InputError> {
+    let scene = file::resolve(arg)?;
+    validate::validate(&scene)?;
+    Ok(scene)
+}
+
+fn experiment(cmd: ExperimentCmd) -> Result<(), Box<dyn std::error::Error>> {
+    use penumbra::experiment::{accuracy_time, sized, tile_size, wedge_blending};
+    let size_range = |size: u32| {
+        if (16..=2048).contains(&size) {
+            Ok(size)
+        } else {
+            Err(InputError::at(
+                "--size",
+                size.to_string(),
+                "expected 16…2048",
+            ))
+        }
+    };
+    match cmd {
+        ExperimentCmd::TileSize { scene, out } => {
+            print!("{}", tile_size::run(&load_scene(&scene)?, &out)?);
+            println!(
+                "outputs: {0}/tile_size.csv, {0}/tile_size.svg",
+                out.display()
+            );
+        }
+        ExperimentCmd::WedgeBlending { scene, out, size } => {
+            let scenes = match scene {
+                Some(s) => vec![load_scene(&s)?],
+                None => wedge_blending::SCENES
+                    .iter()
+                    .map(|n| builtin::load(n).ok_or("missing built-in scene"))
+                    .collect::<Result<_, _>>()?,
+            };
+            if let Some(bad) = scenes.iter().find(|s| {
+                !penumbra::methods::supports_scene("wedge-blending", s) || s.is_multi_light()
+            }) {
+                return Err(InputError::at(
+                    &bad.source,
+                    "light",
+                    "the wedge-blending experiment needs one rect light",
+                )
+                .into());
+            }
+            print!("{}", wedge_blending::run(&scenes, size_range(size)?, &out)?);
+            println!(
+                "outputs: {0}/wedge_blending_errors.csv, {0}/wedge_blending_times.csv, {0}/summary.md",
+                out.display()
+            );
+        }
+        ExperimentCmd::AccuracyTime {
+            scenes,
+            out,
+            size,
+            shard,
+            runs,
+        } => {
+            let shard = match shard {
+                Some(spec) => accuracy_time::Shard::parse(&spec)?,
+                None => accuracy_time::Shard::WHOLE,
+            };
+            let size = size.map(size_range).transpose()?;
+            let mut loaded = Vec::new();
+            for arg in &scenes {
+                let scene = load_scene(arg)?;
+                let scene = match size {
+                    Some(n) => sized(scene, n),
+                    None => scene,
+                };
+                // The sweep keeps one method's output at a time.
+                for m in penumbra::methods::ALL {
+                    memory::check_fits(
+                        &scene,
+                        &[m.to_string()],
+                        memory::default_limit(),
+                        "half of the machine's memory",
+                    )?;
+                }
+                loaded.push(scene);
+            }
+            let sweep = accuracy_time::run(&loaded, accuracy_time::CONFIGURATIONS, runs, shard)?;
+            accuracy_time::write(&sweep, &out)?;
+            print!("{}", accuracy_time::summary(&sweep));
+            print_accuracy_outputs(&sweep, &out);
+        }
+        ExperimentCmd::Merge { dirs, out } => {
+            let shards = dirs
+                .iter()
+                .map(|d| Ok((d.display().to_string(), accuracy_time::read(d)?)))
+                .collect::<Result<Vec<_>, InputError>>()?;
+            let sweep = accuracy_time::merge(&shards)?;
+            accuracy_time::write(&sweep, &out)?;
+            print!("{}", accuracy_time::summary(&sweep));
+            print_accuracy_outputs(&sweep, &out);
+        }
+    }
+    Ok(())
+}
+
+/// The files an accuracy-time run or merge wrote.
+fn print_accuracy_outputs(
+    sweep: &penumbra::experiment::accuracy_time::Sweep,
+    out: &std::path::Path,
+) {
+    use penumbra::experiment::accuracy_time::{CSV_FILE, JSON_FILE};
+    let plots = if sweep.shard == penumbra::experiment::accuracy_time::Shard::WHOLE {
+        ", SCENE-pareto.png, SCENE-pareto.svg"
+    } else {
+        " (a shard: plots come from `experiment merge`)"
+    };
+    println!(
+        "outputs: {}/{{{CSV_FILE}, {JSON_FILE}, summary.md}}{plots}",
+        out.display()
+    );
+}
+
 fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(n) = cli.threads {
         let bad = |why: String| InputError::at("--threads", n.to_string(), why);
@@ -194,61 +351,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
             }
             Ok(())
         }
-        Some(Cmd::Experiment {
-            name,
-            scene,
-            out,
-            size,
-        }) => {
-            let scene = scene.map(|s| file::resolve(&s)).transpose()?;
-            if let Some(s) = &scene {
-                validate::validate(s)?;
-            }
-            if name == "wedge-blending" {
-                let scenes = match scene {
-                    Some(s) => vec![s],
-                    None => penumbra::experiment::wedge_blending::SCENES
-                        .iter()
-                        .map(|n| builtin::load(n).ok_or("missing built-in scene"))
-                        .collect::<Result<_, _>>()?,
-                };
-                if let Some(bad) = scenes.iter().find(|s| {
-                    !penumbra::methods::supports_scene("wedge-blending", s) || s.is_multi_light()
-                }) {
-                    return Err(InputError::at(
-                        &bad.source,
-                        "light",
-                        "the wedge-blending experiment needs one rect light",
-                    )
-                    .into());
-                }
-                if !(16..=2048).contains(&size) {
-                    return Err(InputError::at("--size", "size", "expected 16…2048").into());
-                }
-                print!(
-                    "{}",
-                    penumbra::experiment::wedge_blending::run(&scenes, size, &out)?
-                );
-                println!(
-                    "outputs: {0}/wedge_blending_errors.csv, {0}/wedge_blending_times.csv, {0}/summary.md",
-                    out.display()
-                );
-                return Ok(());
-            }
-            let scene = scene.ok_or_else(|| {
-                InputError::at(
-                    "experiment",
-                    "scene",
-                    "tile-size needs a SCENE (sphere light)",
-                )
-            })?;
-            print!("{}", penumbra::experiment::tile_size::run(&scene, &out)?);
-            println!(
-                "outputs: {0}/tile_size.csv, {0}/tile_size.svg",
-                out.display()
-            );
-            Ok(())
-        }
+        Some(Cmd::Experiment(e)) => experiment(e),
         Some(Cmd::Render(a)) => render(&a),
         Some(Cmd::List) => {
             println!("# built-in scenes");

@@ -1,5 +1,26 @@
 //! Experiments that sweep a parameter and report counters (DESIGN.md "report/": sweeps,
 //! CSV, plots).
 
+pub mod accuracy_time;
 pub mod tile_size;
 pub mod wedge_blending;
+
+use crate::scene::{OptionValue, Scene};
+
+/// `scene` with `method`'s options `knobs` set on top of its own `[options.METHOD]` table,
+/// each value read as `--opt METHOD.KEY=VALUE` reads it ([`OptionValue::parse_cli`]).
+pub fn configured(scene: &Scene, method: &str, knobs: &[(&str, &str)]) -> Scene {
+    let mut s = scene.clone();
+    let table = s.options.entry(method.to_string()).or_default();
+    for (k, v) in knobs {
+        table.insert(k.to_string(), OptionValue::parse_cli(v));
+    }
+    s
+}
+
+/// `scene` rendered at `size`×`size` pixels.
+pub fn sized(mut scene: Scene, size: u32) -> Scene {
+    scene.width = size;
+    scene.height = size;
+    scene
+}

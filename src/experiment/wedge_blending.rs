@@ -29,6 +29,7 @@
 //! command prints (also `summary.md`). Errors and counters are deterministic; times are
 //! informational and depend on the machine.
 
+use super::{configured, sized};
 use crate::error::InputError;
 use crate::frame::{Frame, GpuSettings};
 use crate::light::coverage::RectLight;
@@ -37,7 +38,7 @@ use crate::methods::output::Visibility;
 use crate::methods::wedge_blending::{self, render_probed, ProbeStep};
 use crate::metrics::{compare_where, ErrorStats};
 use crate::plan::segment_hits_mesh;
-use crate::scene::{builtin, OptionValue, Scene};
+use crate::scene::{builtin, Scene};
 use glam::DVec3;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -220,26 +221,12 @@ fn variant(label: &str) -> &'static Variant {
         .expect("a listed variant")
 }
 
-/// `scene` with `v`'s options.
-fn configured(scene: &Scene, v: &Variant) -> Scene {
-    let mut s = scene.clone();
-    let table = s.options.entry(v.method.to_string()).or_default();
-    for (k, val) in v.options {
-        let value = val
-            .parse::<i64>()
-            .map(OptionValue::Int)
-            .unwrap_or_else(|_| OptionValue::Str(val.to_string()));
-        table.insert(k.to_string(), value);
-    }
-    s
-}
-
 /// Run `v` on `frame`'s geometry (the scene pass is shared).
 fn run_variant(
     frame: &Frame,
     v: &Variant,
 ) -> Result<crate::methods::output::MethodOutput, InputError> {
-    let scene = configured(frame.scene, v);
+    let scene = configured(frame.scene, v.method, v.options);
     crate::methods::run(v.method, &frame.lit_by(&scene))
 }
 
@@ -252,7 +239,12 @@ pub fn measure_scene(scene: &Scene) -> Result<SceneReport, InputError> {
     let frame = Frame::render(scene, GpuSettings::default())?;
     let reference = crate::methods::run("raycast", &frame)?.visibility;
     let f32_variant = variant("wedge-blending f32");
-    let unpacked = wedge_blending::options(&frame.lit_by(&configured(scene, f32_variant)))?.0;
+    let unpacked = wedge_blending::options(&frame.lit_by(&configured(
+        scene,
+        f32_variant.method,
+        f32_variant.options,
+    )))?
+    .0;
     let mask_render = wedge_blending::render(&frame, &unpacked)?;
     let overlap: Vec<bool> = mask_render.penumbrae.iter().map(|n| *n >= 2).collect();
     let mut errors = Vec::new();
@@ -623,13 +615,6 @@ fn times_csv(rows: &[TimeRow]) -> String {
         );
     }
     s
-}
-
-/// `scene` at `size`².
-fn sized(mut scene: Scene, size: u32) -> Scene {
-    scene.width = size;
-    scene.height = size;
-    scene
 }
 
 /// The whole experiment on `scenes` (module doc) at `size`; writes the CSVs and `summary.md`

@@ -6,7 +6,7 @@
 //! result does not depend on threads or scheduling.
 
 use crate::methods::output::Visibility;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 pub mod error_report;
 
@@ -16,7 +16,7 @@ pub mod error_report;
 /// `mean_abs`; a pixel counts towards `pct_over_1_255` when **any** of its channels is off by
 /// more than 1/255. A NaN difference (NaN on one side only, or with different bits) makes
 /// `rmse`, `mean_abs` and `max_abs` NaN and counts as off, so it cannot hide.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct ErrorStats {
     /// Root mean square of the differences.
     pub rmse: f64,
