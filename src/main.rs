@@ -105,10 +105,10 @@ struct RenderArgs {
     /// Comma-separated methods (default: the scene's list, else every method its light supports).
     #[arg(long, value_delimiter = ',')]
     methods: Option<Vec<String>>,
-    /// Override the image width.
+    /// Override the image width (alone, the height follows the scene's aspect ratio).
     #[arg(long)]
     width: Option<u32>,
-    /// Override the image height.
+    /// Override the image height (alone, the width follows the scene's aspect ratio).
     #[arg(long)]
     height: Option<u32>,
     /// Output directory.
@@ -127,12 +127,7 @@ fn apply_overrides(scene: &mut Scene, a: &RenderArgs) -> Result<(), InputError> 
     if let Some(m) = &a.methods {
         scene.methods = Some(m.clone());
     }
-    if let Some(w) = a.width {
-        scene.width = w;
-    }
-    if let Some(h) = a.height {
-        scene.height = h;
-    }
+    scene.resize(a.width, a.height);
     for o in &a.opts {
         let bad = || InputError::at("--opt", o.as_str(), "expected METHOD.KEY=VALUE");
         let (lhs, value) = o.split_once('=').ok_or_else(bad)?;

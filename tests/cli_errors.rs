@@ -726,3 +726,20 @@ fn golden_outside_the_repository_refuses_and_writes_nothing() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// `--width` alone keeps the scene's aspect ratio (the height follows), as users expect.
+#[test]
+fn width_alone_keeps_the_aspect_ratio() {
+    let scene = penumbra::scene::builtin::load("cube-of-spheres").unwrap();
+    let (output, out) = render(
+        "aspect",
+        &["cube-of-spheres", "--width", "40", "--methods", "hard-sv"],
+    );
+    assert_eq!(output.status.code(), Some(0));
+    let stats: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("hard-sv/stats.json")).unwrap()).unwrap();
+    let expected = (40.0 * f64::from(scene.height) / f64::from(scene.width)).round();
+    assert_eq!(stats["width"], 40);
+    assert_eq!(stats["height"].as_f64(), Some(expected));
+    std::fs::remove_dir_all(&out).unwrap();
+}

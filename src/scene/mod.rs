@@ -186,6 +186,24 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// Set the image size from `width` and/or `height`: one given alone keeps the scene's
+    /// aspect ratio (the other side rounded to the nearest pixel, at least 1), both replace
+    /// both, neither changes nothing.
+    pub fn resize(&mut self, width: Option<u32>, height: Option<u32>) {
+        let scaled = |side: u32, from: u32, to: u32| -> u32 {
+            let exact = u64::from(side) * u64::from(to);
+            let rounded = (2 * exact + u64::from(from)) / (2 * u64::from(from).max(1));
+            rounded.clamp(1, u64::from(u32::MAX)) as u32
+        };
+        let (w0, h0) = (self.width, self.height);
+        (self.width, self.height) = match (width, height) {
+            (Some(w), Some(h)) => (w, h),
+            (Some(w), None) => (w, scaled(h0, w0, w)),
+            (None, Some(h)) => (scaled(w0, h0, h), h),
+            (None, None) => (w0, h0),
+        };
+    }
+
     /// The light of a single-light scene. Methods that render one light at a time only ever
     /// see single-light scenes ([`Scene::with_only_light`]); for a multi-light scene this is
     /// the first light.
@@ -248,5 +266,27 @@ impl Scene {
             }
         }
         (lo, hi)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// `--width` or `--height` alone keeps the aspect ratio; both replace both.
+    #[test]
+    fn resize_keeps_the_aspect_ratio_when_one_side_is_given() {
+        let mut s = super::builtin::load("single-quad").unwrap();
+        (s.width, s.height) = (320, 240);
+        s.resize(Some(64), None);
+        assert_eq!((s.width, s.height), (64, 48));
+        s.resize(None, Some(100));
+        assert_eq!((s.width, s.height), (133, 100), "133.33 rounds down");
+        s.resize(Some(2), None);
+        assert_eq!((s.width, s.height), (2, 2), "1.5 rounds up");
+        s.resize(Some(1), None);
+        assert_eq!((s.width, s.height), (1, 1), "never 0");
+        s.resize(Some(30), Some(10));
+        assert_eq!((s.width, s.height), (30, 10));
+        s.resize(None, None);
+        assert_eq!((s.width, s.height), (30, 10));
     }
 }
