@@ -28,6 +28,9 @@
 //! [[meshes]]
 //! obj = "models/bunny.obj"    # relative to the scene file
 //! transform = [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]   # optional, column-major, affine
+//! # or instead of transform, its parts (each optional; scaled, then rotated, then moved):
+//! # scale = 2.0 or [sx, sy, sz]; rotate_deg = [x, y, z] (Euler angles in degrees about the
+//! # world axes, X first, then Y, then Z); translate = [tx, ty, tz]
 //! color = [0.8, 0.8, 0.8]     # optional, linear RGB albedo
 //!
 //! [options.nsample]           # per-method options, checked later by each method
@@ -47,7 +50,7 @@ use super::validate::validate;
 use super::{builtin, Camera, Light, LightShape, Mesh, OptionValue, RawOptions, RgbTexture, Scene};
 use crate::error::InputError;
 use crate::limits::MAX_LIGHTS;
-use glam::{DVec3, Mat4, Vec3};
+use glam::{DMat4, DVec3, Mat4, Vec3};
 use serde::de::{self, IgnoredAny, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 use std::collections::BTreeMap;
@@ -125,7 +128,18 @@ struct LightDef {
 struct MeshDef {
     obj: String,
     transform: Option<Vec<f64>>,
+    scale: Option<Scale>,
+    rotate_deg: Option<Three>,
+    translate: Option<Three>,
     color: Option<Three>,
+}
+
+/// `scale`: one number for all three axes, or three numbers.
+#[derive(Deserialize, Clone, Copy)]
+#[serde(untagged, expecting = "a number or three numbers")]
+enum Scale {
+    Uniform(f64),
+    PerAxis(Three),
 }
 
 /// Exactly three numbers (a point, a vector or an RGB colour): a list of any other length is
@@ -477,12 +491,46 @@ fn build_light(
     })
 }
 
+/// The matrix of a mesh's `scale`, `rotate_deg` and `translate` (each optional): T · R · S,
+/// so the mesh is scaled first, then rotated, then moved. `rotate_deg = [x, y, z]` are Euler
+/// angles in degrees about the world axes, applied X first, then Y, then Z
+/// (R = R_z · R_y · R_x), each counter-clockwise looking down its axis toward the origin
+/// (right-handed). Computed in f64, rounded to f32 once, as a written `transform` is.
+fn transform_from_parts(m: &MeshDef) -> Mat4 {
+    let scale = match m.scale {
+        None => DVec3::ONE,
+        Some(Scale::Uniform(k)) => DVec3::splat(k),
+        Some(Scale::PerAxis(k)) => DVec3::from_array(k.0),
+    };
+    let [x, y, z] = m.rotate_deg.map_or([0.0; 3], |r| r.0.map(f64::to_radians));
+    let rotation =
+        DMat4::from_rotation_z(z) * DMat4::from_rotation_y(y) * DMat4::from_rotation_x(x);
+    let translation = m.translate.map_or(DVec3::ZERO, |t| DVec3::from_array(t.0));
+    let mat = DMat4::from_translation(translation) * rotation * DMat4::from_scale(scale);
+    Mat4::from_cols_array(&mat.to_cols_array().map(|x| x as f32))
+}
+
 fn build_mesh(m: &MeshDef, i: usize, source: &str, base_dir: &Path) -> Result<Mesh, InputError> {
     let at = |field: &str, message: String| {
         InputError::at(source, format!("meshes[{i}]{field}"), message)
     };
+    let parts = m.scale.is_some() || m.rotate_deg.is_some() || m.translate.is_some();
     let transform = match &m.transform {
-        None => None,
+        Some(_) if parts => {
+            return Err(at(
+                "",
+                "has `transform` and `scale`/`rotate_deg`/`translate`: give either the matrix \
+                 or its parts"
+                    .into(),
+            ))
+        }
+        None if !parts => None,
+        None => {
+            let mat = transform_from_parts(m);
+            let field = ".scale/.rotate_deg/.translate";
+            check_transform(&mat).map_err(|e| at(field, e))?;
+            Some(mat)
+        }
         Some(t) => {
             let arr: [f64; 16] = t.as_slice().try_into().map_err(|_| {
                 at(
@@ -603,6 +651,55 @@ f = 0.5
 
     fn toml(text: &str) -> Result<Scene, InputError> {
         toml_in(&fixture(), text)
+    }
+
+    /// `scale`, `rotate_deg` and `translate` give the matrix T · R_z · R_y · R_x · S: the
+    /// tetrahedron's vertex (1, 1, 0) scaled by 2 is (2, 2, 0), turned 90° about Y (x → −z)
+    /// (0, 2, −2), moved by (1, 2, 3) (1, 4, 1); scale per axis and alone; errors name the mesh.
+    #[test]
+    fn transform_parts_scale_then_rotate_then_translate() {
+        let with =
+            |parts: &str| GOOD.replace("transform = [1,0,0,0, 0,1,0,0, 0,0,1,0, 0.5,0,0,1]", parts);
+        let near = |s: &Scene, p: Vec3| {
+            s.meshes[1]
+                .positions
+                .iter()
+                .any(|q| (*q - p).length() < 1e-6)
+        };
+        let s = toml(&with(
+            "scale = 2\nrotate_deg = [0, 90, 0]\ntranslate = [1, 2, 3]",
+        ))
+        .unwrap();
+        assert!(
+            near(&s, Vec3::new(1.0, 4.0, 1.0)),
+            "{:?}",
+            s.meshes[1].positions
+        );
+        // X first, then Y: (0, 1, 0) turned 90° about X is (0, 0, 1), then about Y (1, 0, 0).
+        let s = toml(&with("rotate_deg = [90, 90, 0]")).unwrap();
+        assert!(
+            near(&s, Vec3::new(1.0, 0.0, 0.0)),
+            "{:?}",
+            s.meshes[1].positions
+        );
+        let s = toml(&with("scale = [1, 1.5, 1]")).unwrap();
+        assert!(near(&s, Vec3::new(0.0, 3.0, 0.0)));
+        let err = toml(&with(
+            "transform = [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]\nscale = 2",
+        ))
+        .unwrap_err()
+        .to_string();
+        assert!(
+            err.contains("meshes[1]: has `transform` and `scale`"),
+            "{err}"
+        );
+        let err = toml(&with("scale = 0")).unwrap_err().to_string();
+        assert!(
+            err.contains("meshes[1].scale/.rotate_deg/.translate: is singular"),
+            "{err}"
+        );
+        let err = toml(&with("scale = \"big\"")).unwrap_err().to_string();
+        assert!(err.contains("a number or three numbers"), "{err}");
     }
 
     #[test]
