@@ -16,7 +16,7 @@ use crate::gpu::setup::CullMode;
 use crate::gpu::tiling::Tiling;
 use crate::gpu::transform::{ClipVertex, Projection};
 use crate::methods::output::PassStats;
-use crate::scene::Scene;
+use crate::scene::{Mesh, Scene};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use std::sync::OnceLock;
@@ -94,8 +94,9 @@ pub struct Frame<'s> {
     pub gpu: GpuSettings,
     /// Tiling of the image.
     pub tiling: Tiling,
-    /// Edge adjacency of each mesh.
-    pub adjacency: Vec<Adjacency>,
+    /// The meshes that cast shadows (all but the receiver-only ones), in scene order: each
+    /// mesh's index in the scene and its edge adjacency.
+    pub casters: Vec<(usize, Adjacency)>,
     /// Scene depth and primitive ids, tile-major, hierarchical Z built.
     pub tiles: Vec<SceneTile>,
     /// Mesh index and triangle index of each primitive id.
@@ -111,20 +112,22 @@ pub struct Frame<'s> {
 impl<'s> Frame<'s> {
     /// Build adjacency and render the scene depth pass.
     pub fn render(scene: &'s Scene, gpu: GpuSettings) -> Result<Self, InputError> {
-        let adjacency = scene
+        let casters = scene
             .meshes
             .iter()
             .enumerate()
+            .filter(|(_, m)| !m.receiver_only)
             .map(|(k, m)| {
-                adjacency::build(m).map_err(|e| {
+                let adjacency = adjacency::build(m).map_err(|e| {
                     InputError::at(
                         &scene.source,
                         format!("meshes[{k}] ({})", m.name),
                         e.to_string(),
                     )
-                })
+                })?;
+                Ok((k, adjacency))
             })
-            .collect::<Result<Vec<_>, _>>()?;
+            .collect::<Result<Vec<_>, InputError>>()?;
         let tiling = Tiling::new(scene.width, scene.height, gpu.tile_size)
             .map_err(|e| InputError::at(&scene.source, "options.gpu.tile_size", e))?;
         let proj = Projection::for_scene(scene);
@@ -189,13 +192,28 @@ impl<'s> Frame<'s> {
             proj,
             gpu,
             tiling,
-            adjacency,
+            casters,
             tiles,
             prim_owner,
             pass,
             prim_rows: OnceLock::new(),
             depth_receivers: OnceLock::new(),
         })
+    }
+
+    /// The meshes that cast shadows with their adjacency ([`Frame::casters`]), in scene order:
+    /// what every method builds silhouettes, volumes and wedges from.
+    pub fn caster_meshes(&self) -> Vec<(&'s Mesh, &Adjacency)> {
+        self.casters
+            .iter()
+            .map(|(k, adj)| (&self.scene.meshes[*k], adj))
+            .collect()
+    }
+
+    /// `meshes[i] (name)`, the object an error names, for the `k`-th of [`Frame::casters`].
+    pub fn caster_object(&self, k: usize) -> String {
+        let i = self.casters[k].0;
+        format!("meshes[{i}] ({})", self.scene.meshes[i].name)
     }
 
     /// This frame for `scene`, a scene that differs from this frame's only in its lights
@@ -213,7 +231,7 @@ impl<'s> Frame<'s> {
             proj: self.proj.clone(),
             gpu: self.gpu,
             tiling: self.tiling,
-            adjacency: self.adjacency.clone(),
+            casters: self.casters.clone(),
             tiles: self.tiles.clone(),
             prim_owner: self.prim_owner.clone(),
             pass: self.pass.clone(),
@@ -463,6 +481,7 @@ mod tests {
             ],
             triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
             color: [0.5; 3],
+            receiver_only: false,
         });
         crate::scene::validate::validate(&s).unwrap();
         // Outside the tetrahedron, looking along its face x = 1 toward −z; the near plane's

@@ -115,7 +115,7 @@ pub fn near_rect_meets_shadow(scene: &Scene, near: f64, lights: &[Vec3]) -> bool
     let min_area = area(&rect) * 1e-12;
     lights.iter().any(|l| {
         let l = l.as_dvec3();
-        scene.meshes.iter().any(|m| {
+        scene.meshes.iter().filter(|m| !m.receiver_only).any(|m| {
             m.triangles.iter().any(|t| {
                 let [a, b, c] = t.map(|i| m.positions[i as usize].as_dvec3());
                 let n = (b - a).cross(c - a);
@@ -159,10 +159,15 @@ fn clip(poly: &[DVec3], h: DVec3, d: f64) -> Vec<DVec3> {
     out
 }
 
-/// Whether the open segment p→q crosses any scene triangle (exact f64 test, used for the
-/// z-fail decision and as hard-shadow ground truth in tests).
+/// Whether the open segment p→q crosses a triangle of a mesh that casts shadows (not a
+/// receiver-only one; exact f64 test, used for the z-fail decision and as hard-shadow ground
+/// truth in tests).
 pub fn segment_blocked(scene: &Scene, p: DVec3, q: DVec3) -> bool {
-    scene.meshes.iter().any(|m| segment_hits_mesh(m, p, q))
+    scene
+        .meshes
+        .iter()
+        .filter(|m| !m.receiver_only)
+        .any(|m| segment_hits_mesh(m, p, q))
 }
 
 /// Whether the open segment p→q crosses a triangle of `mesh` (exact f64 test).

@@ -272,6 +272,7 @@ fn l_slab() -> Mesh {
         positions,
         triangles,
         color: [0.5; 3],
+        receiver_only: false,
     }
 }
 
@@ -500,7 +501,7 @@ fn concave_occluders_keep_the_farthest_crossing() {
     };
     let disk = Disk::new(scene.light().center, normal, radius);
     let frame = Frame::render(&scene, GpuSettings::default()).unwrap();
-    let meshes: Vec<_> = scene.meshes.iter().zip(&frame.adjacency).collect();
+    let meshes = frame.caster_meshes();
     let ex = Extrusion {
         bound: r.range / (1.0 + dbuffer::BOUND_MARGIN),
         fan_segments: dbuffer::DEFAULT_FAN_SEGMENTS,

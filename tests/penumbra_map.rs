@@ -248,7 +248,7 @@ fn overlapping_penumbrae_keep_the_darkest() {
         unreachable!()
     };
     let light = penumbra_map::cone_light(&full.view, radius);
-    let meshes: Vec<_> = scene.meshes.iter().zip(&frame.adjacency).collect();
+    let meshes = frame.caster_meshes();
     let sils = silhouettes(&meshes, scene.light().center).unwrap();
     let map_of = |parity: usize| {
         let (m, sl): (Vec<_>, Vec<_>) = scene

@@ -674,6 +674,7 @@ impl EdgeInput {
             positions: ends.to_vec(),
             triangles: vec![[0, 1, 1]],
             color: [0.8; 3],
+            receiver_only: false,
         };
         let apart = light_shape_touches(&edge, &light).is_none();
         let [e0, e1] = ends.map(|e| e.as_dvec3());
@@ -1050,6 +1051,7 @@ pub fn tight_wedge(data: &[u8]) {
             positions,
             triangles: Vec::new(),
             color: [0.8; 3],
+            receiver_only: false,
         }],
         methods: None,
         options: Default::default(),
@@ -1209,6 +1211,7 @@ pub fn pw_wedges(data: &[u8]) {
             positions,
             triangles,
             color: [0.8; 3],
+            receiver_only: false,
         }],
         methods: None,
         options: Default::default(),

@@ -265,6 +265,7 @@ mod tests {
             positions,
             triangles,
             color: [1.0; 3],
+            receiver_only: false,
         }
     }
 

@@ -281,11 +281,16 @@ impl LightView {
         )
     }
 
-    /// The clip coordinates of every triangle of `scene` in this view, meshes in file order,
-    /// triangles in order (the primitive ids of the scene pass).
-    fn scene_triangles(&self, scene: &Scene) -> Vec<[ClipVertex; 3]> {
+    /// The clip coordinates of the triangles of `scene` in this view, meshes in file order,
+    /// triangles in order: of every mesh (the primitive ids of the scene pass), or with
+    /// `casters_only` of the meshes that cast shadows (not the receiver-only ones).
+    fn scene_triangles(&self, scene: &Scene, casters_only: bool) -> Vec<[ClipVertex; 3]> {
         let mut prims = Vec::new();
-        for m in &scene.meshes {
+        for m in scene
+            .meshes
+            .iter()
+            .filter(|m| !(casters_only && m.receiver_only))
+        {
             let clip: Vec<ClipVertex> = m
                 .positions
                 .iter()
@@ -301,7 +306,11 @@ impl LightView {
     /// [`PolygonOffset`] — for a depth offset applied when a map is read rather than when it
     /// is rendered. A triangle setup drops (seen edge-on) gets slope 0 and depth 1.
     pub fn depth_slopes(&self, scene: &Scene) -> Vec<(f64, f32)> {
-        let (tris, _) = setup_all(&self.scene_triangles(scene), CullMode::None, &self.tiling);
+        let (tris, _) = setup_all(
+            &self.scene_triangles(scene, false),
+            CullMode::None,
+            &self.tiling,
+        );
         let mut out = vec![(0.0, 1.0); scene.meshes.iter().map(|m| m.triangles.len()).sum()];
         for t in tris.iter().rev() {
             out[t.prim as usize] = (t.max_depth_slope(), t.z_range[1]);
@@ -318,10 +327,11 @@ impl LightView {
         self.depth.quantize(z) as f64 <= stored
     }
 
-    /// Render the depth of every mesh of `scene` from the light with polygon `offset`
-    /// (module doc, "The shadow map"): the tile-major depth target and the pass counters.
+    /// Render the depth of every mesh of `scene` that casts shadows (receiver-only meshes
+    /// cast none) from the light with polygon `offset` (module doc, "The shadow map"): the
+    /// tile-major depth target and the pass counters.
     pub fn render_depth(&self, scene: &Scene, offset: PolygonOffset) -> (Vec<DepthTile>, Counters) {
-        let prims = self.scene_triangles(scene);
+        let prims = self.scene_triangles(scene, true);
         let (tris, mut counters) = setup_all(&prims, CullMode::Back, &self.tiling);
         let bins = bin(&self.tiling, &tris);
         let mut tiles = alloc_tiles(&self.tiling, |_, len| DepthTile::cleared(self.depth, len));

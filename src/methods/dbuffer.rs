@@ -598,18 +598,13 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
 
     // Pass 1: the volumes (CPU).
     let t = Instant::now();
-    let meshes: Vec<_> = scene.meshes.iter().zip(&frame.adjacency).collect();
+    let meshes = frame.caster_meshes();
     let ex = Extrusion {
         bound,
         fan_segments: s.fan_segments,
     };
-    let volumes = build_volumes(&meshes, &disk, &ex).map_err(|(i, e)| {
-        InputError::at(
-            &scene.source,
-            format!("meshes[{i}] ({})", scene.meshes[i].name),
-            e,
-        )
-    })?;
+    let volumes = build_volumes(&meshes, &disk, &ex)
+        .map_err(|(i, e)| InputError::at(&scene.source, frame.caster_object(i), e))?;
     let pass_volumes = PassStats::since("volumes", t, Counters::default());
 
     // Pass 2: the D-buffer, three draws.
@@ -620,7 +615,7 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
     });
     let t = Instant::now();
     let mut scene_input = DrawInput::default();
-    for m in &scene.meshes {
+    for (m, _) in &meshes {
         let world: Vec<DVec3> = m.positions.iter().map(|p| p.as_dvec3()).collect();
         let clip: Vec<ClipVertex> = world
             .iter()

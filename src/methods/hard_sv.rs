@@ -140,7 +140,7 @@ pub fn stencil_shadow(
         ShadowTest::ZPass => Capping::Open,
         ShadowTest::ZFail => Capping::Capped,
     };
-    let meshes: Vec<_> = frame.scene.meshes.iter().zip(&frame.adjacency).collect();
+    let meshes = frame.caster_meshes();
     let prims = shadow_volume_triangles(&meshes, light, &frame.proj, capping);
     let state = volume_stencil_state(s.test, s.overflow);
     let depth = DepthState {

@@ -290,19 +290,14 @@ pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRende
 
     // The silhouette from the light center (CPU; the paper's 30 %).
     let t = Instant::now();
-    let meshes: Vec<_> = scene.meshes.iter().zip(&frame.adjacency).collect();
-    let sils = silhouettes(&meshes, light.center).map_err(|(i, e)| {
-        InputError::at(
-            &scene.source,
-            format!("meshes[{i}] ({})", scene.meshes[i].name),
-            e,
-        )
-    })?;
+    let meshes = frame.caster_meshes();
+    let sils = silhouettes(&meshes, light.center)
+        .map_err(|(i, e)| InputError::at(&scene.source, frame.caster_object(i), e))?;
     let pass_sil = PassStats::since("silhouettes", t, Counters::default());
 
     // Pass 2: cones and sheets into the penumbra map.
     let t = Instant::now();
-    let mesh_refs: Vec<_> = scene.meshes.iter().collect();
+    let mesh_refs: Vec<_> = meshes.iter().map(|(m, _)| *m).collect();
     let geometry = cones_and_sheets(
         &mesh_refs,
         &sils,

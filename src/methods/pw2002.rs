@@ -157,7 +157,7 @@ fn sphere_lights(scene: &Scene) -> Result<Vec<WedgeOptions>, InputError> {
 /// wedges go into one LI buffer, in light order, each with amounts scaled by 255/n).
 pub fn frame_wedges(frame: &Frame, s: &WedgeSettings) -> Result<WedgeSet, InputError> {
     let scene = frame.scene;
-    let meshes: Vec<_> = scene.meshes.iter().zip(&frame.adjacency).collect();
+    let meshes = frame.caster_meshes();
     let mut all = WedgeSet::default();
     for light in sphere_lights(scene)? {
         let opts = WedgeOptions {

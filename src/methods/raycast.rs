@@ -437,7 +437,8 @@ pub struct ShadowRayCaster {
 }
 
 impl ShadowRayCaster {
-    /// Collects the triangles of every mesh of `scene` and builds the BVH over them.
+    /// Collects the triangles of every mesh of `scene` that casts shadows (not the
+    /// receiver-only ones) and builds the BVH over them.
     pub fn new(scene: &Scene) -> Self {
         let (mesh_lo, mesh_hi) = scene.mesh_bounds();
         // δ uses the diagonal of the meshes' bounds as an f32 length.
@@ -471,7 +472,8 @@ impl ShadowRayCaster {
         let pad = BOX_PADDING * diagonal + 4.0 * f64::from(f32::EPSILON) * magnitude;
         let mut triangles = Vec::new();
         let mut shapes = Vec::new();
-        for mesh in &scene.meshes {
+        // Receiver-only meshes cast no shadow here either (methods stay comparable).
+        for mesh in scene.meshes.iter().filter(|m| !m.receiver_only) {
             for tri in &mesh.triangles {
                 let [a, b, c] = tri.map(|i| mesh.positions[i as usize].as_dvec3());
                 // f32 rounding moves the box by half an ulp, far less than `pad`.
@@ -892,6 +894,7 @@ mod tests {
             positions,
             triangles,
             color: [0.8; 3],
+            receiver_only: false,
         }
     }
 
@@ -935,6 +938,7 @@ mod tests {
             positions,
             triangles,
             color: [0.8; 3],
+            receiver_only: false,
         }
     }
 

@@ -387,7 +387,7 @@ fn render_with<V: VBufferTile>(frame: &Frame, settings: &SsvSettings) -> SsvRend
 fn edge_wedges(frame: &Frame, light: &WedgeLight) -> Vec<EdgeWedge> {
     let center = frame.scene.light().center;
     let mut out = Vec::new();
-    for (mesh, adj) in frame.scene.meshes.iter().zip(&frame.adjacency) {
+    for (mesh, adj) in frame.caster_meshes() {
         let facing = light_facing(mesh, center);
         for e in possible_silhouettes(mesh, adj, &facing) {
             let (e0, e1) = (e.b.as_dvec3(), e.a.as_dvec3());
@@ -409,7 +409,7 @@ fn hard_quads_pass<V: VBufferTile>(frame: &Frame, test: ShadowTest, vbuf: &mut [
         ShadowTest::ZPass => Capping::Open,
         ShadowTest::ZFail => Capping::Capped,
     };
-    let meshes: Vec<_> = frame.scene.meshes.iter().zip(&frame.adjacency).collect();
+    let meshes = frame.caster_meshes();
     let prims = shadow_volume_triangles(&meshes, frame.scene.light().center, &frame.proj, capping);
     let (tris, mut counters) = setup_all(&prims, CullMode::None, &frame.tiling);
     let bins = bin(&frame.tiling, &tris);

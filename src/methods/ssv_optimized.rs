@@ -350,11 +350,11 @@ const HALVES_PER_CLEAR: usize = 255;
 /// The silhouette edges (a, b) of every mesh from light point `c`, and their loops.
 fn silhouettes(frame: &Frame, c: Vec3) -> Result<Vec<Vec<[DVec3; 2]>>, InputError> {
     let mut loops = Vec::new();
-    for (mi, (mesh, adj)) in frame.scene.meshes.iter().zip(&frame.adjacency).enumerate() {
+    for (k, (mesh, adj)) in frame.caster_meshes().into_iter().enumerate() {
         let facing = light_facing(mesh, c);
         let edges = possible_silhouettes(mesh, adj, &facing);
         let mesh_loops = silhouette_loops(&edges)
-            .map_err(|e| InputError::at(&frame.scene.source, format!("meshes[{mi}]"), e))?;
+            .map_err(|e| InputError::at(&frame.scene.source, frame.caster_object(k), e))?;
         for l in mesh_loops {
             loops.push(
                 l.iter()
@@ -612,7 +612,7 @@ fn piece_visibility(
     let c = light.center().as_vec3();
     let loops = silhouettes(frame, c)?;
     if !s.overlap {
-        let meshes: Vec<_> = frame.scene.meshes.iter().zip(&frame.adjacency).collect();
+        let meshes = frame.caster_meshes();
         let capping = if s.zfail {
             Capping::Capped
         } else {

@@ -555,6 +555,7 @@ fn heightfield(name: &str, heights: &[Vec<f64>], size: f64, base_y: f64) -> Mesh
         positions: pos.iter().map(|p| p.as_vec3()).collect(),
         triangles,
         color: OCCLUDER,
+        receiver_only: false,
     }
 }
 

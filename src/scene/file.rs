@@ -32,6 +32,7 @@
 //! # scale = 2.0 or [sx, sy, sz]; rotate_deg = [x, y, z] (Euler angles in degrees about the
 //! # world axes, X first, then Y, then Z); translate = [tx, ty, tz]
 //! color = [0.8, 0.8, 0.8]     # optional, linear RGB albedo
+//! receiver_only = true        # optional: casts no shadow in any method, may be open
 //!
 //! [options.nsample]           # per-method options, checked later by each method
 //! n = 256
@@ -132,6 +133,7 @@ struct MeshDef {
     rotate_deg: Option<Three>,
     translate: Option<Three>,
     color: Option<Three>,
+    receiver_only: Option<bool>,
 }
 
 /// `scale`: one number for all three axes, or three numbers.
@@ -549,8 +551,10 @@ fn build_mesh(m: &MeshDef, i: usize, source: &str, base_dir: &Path) -> Result<Me
     let color = m.color.map_or(DEFAULT_COLOR, |c| c.0).map(|c| c as f32);
     let path = base_dir.join(&m.obj);
     let display = path.display().to_string();
-    load_obj(&path, &display, transform, color)
-        .map_err(|e| InputError::at(source, format!("meshes[{i}] ({display})"), e.message))
+    let mut mesh = load_obj(&path, &display, transform, color)
+        .map_err(|e| InputError::at(source, format!("meshes[{i}] ({display})"), e.message))?;
+    mesh.receiver_only = m.receiver_only.unwrap_or(false);
+    Ok(mesh)
 }
 
 /// Loads an image as linear RGB in [0, 1]: 8- and 16-bit images are sRGB-decoded, float

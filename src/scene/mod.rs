@@ -115,6 +115,10 @@ pub struct Mesh {
     pub triangles: Vec<[u32; 3]>,
     /// Diffuse albedo in linear RGB, used only for the shaded image.
     pub color: [f32; 3],
+    /// A receiver only (`receiver_only = true`): it receives shadows but casts none in any
+    /// method (`raycast` included, so that methods stay comparable), and it may be open (a
+    /// floor plane): it is exempt from the closed-mesh check.
+    pub receiver_only: bool,
 }
 
 /// Raw per-method options as written in `[options.METHOD]` or with `--opt METHOD.KEY=VALUE`.

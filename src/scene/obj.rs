@@ -139,6 +139,7 @@ pub fn parse_obj(
         positions,
         triangles,
         color,
+        receiver_only: false,
     })
 }
 

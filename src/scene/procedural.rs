@@ -69,6 +69,7 @@ pub fn uv_sphere(
         positions,
         triangles,
         color,
+        receiver_only: false,
     }
 }
 
@@ -101,6 +102,7 @@ pub fn box_mesh(name: &str, min: Vec3, max: Vec3, color: [f32; 3]) -> Mesh {
         positions,
         triangles,
         color,
+        receiver_only: false,
     }
 }
 
@@ -147,6 +149,7 @@ pub fn cylinder(
         positions,
         triangles,
         color,
+        receiver_only: false,
     }
 }
 
@@ -193,6 +196,7 @@ pub fn torus(
         positions,
         triangles,
         color,
+        receiver_only: false,
     }
 }
 
@@ -233,6 +237,7 @@ pub fn prism(name: &str, base: &[[f32; 2]], y: [f32; 2], color: [f32; 3]) -> Mes
         positions,
         triangles,
         color,
+        receiver_only: false,
     }
 }
 
@@ -247,6 +252,7 @@ pub fn two_sided_quad(name: &str, corners: [Vec3; 4], color: [f32; 3]) -> Mesh {
         positions: corners.to_vec(),
         triangles: vec![[0, 1, 2], [0, 2, 3], [1, 0, 3], [1, 3, 2]],
         color,
+        receiver_only: false,
     }
 }
 
@@ -271,6 +277,7 @@ pub fn transformed(mesh: &Mesh, m: Mat4) -> Mesh {
         positions,
         triangles,
         color: mesh.color,
+        receiver_only: mesh.receiver_only,
     }
 }
 

@@ -430,6 +430,10 @@ fn validate_mesh(m: &Mesh) -> Result<(), String> {
     if m.triangles.is_empty() {
         return Err("the mesh has no triangles".into());
     }
+    if m.receiver_only {
+        // It casts nothing, so it needs no silhouettes and may be open (a floor plane).
+        return Ok(());
+    }
     adjacency::build(m).map_err(|e| e.to_string())?;
     // Outward winding: the signed volume (relative to the first vertex, to limit
     // cancellation) must not be negative beyond rounding; flat closed meshes such as
@@ -456,8 +460,9 @@ fn validate_mesh(m: &Mesh) -> Result<(), String> {
     Ok(())
 }
 
-/// Whether the point `c` is on or inside the closed mesh `m`: `None` when strictly outside,
-/// else the words for the message ("inside", "on the surface of").
+/// Whether the point `c` is on or inside the closed mesh `m` (on, for a receiver-only mesh,
+/// which may be open): `None` when strictly outside, else the words for the message
+/// ("inside", "on the surface of").
 ///
 /// Outside the mesh's bounding box is outside. Otherwise a point within 1e-6 of the box
 /// diagonal of a triangle is on the surface, and else the parity of ray crossings decides.
@@ -481,6 +486,10 @@ pub fn point_touches(m: &Mesh, c: Vec3) -> Option<&'static str> {
         closest_point_on_triangle(cd, a, b, p).distance(cd) <= tol
     }) {
         return Some("on the surface of");
+    }
+    if m.receiver_only {
+        // An open mesh has no inside.
+        return None;
     }
     const DIRS: [DVec3; 3] = [
         DVec3::new(0.431_752_3, 0.810_293_7, 0.396_122_1),

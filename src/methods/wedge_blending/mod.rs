@@ -246,11 +246,12 @@ pub fn silhouettes(frame: &Frame, s: &Settings) -> Result<Vec<Silhouette>, Input
         ShadowTest::ZFail => Capping::Capped,
     };
     let mut out = Vec::new();
-    for (mi, (mesh, adj)) in frame.scene.meshes.iter().zip(&frame.adjacency).enumerate() {
+    for (k, (mesh, adj)) in frame.caster_meshes().into_iter().enumerate() {
+        let mi = frame.casters[k].0;
         let facing = light_facing(mesh, c);
         let edges = possible_silhouettes(mesh, adj, &facing);
         let loops = silhouette_loops(&edges)
-            .map_err(|e| InputError::at(&frame.scene.source, format!("meshes[{mi}]"), e))?;
+            .map_err(|e| InputError::at(&frame.scene.source, frame.caster_object(k), e))?;
         let edge_of = |k: usize| [edges[k].a.as_dvec3(), edges[k].b.as_dvec3()];
         // z-fail needs closed volumes: a loop is closed by its mesh's caps only when it is
         // the mesh's only loop (module doc).
