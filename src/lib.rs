@@ -26,4 +26,5 @@ pub mod output;
 pub mod plan;
 pub mod progress;
 pub mod render;
+pub mod report;
 pub mod scene;
