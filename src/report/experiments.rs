@@ -74,11 +74,15 @@ impl Found {
         };
         h.element("h3", &[], "Accuracy against time");
         h.open("p", &[]);
+        let shard = if sweep.shard == accuracy_time::Shard::WHOLE {
+            String::new()
+        } else {
+            format!(", shard {} only", sweep.shard)
+        };
         h.text(&format!(
-            "From the accuracy–time experiment ({}, shard {}): every configuration at {}×{}, \
+            "From the accuracy–time experiment ({}{shard}): every configuration at {}×{}, \
              error against {}, time of the method alone (median of its timed runs). ",
             rel.join(accuracy_time::JSON_FILE).display(),
-            sweep.shard,
             first.item.width,
             first.item.height,
             sweep.reference

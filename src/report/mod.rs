@@ -61,7 +61,7 @@ impl SceneRuns<'_> {
 const STYLE: &str = "
 body { font: 14px/1.4 system-ui, sans-serif; margin: 1.5em; color: #222; max-width: 1600px; }
 h1 { margin: 0 0 .2em; } h2 { margin-top: 1.6em; border-bottom: 1px solid #ccc; }
-.grid { display: grid; grid-template-columns: repeat(auto-fill, minmax(190px, 1fr)); gap: 12px; }
+.grid { display: grid; grid-template-columns: repeat(auto-fill, minmax(170px, 1fr)); gap: 12px; }
 figure { margin: 0; background: #f6f6f6; padding: 6px; border-radius: 4px; }
 figure img { width: 100%; height: auto; image-rendering: pixelated; display: block; }
 figure.reference { outline: 2px solid #555; }

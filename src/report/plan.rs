@@ -38,10 +38,10 @@ fn decisions(map: &serde_json::Map<String, Value>, nested: bool, out: &mut Vec<S
     }
 }
 
-/// The settings a method decided for this frame, in one line ([`decisions`]): those of the
-/// plan's `settings.resolved` (after automatic choices such as `test=ZFail`) or of its
-/// option table `settings.settings`, where the method has one, else its settings without the
-/// frame-wide `gpu` table.
+/// The settings a method decided for this frame, in one line (strings, booleans, integers,
+/// enum variants, also one level down): those of the plan's `settings.resolved` (after
+/// automatic choices such as `test=ZFail`) or of its option table `settings.settings`, where
+/// the method has one, else its settings without the frame-wide `gpu` table.
 pub fn settings_summary(plan: &Value) -> String {
     let settings = &plan["settings"];
     let mut out = Vec::new();
