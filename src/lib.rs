@@ -4,8 +4,9 @@
 //! The crate is layered; dependency arrows point down:
 //!
 //! ```text
-//! cli (main.rs) ─► render ─► methods ─► gpu, geometry, light ─► scene ─► limits
-//!                     └────► output, metrics
+//! cli (main.rs) ─► report ─► render ─► methods ─► gpu, geometry, light ─► scene ─► limits
+//!       │             │         └────► output, metrics
+//!       └► progress   └────► experiment (results read back for the page)
 //! ```
 //!
 //! See `../shared/DESIGN.md` for the bit-exactness contract the [`gpu`] module implements.
@@ -23,5 +24,7 @@ pub mod methods;
 pub mod metrics;
 pub mod output;
 pub mod plan;
+pub mod progress;
 pub mod render;
+pub mod report;
 pub mod scene;

@@ -1,14 +1,18 @@
-//! The `penumbra` command line: `render`, `list`, `experiment`, `golden`. With no arguments it renders the
-//! built-in default scene with every available method into `out/` and prints the error/time
-//! table. Bad input prints one line naming the file and the problem and exits with code 2,
+//! The `penumbra` command line: `render`, `report`, `list`, `experiment`, `golden`. With no
+//! arguments it renders the built-in default scene with every available method into `out/`
+//! and its companions into `out/NAME/`, prints the error/time tables, and writes the HTML
+//! report `out/index.html`. Bad input prints one line naming the file and the problem and exits with code 2,
 //! before any output is written.
 
 use clap::{Parser, Subcommand};
 use penumbra::error::InputError;
 use penumbra::limits::MAX_THREADS;
 use penumbra::memory;
+use penumbra::progress::Progress;
+use penumbra::render::MethodRun;
+use penumbra::report::SceneRuns;
 use penumbra::scene::{builtin, file, validate, OptionValue, Scene};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser, Debug)]
@@ -29,6 +33,8 @@ struct Cli {
 enum Cmd {
     /// Render a scene (file or built-in name) with its methods and print the error/time table.
     Render(RenderArgs),
+    /// Render scenes like `render` and write an HTML page showing them all, DIR/index.html.
+    Report(ReportArgs),
     /// Print the built-in scenes and the methods, one per line.
     List,
     /// Run an experiment, or merge the shards of an accuracy–time sweep.
@@ -52,7 +58,7 @@ enum ExperimentCmd {
         /// Scene file or built-in name (sphere light).
         scene: String,
         /// Output directory for the CSV file, plot and summary.
-        #[arg(long, default_value = "out/experiment")]
+        #[arg(long, default_value = penumbra::experiment::DEFAULT_OUT)]
         out: PathBuf,
     },
     /// Forest et al. 2006: error and time of the overlap correction (default scenes
@@ -61,7 +67,7 @@ enum ExperimentCmd {
         /// Scene file or built-in name (one rect light).
         scene: Option<String>,
         /// Output directory for the CSV files and summary.
-        #[arg(long, default_value = "out/experiment")]
+        #[arg(long, default_value = penumbra::experiment::DEFAULT_OUT)]
         out: PathBuf,
         /// Image side (errors at SIZE², times at SIZE² and (2·SIZE)²).
         #[arg(long, default_value_t = 256)]
@@ -97,11 +103,9 @@ enum ExperimentCmd {
     },
 }
 
-#[derive(clap::Args, Debug)]
-struct RenderArgs {
-    /// Scene file (.toml/.json) or built-in scene name.
-    #[arg(default_value = builtin::DEFAULT)]
-    scene: String,
+/// What `render` and `report` may change in a scene before rendering it.
+#[derive(clap::Args, Debug, Default)]
+struct SceneOverrides {
     /// Comma-separated methods (default: the scene's list, else every method its light supports).
     #[arg(long, value_delimiter = ',')]
     methods: Option<Vec<String>>,
@@ -111,9 +115,6 @@ struct RenderArgs {
     /// Override the image height (alone, the width follows the scene's aspect ratio).
     #[arg(long)]
     height: Option<u32>,
-    /// Output directory.
-    #[arg(long, default_value = "out")]
-    out: PathBuf,
     /// A method option, METHOD.KEY=VALUE (repeatable), e.g. nsample.n=256 or gpu.tile_size=16.
     #[arg(long = "opt")]
     opts: Vec<String>,
@@ -123,7 +124,31 @@ struct RenderArgs {
     max_memory: Option<String>,
 }
 
-fn apply_overrides(scene: &mut Scene, a: &RenderArgs) -> Result<(), InputError> {
+#[derive(clap::Args, Debug)]
+struct RenderArgs {
+    /// Scene file (.toml/.json) or built-in scene name.
+    #[arg(default_value = builtin::DEFAULT)]
+    scene: String,
+    #[command(flatten)]
+    overrides: SceneOverrides,
+    /// Output directory.
+    #[arg(long, default_value = penumbra::render::DEFAULT_OUT)]
+    out: PathBuf,
+}
+
+#[derive(clap::Args, Debug)]
+struct ReportArgs {
+    /// Scene files (.toml/.json) or built-in scene names.
+    #[arg(required = true)]
+    scenes: Vec<String>,
+    #[command(flatten)]
+    overrides: SceneOverrides,
+    /// Output directory: DIR/index.html and DIR/SCENE/METHOD/….
+    #[arg(long, default_value = penumbra::render::DEFAULT_OUT)]
+    out: PathBuf,
+}
+
+fn apply_overrides(scene: &mut Scene, a: &SceneOverrides) -> Result<(), InputError> {
     if let Some(m) = &a.methods {
         scene.methods = Some(m.clone());
     }
@@ -144,8 +169,10 @@ fn apply_overrides(scene: &mut Scene, a: &RenderArgs) -> Result<(), InputError> 
     validate::validate(scene)
 }
 
-fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
-    let mut scene = file::resolve(&a.scene)?;
+/// The scene argument `arg` with the overrides applied, validated, and checked against the
+/// memory limit; prints the f32-rounding warning if it applies. Nothing is rendered yet.
+fn prepare(arg: &str, a: &SceneOverrides) -> Result<Scene, Box<dyn std::error::Error>> {
+    let mut scene = file::resolve(arg)?;
     apply_overrides(&mut scene, a)?;
     let (limit, origin) = match &a.max_memory {
         Some(text) => (
@@ -164,8 +191,31 @@ fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     if let Some(w) = validate::f32_rounding_warning(&scene) {
         eprintln!("penumbra: {w}");
     }
-    let runs = penumbra::render::render_scene(&scene)?;
-    penumbra::render::write_runs(&a.out, &scene, &runs)?;
+    Ok(scene)
+}
+
+/// Renders `scene` with a progress bar on a terminal (one step per method).
+fn render_scene(scene: &Scene) -> Result<Vec<MethodRun>, InputError> {
+    let progress = Progress::new(penumbra::render::render_order(scene)?.len(), &scene.source);
+    let runs = penumbra::render::render_scene_with(scene, |m| progress.start(m));
+    progress.finish();
+    runs
+}
+
+/// A rendered scene with the files its runs wrote.
+struct Rendered {
+    scene: Scene,
+    runs: Vec<MethodRun>,
+    files: Vec<Vec<String>>,
+}
+
+/// Writes `scene`'s runs into `out/METHOD/` and prints its table and the outputs written.
+fn write_and_print(
+    out: &Path,
+    scene: Scene,
+    runs: Vec<MethodRun>,
+) -> Result<Rendered, Box<dyn std::error::Error>> {
+    let files = penumbra::render::write_runs(out, &scene, &runs)?;
     print!("{}", penumbra::render::table(&scene, &runs));
     let error_png = if runs
         .iter()
@@ -177,9 +227,67 @@ fn render(a: &RenderArgs) -> Result<(), Box<dyn std::error::Error>> {
     };
     println!(
         "outputs: {}/METHOD/{{image.png, visibility.png, visibility.exr, visibility.pfm, {error_png}stats.json}}",
-        a.out.display()
+        out.display()
     );
+    Ok(Rendered { scene, runs, files })
+}
+
+fn render(a: &RenderArgs) -> Result<Rendered, Box<dyn std::error::Error>> {
+    let scene = prepare(&a.scene, &a.overrides)?;
+    let runs = render_scene(&scene)?;
+    write_and_print(&a.out, scene, runs)
+}
+
+/// Writes the report page for `rendered` scenes, whose method folders are `dirs` (relative to
+/// `out`), and prints its path.
+fn write_report(
+    out: &Path,
+    rendered: &[Rendered],
+    dirs: &[PathBuf],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let scenes: Vec<SceneRuns> = rendered
+        .iter()
+        .zip(dirs)
+        .map(|(r, dir)| SceneRuns {
+            scene: &r.scene,
+            runs: &r.runs,
+            files: &r.files,
+            dir: dir.clone(),
+        })
+        .collect();
+    let path = penumbra::report::write(out, &scenes)?;
+    println!("report: {}", path.display());
     Ok(())
+}
+
+/// `report`: every scene is loaded and checked, then rendered, before anything is written, so
+/// a bad scene or option leaves no output. Each scene's methods go to `out/SCENE/METHOD/`
+/// (SCENE: the name's file stem, made unique), then the page to `out/index.html`.
+fn report(a: &ReportArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let scenes = a
+        .scenes
+        .iter()
+        .map(|arg| prepare(arg, &a.overrides))
+        .collect::<Result<Vec<_>, _>>()?;
+    let runs = scenes
+        .iter()
+        .map(render_scene)
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut dirs: Vec<PathBuf> = Vec::new();
+    let mut rendered = Vec::new();
+    for (scene, runs) in scenes.into_iter().zip(runs) {
+        let stem = penumbra::experiment::accuracy_time::plot_stem(&scene.source);
+        let dir = (1..)
+            .map(|k| match k {
+                1 => PathBuf::from(&stem),
+                k => PathBuf::from(format!("{stem}-{k}")),
+            })
+            .find(|d| !dirs.contains(d))
+            .expect("some suffix is free");
+        rendered.push(write_and_print(&a.out.join(&dir), scene, runs)?);
+        dirs.push(dir);
+    }
+    write_report(&a.out, &rendered, &dirs)
 }
 
 /// A scene argument, loaded and validated.
@@ -206,8 +314,10 @@ fn experiment(cmd: ExperimentCmd) -> Result<(), Box<dyn std::error::Error>> {
         ExperimentCmd::TileSize { scene, out } => {
             print!("{}", tile_size::run(&load_scene(&scene)?, &out)?);
             println!(
-                "outputs: {0}/tile_size.csv, {0}/tile_size.svg",
-                out.display()
+                "outputs: {0}/{1}, {0}/{2}",
+                out.display(),
+                tile_size::CSV_FILE,
+                tile_size::SVG_FILE
             );
         }
         ExperimentCmd::WedgeBlending { scene, out, size } => {
@@ -288,14 +398,14 @@ fn print_accuracy_outputs(
     sweep: &penumbra::experiment::accuracy_time::Sweep,
     out: &std::path::Path,
 ) {
-    use penumbra::experiment::accuracy_time::{CSV_FILE, JSON_FILE};
+    use penumbra::experiment::accuracy_time::{CSV_FILE, JSON_FILE, SUMMARY_FILE};
     let plots = if sweep.shard == penumbra::experiment::accuracy_time::Shard::WHOLE {
         ", SCENE-pareto.png, SCENE-pareto.svg"
     } else {
         " (a shard: plots come from `experiment merge`)"
     };
     println!(
-        "outputs: {}/{{{CSV_FILE}, {JSON_FILE}, summary.md}}{plots}",
+        "outputs: {}/{{{CSV_FILE}, {JSON_FILE}, {SUMMARY_FILE}}}{plots}",
         out.display()
     );
 }
@@ -318,15 +428,13 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
         // the slowest method, to keep the default run short; raycast is every table's
         // reference.
         None => {
-            render(&RenderArgs {
+            let out = PathBuf::from(penumbra::render::DEFAULT_OUT);
+            let mut rendered = vec![render(&RenderArgs {
                 scene: builtin::DEFAULT.into(),
-                methods: None,
-                width: None,
-                height: None,
-                out: "out".into(),
-                opts: vec![],
-                max_memory: None,
-            })?;
+                overrides: SceneOverrides::default(),
+                out: out.clone(),
+            })?];
+            let mut dirs = vec![PathBuf::new()];
             for name in builtin::DEFAULT_COMPANIONS {
                 let scene = builtin::load(name).ok_or("missing built-in companion scene")?;
                 let methods = penumbra::methods::ALL
@@ -334,20 +442,21 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
                     .filter(|m| **m != "nsample" && penumbra::methods::supports_scene(m, &scene))
                     .map(|m| m.to_string())
                     .collect();
-                render(&RenderArgs {
+                rendered.push(render(&RenderArgs {
                     scene: name.to_string(),
-                    methods: Some(methods),
-                    width: None,
-                    height: None,
-                    out: format!("out/{name}").into(),
-                    opts: vec![],
-                    max_memory: None,
-                })?;
+                    overrides: SceneOverrides {
+                        methods: Some(methods),
+                        ..SceneOverrides::default()
+                    },
+                    out: out.join(name),
+                })?);
+                dirs.push(PathBuf::from(name));
             }
-            Ok(())
+            write_report(&out, &rendered, &dirs)
         }
         Some(Cmd::Experiment(e)) => experiment(e),
-        Some(Cmd::Render(a)) => render(&a),
+        Some(Cmd::Render(a)) => render(&a).map(|_| ()),
+        Some(Cmd::Report(a)) => report(&a),
         Some(Cmd::List) => {
             println!("# built-in scenes");
             for n in builtin::names() {

@@ -6,11 +6,14 @@ use crate::error::InputError;
 use crate::frame::{Frame, GpuSettings, BACKGROUND};
 use crate::gpu::depth::DepthFormat;
 use crate::methods::{self, options::OptionReader, output::MethodOutput, output::Visibility};
-use crate::metrics::error_report::error_report;
-use crate::metrics::{compare, ErrorStats};
+use crate::metrics::error_report::{error_report, ErrorReport};
+use crate::metrics::ErrorStats;
 use crate::output::Comparison;
 use crate::scene::Scene;
 use std::path::Path;
+
+/// Where `render`, `report` and the default run write by default.
+pub const DEFAULT_OUT: &str = "out";
 
 /// Colour of pixels where no geometry was drawn (linear RGB).
 pub const BACKGROUND_COLOR: [f32; 3] = [0.02, 0.02, 0.03];
@@ -24,8 +27,9 @@ pub struct MethodRun {
     pub output: MethodOutput,
     /// The shaded image, linear RGB, row-major.
     pub shaded: Vec<[f32; 3]>,
-    /// Error against the reference, when the reference ran and this is not it.
-    pub error: Option<ErrorStats>,
+    /// Error against the reference (whole image and the reference's penumbra), when the
+    /// reference ran and this is not it.
+    pub error: Option<ErrorReport>,
     /// For the reference: its own sampling noise, the reference against itself with the next
     /// seed ([`methods::reference_noise_floor`]).
     pub noise_floor: Option<ErrorStats>,
@@ -91,28 +95,44 @@ pub fn shade(frame: &Frame, vis: &Visibility) -> Vec<[f32; 3]> {
 /// Render `scene` with its selected methods. The reference runs first when selected; every
 /// other method's error is measured against it.
 pub fn render_scene(scene: &Scene) -> Result<Vec<MethodRun>, InputError> {
-    methods::check_option_tables(scene)?;
+    render_scene_with(scene, |_| {})
+}
+
+/// The methods [`render_scene`] runs on `scene`, in the order it runs them: the reference
+/// first when selected, then the others in their selected order.
+pub fn render_order(scene: &Scene) -> Result<Vec<String>, InputError> {
     let selected = methods::selected(scene)?;
+    let (mut order, others): (Vec<String>, Vec<String>) = selected
+        .into_iter()
+        .partition(|m| m.as_str() == methods::REFERENCE);
+    order.extend(others);
+    Ok(order)
+}
+
+/// [`render_scene`], calling `starting(method)` before each method runs (e.g. to advance a
+/// progress bar).
+pub fn render_scene_with(
+    scene: &Scene,
+    mut starting: impl FnMut(&str),
+) -> Result<Vec<MethodRun>, InputError> {
+    methods::check_option_tables(scene)?;
+    let order = render_order(scene)?;
     let gpu = gpu_settings(scene)?;
     let frame = Frame::render(scene, gpu)?;
     // Every option table is checked before anything runs, also for methods not rendered now.
     for method in scene.options.keys().filter(|k| k.as_str() != "gpu") {
         methods::check_options(method, &frame)?;
     }
-    let mut order: Vec<&String> = selected
-        .iter()
-        .filter(|m| m.as_str() == methods::REFERENCE)
-        .collect();
-    order.extend(selected.iter().filter(|m| m.as_str() != methods::REFERENCE));
     let mut runs: Vec<MethodRun> = Vec::new();
-    for m in order {
+    for m in &order {
+        starting(m);
         let output = methods::run(m, &frame)?;
         let shaded = shade(&frame, &output.visibility);
         let error = runs
             .iter()
             .find(|r| r.method == methods::REFERENCE)
             .filter(|_| m != methods::REFERENCE)
-            .map(|r| compare(&output.visibility, &r.output.visibility));
+            .map(|r| error_report(&output.visibility, &r.output.visibility, methods::REFERENCE));
         let noise_floor = if m == methods::REFERENCE {
             Some(methods::reference_noise_floor(&frame, &output.visibility)?)
         } else {
@@ -132,24 +152,25 @@ pub fn render_scene(scene: &Scene) -> Result<Vec<MethodRun>, InputError> {
 /// Write every run's files under `dir/METHOD/`, all or nothing: the method folders appear
 /// only once every method's files were written ([`crate::output::write_method_dirs`]). When
 /// the reference ran, every other method also gets `error.png` and its error (whole image and
-/// penumbra only) in `stats.json` ([`Comparison`]).
-pub fn write_runs(dir: &Path, scene: &Scene, runs: &[MethodRun]) -> std::io::Result<()> {
+/// penumbra only) in `stats.json` ([`Comparison`]). Returns the names of the files written
+/// into each method's folder, in the order of `runs`.
+pub fn write_runs(
+    dir: &Path,
+    scene: &Scene,
+    runs: &[MethodRun],
+) -> std::io::Result<Vec<Vec<String>>> {
     let names: Vec<&str> = runs.iter().map(|r| r.method.as_str()).collect();
     let reference = runs.iter().find(|r| r.method == methods::REFERENCE);
     crate::output::write_method_dirs(dir, &names, |i| {
         let r = &runs[i];
-        let comparison = match reference {
-            None => Comparison::NoReference,
-            Some(_) if r.method == methods::REFERENCE => Comparison::Reference {
-                noise_floor: r.noise_floor,
-            },
-            Some(reference) => Comparison::Against {
-                report: error_report(
-                    &r.output.visibility,
-                    &reference.output.visibility,
-                    methods::REFERENCE,
-                ),
+        let comparison = match (reference, &r.error) {
+            (None, _) => Comparison::NoReference,
+            (Some(reference), Some(report)) => Comparison::Against {
+                report: report.clone(),
                 reference: &reference.output.visibility,
+            },
+            (Some(_), None) => Comparison::Reference {
+                noise_floor: r.noise_floor,
             },
         };
         crate::output::encode_method_outputs(
@@ -162,57 +183,66 @@ pub fn write_runs(dir: &Path, scene: &Scene, runs: &[MethodRun]) -> std::io::Res
     })
 }
 
-/// The table the default run prints: time and error vs the reference per method.
-pub fn table(scene: &Scene, runs: &[MethodRun]) -> String {
-    let shapes: Vec<&str> = scene.lights.iter().map(|l| l.shape.type_name()).collect();
-    let mut s = format!(
-        "scene {} ({}×{}, {} light{}, reference: {})\n",
-        scene.source,
-        scene.width,
-        scene.height,
-        shapes.join(" + "),
-        if shapes.len() > 1 { "s" } else { "" },
-        methods::REFERENCE
-    );
-    s += &format!(
-        "{:<18} {:>10} {:>10} {:>10} {:>10} {:>12} {:>12}\n",
-        "method", "time [s]", "RMSE", "mean |e|", "max |e|", "% > 1/255", "MB traffic"
-    );
-    for r in runs {
-        let t = r.output.stats.wall_seconds;
-        let mb = r.output.stats.totals.total_bytes() as f64 / 1e6;
-        match r.error.as_ref().or(r.noise_floor.as_ref()) {
-            Some(e) => {
-                s += &format!(
-                    "{:<18} {:>10.3} {:>10.5} {:>10.5} {:>10.5} {:>12.3} {:>12.2}\n",
-                    r.method, t, e.rmse, e.mean_abs, e.max_abs, e.pct_over_1_255, mb
-                )
-            }
-            None => {
-                s += &format!(
-                    "{:<18} {:>10.3} {:>10} {:>10} {:>10} {:>12} {:>12.2}\n",
-                    r.method, t, "—", "—", "—", "—", mb
-                )
-            }
-        }
+/// One row of a run's table: what [`table`] prints and the HTML report
+/// ([`crate::report`]) shows.
+#[derive(Debug, Clone, Copy)]
+pub struct TableRow<'a> {
+    /// The method's run.
+    pub run: &'a MethodRun,
+    /// Its error against the reference over the whole image or, for the reference itself,
+    /// its noise floor; `None` when no reference ran.
+    pub error: Option<&'a ErrorStats>,
+    /// Its error over the reference's penumbra (not for the reference itself).
+    pub penumbra_error: Option<&'a ErrorStats>,
+    /// Buffer traffic of the whole method, in MB (10⁶ bytes).
+    pub traffic_mb: f64,
+}
+
+impl TableRow<'_> {
+    /// The method's wall time in seconds.
+    pub fn seconds(&self) -> f64 {
+        self.run.output.stats.wall_seconds
     }
+
+    /// Whether this is the reference's row (its error columns hold its noise floor).
+    pub fn is_reference(&self) -> bool {
+        self.run.method == methods::REFERENCE
+    }
+}
+
+/// The rows of the table, one per run in run order.
+pub fn table_rows(runs: &[MethodRun]) -> Vec<TableRow<'_>> {
+    runs.iter()
+        .map(|r| TableRow {
+            run: r,
+            error: r.error.as_ref().map(|e| &e.all).or(r.noise_floor.as_ref()),
+            penumbra_error: r.error.as_ref().map(|e| &e.penumbra_only),
+            traffic_mb: r.output.stats.totals.total_mb(),
+        })
+        .collect()
+}
+
+/// The sentences under the table, one per line: a missing reference, what the reference's
+/// row holds, every method's warnings, and how a sphere light is sampled.
+pub fn table_notes(scene: &Scene, runs: &[MethodRun]) -> Vec<String> {
+    let mut notes = Vec::new();
     if !runs.iter().any(|r| r.method == methods::REFERENCE) {
-        s += &format!(
-            "no reference in this run, so no error columns: add {} to the methods\n",
+        notes.push(format!(
+            "no reference in this run, so no error columns: add {} to the methods",
             methods::REFERENCE
-        );
+        ));
     }
     if runs.iter().any(|r| r.noise_floor.is_some()) {
-        s += &format!(
+        notes.push(format!(
             "{}'s row: its own sampling noise, seed s against seed s + 1 at the penumbra pixels \
              and their neighbours — differences of this size are the reference's, not the \
-             method's\n",
+             method's",
             methods::REFERENCE
-        );
+        ));
     }
     for r in runs {
         for w in &r.output.stats.warnings {
-            s += &format!("warning: {}: {w}\n", r.method);
+            notes.push(format!("warning: {}: {w}", r.method));
         }
     }
     let sphere = scene
@@ -220,9 +250,58 @@ pub fn table(scene: &Scene, runs: &[MethodRun]) -> String {
         .iter()
         .any(|l| matches!(l.shape, crate::scene::LightShape::Sphere { .. }));
     if sphere && runs.iter().any(|r| r.method == "nsample") {
-        s += "note: a sphere light is the disk facing each receiver for raycast (unless \
-              raycast.sphere = fixed-disk) and the wedge methods, but one disk facing the \
-              center of the mesh bounds for nsample\n";
+        notes.push(
+            "note: a sphere light is the disk facing each receiver for raycast (unless \
+             raycast.sphere = fixed-disk) and the wedge methods, but one disk facing the \
+             center of the mesh bounds for nsample"
+                .into(),
+        );
+    }
+    notes
+}
+
+/// The scene's title line: its name, size, lights and reference.
+pub fn scene_title(scene: &Scene) -> String {
+    let shapes: Vec<&str> = scene.lights.iter().map(|l| l.shape.type_name()).collect();
+    format!(
+        "{} ({}×{}, {} light{}, reference: {})",
+        scene.source,
+        scene.width,
+        scene.height,
+        shapes.join(" + "),
+        if shapes.len() > 1 { "s" } else { "" },
+        methods::REFERENCE
+    )
+}
+
+/// The table the default run prints: time and error vs the reference per method
+/// ([`table_rows`]), then the notes ([`table_notes`]).
+pub fn table(scene: &Scene, runs: &[MethodRun]) -> String {
+    let mut s = format!("scene {}\n", scene_title(scene));
+    s += &format!(
+        "{:<18} {:>10} {:>10} {:>10} {:>10} {:>12} {:>12}\n",
+        "method", "time [s]", "RMSE", "mean |e|", "max |e|", "% > 1/255", "MB traffic"
+    );
+    for row in table_rows(runs) {
+        let (m, t, mb) = (&row.run.method, row.seconds(), row.traffic_mb);
+        match row.error {
+            Some(e) => {
+                s += &format!(
+                    "{:<18} {:>10.3} {:>10.5} {:>10.5} {:>10.5} {:>12.3} {:>12.2}\n",
+                    m, t, e.rmse, e.mean_abs, e.max_abs, e.pct_over_1_255, mb
+                )
+            }
+            None => {
+                s += &format!(
+                    "{:<18} {:>10.3} {:>10} {:>10} {:>10} {:>12} {:>12.2}\n",
+                    m, t, "—", "—", "—", "—", mb
+                )
+            }
+        }
+    }
+    for note in table_notes(scene, runs) {
+        s += &note;
+        s.push('\n');
     }
     s
 }

@@ -28,7 +28,7 @@ fn nsample_1024_agrees_with_raycast_on_single_quad() {
     s.methods = Some(vec!["raycast".into(), "nsample".into()]);
     let runs = penumbra::render::render_scene(&s).unwrap();
     let ns = runs.iter().find(|r| r.method == "nsample").unwrap();
-    let e = ns.error.as_ref().expect("error vs the reference");
+    let e = &ns.error.as_ref().expect("error vs the reference").all;
     eprintln!("single-quad 64²: nsample vs raycast {e:?}");
     let k = 32.0;
     let n = 1024.0;
@@ -78,7 +78,7 @@ fn references_agree_on_one_sphere_definition_and_differ_by_the_gap_otherwise() {
     let mean = |s: &penumbra::scene::Scene| {
         let runs = penumbra::render::render_scene(s).unwrap();
         let ns = runs.iter().find(|r| r.method == "nsample").unwrap();
-        ns.error.as_ref().unwrap().mean_abs
+        ns.error.as_ref().unwrap().all.mean_abs
     };
     let facing = mean(&s);
     set(
@@ -115,7 +115,7 @@ fn the_reference_is_not_fooled_by_a_near_plane_too_close() {
         .iter()
         .any(|w| w.contains("depth buffer cannot hold")));
     let hard = runs.iter().find(|r| r.method == "hard-sv").unwrap();
-    let e = hard.error.as_ref().unwrap();
+    let e = &hard.error.as_ref().unwrap().all;
     assert!(e.mean_abs < 0.02, "{e:?}");
     let ok = builtin::load("single-quad").unwrap();
     let frame = penumbra::frame::Frame::render(&ok, Default::default()).unwrap();

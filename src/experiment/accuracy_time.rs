@@ -230,6 +230,9 @@ pub const JSON_FILE: &str = "accuracy-time.json";
 /// The CSV file a run writes.
 pub const CSV_FILE: &str = "accuracy-time.csv";
 
+/// The table and Pareto-optimal configurations ([`summary`]) as a file.
+pub const SUMMARY_FILE: &str = "summary.md";
+
 /// The knobs of a configuration as one string: `key=value` pairs separated by spaces, in
 /// table order, or `default` when there are none.
 pub fn knobs_label(knobs: &[(&str, &str)]) -> String {
@@ -739,6 +742,27 @@ fn row_scenes(sweep: &Sweep) -> Vec<&str> {
     scenes
 }
 
+/// The Pareto-optimal rows of `scene`, fastest first, each with its number in the scene's
+/// table (1-based, the number of its marker in the plot).
+pub fn pareto_rows<'a>(sweep: &'a Sweep, scene: &str) -> Vec<(usize, &'a Row)> {
+    let mut front: Vec<(usize, &Row)> = sweep
+        .rows
+        .iter()
+        .filter(|r| r.item.scene == scene)
+        .enumerate()
+        .filter(|(_, r)| r.pareto)
+        .map(|(n, r)| (n + 1, r))
+        .collect();
+    front.sort_by(|a, b| a.1.median_seconds.total_cmp(&b.1.median_seconds));
+    front
+}
+
+/// The file names of `scene`'s Pareto plot, PNG and SVG ([`plot_stem`]).
+pub fn plot_files(scene: &str) -> [String; 2] {
+    let stem = plot_stem(scene);
+    [format!("{stem}-pareto.png"), format!("{stem}-pareto.svg")]
+}
+
 /// The table and the Pareto-optimal configurations of every scene (what the command prints
 /// and `summary.md` holds).
 pub fn summary(sweep: &Sweep) -> String {
@@ -791,15 +815,12 @@ pub fn summary(sweep: &Sweep) -> String {
                 if r.pareto { "★" } else { "" }
             );
         }
-        let mut front: Vec<(usize, &&Row)> =
-            rows.iter().enumerate().filter(|(_, r)| r.pareto).collect();
-        front.sort_by(|a, b| a.1.median_seconds.total_cmp(&b.1.median_seconds));
         let _ = writeln!(s, "\nPareto-optimal on {scene}, fastest first:");
-        for (n, r) in front {
+        for (n, r) in pareto_rows(sweep, scene) {
             let _ = writeln!(
                 s,
                 "- #{} {} {}: {} ms, RMSE {:.5}",
-                n + 1,
+                n,
                 r.item.method,
                 r.item.knobs,
                 fmt_g(1e3 * r.median_seconds),
@@ -824,7 +845,7 @@ pub fn summary(sweep: &Sweep) -> String {
 }
 
 /// `x` with 3 significant digits (no exponent between 0.001 and 10⁶).
-fn fmt_g(x: f64) -> String {
+pub fn fmt_g(x: f64) -> String {
     if x == 0.0 || !x.is_finite() {
         return format!("{x}");
     }
@@ -840,14 +861,14 @@ pub fn write(sweep: &Sweep, out: &Path) -> std::io::Result<()> {
     let mut files = vec![
         (CSV_FILE.to_string(), csv(sweep).into_bytes()),
         (JSON_FILE.to_string(), json.into_bytes()),
-        ("summary.md".to_string(), summary(sweep).into_bytes()),
+        (SUMMARY_FILE.to_string(), summary(sweep).into_bytes()),
     ];
     if sweep.shard == Shard::WHOLE {
         for scene in row_scenes(sweep) {
             let (png, svg) = plot::pareto_plot(sweep, scene).map_err(std::io::Error::other)?;
-            let stem = plot_stem(scene);
-            files.push((format!("{stem}-pareto.png"), png));
-            files.push((format!("{stem}-pareto.svg"), svg.into_bytes()));
+            let [png_file, svg_file] = plot_files(scene);
+            files.push((png_file, png));
+            files.push((svg_file, svg.into_bytes()));
         }
     }
     crate::output::write_files_all_or_nothing(out, &files)

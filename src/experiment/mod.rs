@@ -7,6 +7,9 @@ pub mod wedge_blending;
 
 use crate::scene::{OptionValue, Scene};
 
+/// Where `experiment tile-size` and `experiment wedge-blending` write by default.
+pub const DEFAULT_OUT: &str = "out/experiment";
+
 /// `scene` with `method`'s options `knobs` set on top of its own `[options.METHOD]` table,
 /// each value read as `--opt METHOD.KEY=VALUE` reads it ([`OptionValue::parse_cli`]).
 pub fn configured(scene: &Scene, method: &str, knobs: &[(&str, &str)]) -> Scene {

@@ -361,13 +361,19 @@ pub fn summary(scene: &str, rows: &[Row]) -> String {
     s
 }
 
-/// Run the experiment on `scene` and write `tile_size.csv` and `tile_size.svg` into `out`;
+/// The CSV file the experiment writes ([`csv`]).
+pub const CSV_FILE: &str = "tile_size.csv";
+
+/// The plot the experiment writes ([`svg`]).
+pub const SVG_FILE: &str = "tile_size.svg";
+
+/// Run the experiment on `scene` and write [`CSV_FILE`] and [`SVG_FILE`] into `out`;
 /// returns the summary.
 pub fn run(scene: &Scene, out: &Path) -> Result<String, Box<dyn std::error::Error>> {
     let rows = sweep(scene)?;
     std::fs::create_dir_all(out)?;
-    std::fs::write(out.join("tile_size.csv"), csv(&rows))?;
-    std::fs::write(out.join("tile_size.svg"), svg(&scene.source, &rows))?;
+    std::fs::write(out.join(CSV_FILE), csv(&rows))?;
+    std::fs::write(out.join(SVG_FILE), svg(&scene.source, &rows))?;
     Ok(summary(&scene.source, &rows))
 }
 

@@ -277,10 +277,11 @@ const MIN_CANDIDATE_SINE: f64 = 1e-6;
 /// light with the given corners (module doc, "Construction"). `center` is the light center
 /// (for the edge adjustment). May be fewer than needed to bound the wedge when the edge
 /// crosses the light (the wedge is then everything on one side, §4.1). Candidate planes that
-/// rounding leaves undetermined are left out — spanned by nearly parallel generators
-/// ([`MIN_CANDIDATE_SINE`]), or with every generator within the relative 10⁻⁹ tolerance of the
-/// plane (the edge in the light's plane, or a light too small seen from the edge) — so the
-/// wedge may be larger than the hull but cuts into it by no more than that tolerance.
+/// rounding leaves undetermined are left out — spanned by nearly parallel generators (sine
+/// below `MIN_CANDIDATE_SINE`, 10⁻⁶), or with every generator within the relative 10⁻⁹
+/// tolerance of the plane (the edge in the light's plane, or a light too small seen from the
+/// edge) — so the wedge may be larger than the hull but cuts into it by no more than that
+/// tolerance.
 pub fn wedge_halfspaces(center: DVec3, corners: &[DVec3], e0: DVec3, e1: DVec3) -> Vec<HalfSpace> {
     let apex = adjusted_edge(center, e0, e1);
     let dirs: Vec<DVec3> = apex

@@ -56,6 +56,11 @@ impl Counters {
             + self.color_read_bytes
             + self.color_write_bytes
     }
+
+    /// [`Counters::total_bytes`] in MB (10⁶ bytes), as tables show it.
+    pub fn total_mb(&self) -> f64 {
+        self.total_bytes() as f64 / 1e6
+    }
 }
 
 impl AddAssign for Counters {

@@ -57,6 +57,24 @@ pub const ALL: &[&str] = &[
 /// The reference every other method's error is measured against.
 pub const REFERENCE: &str = "raycast";
 
+/// The paper `method` reproduces, in a few words (`../shared/papers/README.md`; Papers I–V
+/// are those of Assarsson's thesis), for captions; an empty string for an unknown name.
+pub fn paper(method: &str) -> &'static str {
+    match method {
+        "raycast" => "reference: shadow rays per pixel",
+        "nsample" => "Paper III §5.1: N hard shadows",
+        "hard-sv" => "Paper I §3, II §5: hard shadow volumes",
+        "pw2002" => "Paper I: penumbra wedges, EGWR 2002",
+        "pw-restructured" => "Paper II: restructured penumbra wedges",
+        "ssv-optimized" => "Paper IV: optimized soft shadow volumes, GH 2003",
+        "ssv" => "Paper III: soft shadow volumes, SIGGRAPH 2003",
+        "wedge-blending" => "Forest et al., GH 2006: penumbra-wedges blending",
+        "penumbra-map" => "Wyman & Hansen, EGSR 2003: penumbra maps",
+        "dbuffer" => "CGI 2004: umbra and penumbra volumes, D-buffer",
+        _ => "",
+    }
+}
+
 /// Methods that render every light of a scene in one pass structure: Paper I §7 scales the
 /// LI amounts by 255/n into one LI buffer (also used by Paper II's restructured algorithm).
 /// Every other method runs once per light ([`light_average`]).

@@ -68,6 +68,12 @@ pub fn visibility_to_srgb8(vis: &Visibility) -> Vec<[u8; 3]> {
         .collect()
 }
 
+/// The shaded image's file name in a method's folder.
+pub const IMAGE_FILE: &str = "image.png";
+
+/// The signed error map's file name in a method's folder (written when the reference ran).
+pub const ERROR_FILE: &str = "error.png";
+
 fn invalid(msg: String) -> io::Error {
     io::Error::new(io::ErrorKind::InvalidInput, msg)
 }
@@ -380,12 +386,13 @@ pub fn write_files_all_or_nothing(dir: &Path, files: &[(String, Vec<u8>)]) -> io
 /// method `i`, and only when every method's files were encoded and written are they moved into
 /// place, each replacing the folder of the same name as a whole. On any error nothing of this
 /// run is left: the staging folder, and `dir` itself if this call created it, are removed,
-/// and the folders already moved are moved back. Every error names its path.
+/// and the folders already moved are moved back. Every error names its path. Returns the
+/// names of the files written into each folder, in the order of `names`.
 pub fn write_method_dirs(
     dir: &Path,
     names: &[&str],
     encode: impl Fn(usize) -> io::Result<Vec<(String, Vec<u8>)>>,
-) -> io::Result<()> {
+) -> io::Result<Vec<Vec<String>>> {
     for name in names {
         if name.is_empty() || name.contains(['/', '\\']) || name.starts_with('.') {
             return Err(invalid(format!(
@@ -416,9 +423,10 @@ pub fn write_method_dirs(
             let _ = std::fs::remove_dir_all(d);
         }
     };
-    let staged = (|| -> io::Result<()> {
+    let staged = (|| -> io::Result<Vec<Vec<String>>> {
         std::fs::create_dir(&staging)
             .map_err(|e| error_at(&staging, "cannot create directory", e))?;
+        let mut written = Vec::with_capacity(names.len());
         for (i, name) in names.iter().enumerate() {
             let files = encode(i)?;
             let method_dir = staging.join(name);
@@ -427,13 +435,17 @@ pub fn write_method_dirs(
             for (file, bytes) in &files {
                 write_new_file(&method_dir.join(file), bytes)?;
             }
+            written.push(files.into_iter().map(|(file, _)| file).collect());
         }
-        Ok(())
+        Ok(written)
     })();
-    if let Err(e) = staged {
-        cleanup(&staging);
-        return Err(e);
-    }
+    let written = match staged {
+        Ok(written) => written,
+        Err(e) => {
+            cleanup(&staging);
+            return Err(e);
+        }
+    };
     // Move into place: an existing folder is first moved aside into the staging folder.
     let mut moved: Vec<(PathBuf, PathBuf, Option<PathBuf>)> = Vec::new();
     for name in names {
@@ -470,7 +482,8 @@ pub fn write_method_dirs(
         }
     }
     std::fs::remove_dir_all(&staging)
-        .map_err(|e| error_at(&staging, "outputs written, but cannot remove", e))
+        .map_err(|e| error_at(&staging, "outputs written, but cannot remove", e))?;
+    Ok(written)
 }
 
 /// Encodes every output file of one method in memory: `(file name, bytes)` in a fixed order
@@ -488,7 +501,7 @@ pub fn encode_method_outputs(
     let srgb: Vec<[u8; 3]> = shaded.iter().map(|p| p.map(linear_to_srgb8)).collect();
     let mut files = vec![
         (
-            "image.png".to_string(),
+            IMAGE_FILE.to_string(),
             encode_rgb8_png(&srgb, width, height)?,
         ),
         (
@@ -536,7 +549,7 @@ pub fn encode_method_outputs(
             check_len("reference", reference.len(), width, height)?;
             let map = crate::metrics::error_report::signed_error_map(&out.visibility, reference);
             files.push((
-                "error.png".to_string(),
+                ERROR_FILE.to_string(),
                 encode_rgb8_png(&map, width, height)?,
             ));
             serde_json::to_value(report).map_err(encoding)?
@@ -605,6 +618,7 @@ pub fn write_method_outputs(
     write_method_dirs(dir, &[method], |_| {
         encode_method_outputs(out, shaded, width, height, &Comparison::NoReference)
     })
+    .map(|_| ())
 }
 
 /// Width in pixels of the separator between the panels of [`write_side_by_side_png`].

@@ -22,7 +22,7 @@ pub fn assert_ssv_agrees_with_raycast(mut scene: Scene, max_tol: f64, label: &st
     scene.methods = Some(vec!["raycast".into(), "ssv".into()]);
     let runs = render_scene(&scene).unwrap();
     let ssv = runs.iter().find(|r| r.method == "ssv").unwrap();
-    let e = ssv.error.expect("error vs the reference");
+    let e = ssv.error.as_ref().expect("error vs the reference").all;
     eprintln!("{label}: ssv exact vs raycast {e:?}");
     assert!(e.max_abs <= max_tol, "max {} > {max_tol}", e.max_abs);
     assert!(

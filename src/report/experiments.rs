@@ -1,0 +1,160 @@
+//! The experiments' results that lie next to the page: an accuracy–time sweep
+//! ([`crate::experiment::accuracy_time`]: `accuracy-time.json` and the scenes' Pareto plots)
+//! and a tile-size sweep ([`crate::experiment::tile_size`]: its plot and CSV). Each is looked
+//! for in the report's directory itself and where its command writes by default relative to
+//! the default output directory (`experiment/accuracy-time/` and `experiment/`, so that the
+//! default run's `out/index.html` finds `out/experiment/…`). The page shows a scene's Pareto
+//! plot and Pareto-optimal configurations in the scene's section, the tile-size plot once at
+//! the end (its scene is named in the plot).
+
+use super::html::{url, Html};
+use crate::experiment::accuracy_time::{self, fmt_g, pareto_rows, plot_files, Sweep};
+use crate::experiment::tile_size;
+use std::path::{Path, PathBuf};
+
+/// The folders, relative to the report's directory, where an experiment writing by default
+/// to `default_out` may have left its results: the report's directory and `default_out`
+/// taken relative to the default output directory.
+fn candidates(default_out: &str) -> [PathBuf; 2] {
+    let default = Path::new(default_out);
+    let rel = default
+        .strip_prefix(crate::render::DEFAULT_OUT)
+        .unwrap_or(default);
+    [PathBuf::new(), rel.to_path_buf()]
+}
+
+/// What was found next to the page.
+#[derive(Debug)]
+pub struct Found {
+    /// The report's directory.
+    root: PathBuf,
+    /// An accuracy–time sweep: its folder relative to the report's directory, and its results.
+    accuracy: Option<(PathBuf, Sweep)>,
+    /// The tile-size experiment's folder relative to the report's directory.
+    pub tile_size: Option<PathBuf>,
+    /// Results found but unreadable, one sentence each (shown at the top of the page).
+    pub problems: Vec<String>,
+}
+
+impl Found {
+    /// Looks for the experiments' results around the report directory `dir`.
+    pub fn look(dir: &Path) -> Self {
+        let mut found = Found {
+            root: dir.to_path_buf(),
+            accuracy: None,
+            tile_size: None,
+            problems: Vec::new(),
+        };
+        for rel in candidates(accuracy_time::DEFAULT_OUT) {
+            let at = dir.join(&rel);
+            if found.accuracy.is_some() || !at.join(accuracy_time::JSON_FILE).is_file() {
+                continue;
+            }
+            match accuracy_time::read(&at) {
+                Ok(sweep) => found.accuracy = Some((rel, sweep)),
+                Err(e) => found.problems.push(format!("not shown: {e}")),
+            }
+        }
+        found.tile_size = candidates(crate::experiment::DEFAULT_OUT)
+            .into_iter()
+            .find(|rel| dir.join(rel).join(tile_size::SVG_FILE).is_file());
+        found
+    }
+
+    /// The accuracy–time part of the section of scene `source` (the scene's name as the
+    /// sweep records it), if the sweep measured that scene: the Pareto plot (PNG, linking to
+    /// the SVG) and the Pareto-optimal configurations, fastest first.
+    pub fn accuracy_time(&self, h: &mut Html, source: &str) {
+        let Some((rel, sweep)) = &self.accuracy else {
+            return;
+        };
+        let front = pareto_rows(sweep, source);
+        let Some(first) = sweep.rows.iter().find(|r| r.item.scene == source) else {
+            return;
+        };
+        h.element("h3", &[], "Accuracy against time");
+        h.open("p", &[]);
+        let shard = if sweep.shard == accuracy_time::Shard::WHOLE {
+            String::new()
+        } else {
+            format!(", shard {} only", sweep.shard)
+        };
+        h.text(&format!(
+            "From the accuracy–time experiment ({}{shard}): every configuration at {}×{}, \
+             error against {}, time of the method alone (median of its timed runs). ",
+            rel.join(accuracy_time::JSON_FILE).display(),
+            first.item.width,
+            first.item.height,
+            sweep.reference
+        ));
+        let summary = rel.join(accuracy_time::SUMMARY_FILE);
+        if self.root.join(&summary).is_file() {
+            h.element("a", &[("href", &url(&summary))], "Its full table.");
+        }
+        h.close();
+        let [png, svg] = plot_files(source).map(|f| rel.join(f));
+        let exists = |p: &PathBuf| self.root.join(p).is_file();
+        let shown = [&png, &svg].into_iter().find(|p| exists(p));
+        let linked = [&svg, &png].into_iter().find(|p| exists(p));
+        if let (Some(shown), Some(linked)) = (shown, linked) {
+            h.open("div", &[("class", "pareto")]);
+            h.open("a", &[("href", &url(linked))]);
+            let alt = format!("RMSE against time on {source}, log–log, with the Pareto front");
+            h.void("img", &[("src", &url(shown)), ("alt", &alt)]);
+            h.close().close();
+        }
+        h.element(
+            "p",
+            &[],
+            "Pareto-optimal (no other configuration is both at least as fast and at least as \
+             accurate), fastest first, numbered as in the plot:",
+        );
+        h.open("ol", &[("class", "front")]);
+        for (n, r) in front {
+            h.element(
+                "li",
+                &[],
+                &format!(
+                    "#{n} {} {}: {} ms, RMSE {:.5}",
+                    r.item.method,
+                    r.item.knobs,
+                    fmt_g(1e3 * r.median_seconds),
+                    r.error.rmse
+                ),
+            );
+        }
+        h.close();
+    }
+
+    /// The tile-size section, if its results were found.
+    pub fn tile_size(&self, h: &mut Html) {
+        let Some(rel) = &self.tile_size else {
+            return;
+        };
+        h.open("section", &[("id", "tile-size")]);
+        h.element(
+            "h2",
+            &[],
+            "Tile size: pw-restructured's memory accesses (Paper II §7)",
+        );
+        h.open("p", &[]);
+        h.text(&format!(
+            "From the tile-size experiment ({}; its scene is named in the plot). ",
+            rel.join(tile_size::SVG_FILE).display()
+        ));
+        let csv = rel.join(tile_size::CSV_FILE);
+        if self.root.join(&csv).is_file() {
+            h.element("a", &[("href", &url(&csv))], tile_size::CSV_FILE);
+        }
+        h.close();
+        let svg = url(&rel.join(tile_size::SVG_FILE));
+        h.void(
+            "img",
+            &[
+                ("src", &svg),
+                ("alt", "memory accesses per tile size, one line per variant"),
+            ],
+        );
+        h.close();
+    }
+}
