@@ -374,12 +374,12 @@ impl<'s> Frame<'s> {
     }
 }
 
-/// DESIGN.md "Bad input": the camera must not sit inside geometry. If the eye or a point of
-/// the near-plane rectangle is inside or on a closed mesh, the near plane cuts it open and
+/// `docs/architecture.md` "Bad input": the camera must not sit inside geometry. If the eye or a
+/// point of the near-plane rectangle is inside or on a closed mesh, the near plane cuts it open and
 /// every shadow-volume count is wrong (z-fail only repairs near-plane points inside shadow
-/// *volumes*, not inside occluders), so the scene is rejected naming the mesh, the point and
-/// the near distance ([`crate::plan::near_plane_points`], the same ray-parity test as for
-/// lights, [`crate::scene::validate::point_touches`]).
+/// *volumes*, not inside occluders), so the scene is rejected naming the mesh, the point and the
+/// near distance ([`crate::plan::near_plane_points`], the same ray-parity test as for lights,
+/// [`crate::scene::validate::point_touches`]).
 ///
 /// The message reports the most telling contact: the eye before the near plane, and a point
 /// inside a mesh before a point on a surface (a near plane reaching into a mesh also has

@@ -1,11 +1,12 @@
 //! The few constants the emulated GPU derives everything else from (after Mesa's
 //! `lp_limits.h`): sub-pixel precision, tile sizes, depth formats and the guard band.
 
-/// Fractional bits of the fixed-point window coordinates (DESIGN.md: 8 sub-pixel bits).
+/// Fractional bits of the fixed-point window coordinates (`docs/architecture.md` "Rasterization": 8
+/// sub-pixel bits).
 pub const SUBPIXEL_BITS: u32 = 8;
 /// One pixel in fixed-point units.
 pub const FIXED_ONE: i64 = 1 << SUBPIXEL_BITS;
-/// Default tile edge in pixels (DESIGN.md: 8×8).
+/// Default tile edge in pixels (`docs/architecture.md` "Rasterization": 8×8).
 pub const DEFAULT_TILE_SIZE: u32 = 8;
 /// Smallest tile edge the tile sweep allows (Paper II §7: 2×2).
 pub const MIN_TILE_SIZE: u32 = 2;

@@ -1,4 +1,5 @@
-//! The frame plan (DESIGN.md "Only the effects a scene calls for"): derived from the scene
+//! The frame plan (`docs/architecture.md` "Only the effects a scene calls
+//! for"): derived from the scene
 //! before anything is allocated — which methods run, which passes and buffers each needs, and
 //! whether z-fail is needed because the eye sits inside a shadow volume (detected, not asked).
 

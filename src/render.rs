@@ -1,6 +1,7 @@
 //! Rendering one scene with a set of methods: the frame's scene pass, every method, the shaded
 //! images, the error table against the reference — all in memory, so that a bad option stops
-//! the run before any file is written (DESIGN.md "Bad input": no partial outputs).
+//! the run before any file is written (`docs/architecture.md` "Bad input": no partial
+//! outputs).
 
 use crate::error::InputError;
 use crate::frame::{Frame, GpuSettings, BACKGROUND};
@@ -56,11 +57,11 @@ pub fn gpu_settings(scene: &Scene) -> Result<GpuSettings, InputError> {
     Ok(GpuSettings { tile_size, depth })
 }
 
-/// The shaded image (DESIGN.md "Methods"): `albedo · (ambient + visibility · max(0, n·l))` with
-/// l toward the light center (a point light there), per RGB channel of the visibility. With
-/// several lights the diffuse term is the mean of `max(0, n·l_k)` over the lights: a method's
-/// visibility is already the mean over the lights (Paper I §7), so per-light terms cannot be
-/// weighted separately.
+/// The shaded image (`docs/architecture.md` "The flow of one frame"): `albedo · (ambient +
+/// visibility · max(0, n·l))` with l toward the light center (a point light there), per RGB channel
+/// of the visibility. With several lights the diffuse term is the mean of `max(0, n·l_k)` over the
+/// lights: a method's visibility is already the mean over the lights (Paper I §7), so per-light
+/// terms cannot be weighted separately.
 pub fn shade(frame: &Frame, vis: &Visibility) -> Vec<[f32; 3]> {
     let receivers = frame.receivers();
     let prims = frame.prim_ids();

@@ -1,9 +1,9 @@
-//! The command line on bad input (README "Command line", DESIGN.md "Bad input"): every bad
-//! scene file and bad argument gets exactly one line on stderr naming the file and the
-//! problem, exit status 2, and no output at all — the `--out` directory is not created, and an
-//! existing one is left untouched. Plus the good path: one small render writes every
-//! documented file and a `stats.json` with the documented keys, and `penumbra list` prints
-//! the built-in scenes and the methods one per line.
+//! The command line on bad input (README "Command line", `docs/architecture.md` "Bad input"): every
+//! bad scene file and bad argument gets exactly one line on stderr naming the file and the problem,
+//! exit status 2, and no output at all — the `--out` directory is not created, and an existing one
+//! is left untouched. Plus the good path: one small render writes every documented file and a
+//! `stats.json` with the documented keys, and `penumbra list` prints the built-in scenes and the
+//! methods one per line.
 //!
 //! Runs the built binary (`CARGO_BIN_EXE_penumbra`) at 32×32 with `hard-sv`, so each case
 //! takes milliseconds.

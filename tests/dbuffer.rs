@@ -555,15 +555,15 @@ fn with_disks(mut scene: Scene) -> Scene {
     scene
 }
 
-/// DESIGN.md hard cases that apply to disk lights — the sphere-light hard cases with disks
-/// ([`with_disks`]: no umbra, eye in shadow, overlapping boxes, zigzag silhouettes, contact,
-/// two lights, acute corners, edges nearly parallel to the light direction, far from the
-/// origin) and every disk built-in — at 32², in both storage formats and with both eq. 3
-/// denominators: t and V are finite wherever computed (checked before the clamp: the shades
-/// carry t as computed); the corrected eq. 3 leaves [0, 1] before its clamp only where
-/// occluders overlap or touch (a handful of pixels of `pw-fractal` and `pw-columns`, pinned),
-/// the printed one all over; and no silhouette edge has its a inside the circle (§2.1: "this
-/// situation never occurs for a silhouette edge in a closed two-manifold mesh").
+/// The hard cases (`docs/architecture.md` "The hard cases") that apply to disk lights — the
+/// sphere-light hard cases with disks ([`with_disks`]: no umbra, eye in shadow, overlapping boxes,
+/// zigzag silhouettes, contact, two lights, acute corners, edges nearly parallel to the light
+/// direction, far from the origin) and every disk built-in — at 32², in both storage formats and
+/// with both eq. 3 denominators: t and V are finite wherever computed (checked before the clamp:
+/// the shades carry t as computed); the corrected eq. 3 leaves [0, 1] before its clamp only where
+/// occluders overlap or touch (a handful of pixels of `pw-fractal` and `pw-columns`, pinned), the
+/// printed one all over; and no silhouette edge has its a inside the circle (§2.1: "this situation
+/// never occurs for a silhouette edge in a closed two-manifold mesh").
 #[test]
 fn hard_cases_stay_finite_and_a_never_falls_inside_the_circle() {
     use penumbra::gpu::color::ColorFormat;

@@ -1,8 +1,8 @@
-//! Replays every fuzz input kept in the repository — the seed corpora `fuzz/corpus/TARGET/`
-//! and the crashes found and fixed, `fuzz/regressions/TARGET/` — through the same code the
-//! cargo-fuzz targets run (`fuzz/fuzz_targets/common.rs`, included here), so `cargo test`
-//! catches a regression without nightly or cargo-fuzz (DESIGN.md "Tests": fuzz corpora and
-//! every crash found are replayed by `cargo test`).
+//! Replays every fuzz input kept in the repository — the seed corpora `fuzz/corpus/TARGET/` and the
+//! crashes found and fixed, `fuzz/regressions/TARGET/` — through the same code the cargo-fuzz
+//! targets run (`fuzz/fuzz_targets/common.rs`, included here), so `cargo test` catches a regression
+//! without nightly or cargo-fuzz (`docs/architecture.md` "Tests": fuzz corpora and every crash
+//! found are replayed by `cargo test`).
 //!
 //! Each input runs under `catch_unwind`; a test fails listing every input that panicked.
 

@@ -417,10 +417,11 @@ fn stats_account_for_the_passes_and_the_maps() {
     assert!(buffers.contains("shadow-map 48x48") && buffers.contains("penumbra-map colour"));
 }
 
-/// DESIGN.md hard cases that apply to sphere lights ([`sphere_hard_cases`]), at 32²: finite values in [0, 1] with the
-/// intensity I and the screen values checked before any clamp (counted, must be zero), for
-/// the default map and for the float storage formats with the linear falloff (which would let
-/// an out-of-range I through to the visibility), in every depth format.
+/// The hard cases (`docs/architecture.md` "The hard cases") that apply to sphere lights
+/// ([`sphere_hard_cases`]), at 32²: finite values in [0, 1] with the intensity I and the screen
+/// values checked before any clamp (counted, must be zero), for the default map and for the float
+/// storage formats with the linear falloff (which would let an out-of-range I through to the
+/// visibility), in every depth format.
 #[test]
 fn hard_cases_stay_in_range_before_any_clamp() {
     use penumbra::gpu::color::ColorFormat;

@@ -1,5 +1,5 @@
-//! Rasterizer properties (DESIGN.md "Tests"): a quad split into two triangles covers every
-//! pixel of its interior exactly once — no gaps, no double hits — for random quads, both
+//! Rasterizer properties (`docs/architecture.md` "Tests"): a quad split into two triangles covers
+//! every pixel of its interior exactly once — no gaps, no double hits — for random quads, both
 //! diagonals, random tile sizes, including vertices off screen and at sub-pixel positions; the
 //! single-pixel coverage query agrees with the traversal.
 

@@ -1,5 +1,5 @@
-//! Experiments that sweep a parameter and report counters (DESIGN.md "report/": sweeps,
-//! CSV, plots).
+//! Experiments that sweep a parameter and report counters (`docs/architecture.md`
+//! "Experiments and reports": sweeps, CSV, summaries, plots).
 
 pub mod accuracy_time;
 pub mod tile_size;

@@ -271,7 +271,7 @@ pub fn adjusted_edge(center: DVec3, e0: DVec3, e1: DVec3) -> [DVec3; 2] {
 /// Smallest sine of the angle between the two vectors whose cross product is a candidate facet
 /// normal in [`wedge_halfspaces`]: the normal of nearly parallel vectors is off by about
 /// ε / sine, which must stay well below the 10⁻⁹ tolerance of the facet test.
-const MIN_CANDIDATE_SINE: f64 = 1e-6;
+pub const MIN_CANDIDATE_SINE: f64 = 1e-6;
 
 /// The facet half-spaces of the convex hull of the two end pyramids of edge `e0 e1` for a
 /// light with the given corners (module doc, "Construction"). `center` is the light center

@@ -21,7 +21,7 @@ use crate::methods::output::MethodOutput;
 use crate::scene::{builtin, file, OptionValue, Scene};
 use std::path::Path;
 
-/// The default golden image side (DESIGN.md "Goldens are rendered small").
+/// The default golden image side (`docs/architecture.md` "Goldens are rendered small").
 pub const GOLDEN_SIZE: u32 = 64;
 
 /// Options as `(key, value)` pairs, values written as on the command line (`--opt`).

@@ -1,5 +1,5 @@
-//! Golden outputs: the bit-exact regression loop (DESIGN.md "Tests"; after vello's sparse
-//! tests and resvg).
+//! Golden outputs: the bit-exact regression loop (`docs/architecture.md` "Tests"; after vello's
+//! sparse tests and resvg).
 //!
 //! # Layout
 //!

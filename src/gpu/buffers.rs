@@ -1,4 +1,5 @@
-//! Typed per-tile buffers (DESIGN.md "Buffers", "Counters", "Hierarchical Z"). Every access
+//! Typed per-tile buffers (`docs/architecture.md` "Buffers", "Counters",
+//! "Hierarchical Z"). Every access
 //! goes through these types, which add the bytes moved to the caller's [`Counters`].
 //!
 //! Storage is tile-major (see [`super::tiling`]): one value per sample of a T×T tile.

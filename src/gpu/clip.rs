@@ -1,5 +1,5 @@
-//! Homogeneous clipping (DESIGN.md "Projection": homogeneous clipping handles w = 0, far
-//! clipping stays on).
+//! Homogeneous clipping (`docs/architecture.md` "Projection": homogeneous clipping handles w = 0,
+//! far clipping stays on).
 //!
 //! Triangles are clipped in clip space against six planes: near `z + w ≥ 0`, far `w − z ≥ 0`
 //! (points at infinity have z = w and stay inside), and a guard band

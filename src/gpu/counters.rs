@@ -1,5 +1,6 @@
-//! Memory-traffic and work counters (DESIGN.md "Counters"; Paper II §7 counts depth reads and
-//! stencil/LI writes per tile size, Paper III §5.2 counts depth and V-buffer/stencil bytes).
+//! Memory-traffic and work counters (`docs/architecture.md` "Counters"; Paper II §7 counts depth
+//! reads and stencil/LI writes per tile size, Paper III §5.2 counts depth and V-buffer/stencil
+//! bytes).
 //!
 //! Every buffer access goes through the typed buffers in [`super::buffers`], which add to a
 //! tile-local `Counters`; tiles' counters are summed after a pass. Integer sums do not depend

@@ -1,4 +1,4 @@
-//! Depth formats, depth quantization and the depth test (DESIGN.md "Depth").
+//! Depth formats, depth quantization and the depth test (`docs/architecture.md` "Depth").
 //!
 //! * D24 unorm (default): `D24 = round_half_even(f32(z_w · 16777215))`, z_w clamped to [0, 1]
 //!   first (OpenGL clamps interpolated depth to the depth range).

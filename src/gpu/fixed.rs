@@ -1,4 +1,4 @@
-//! Fixed-point window coordinates (DESIGN.md "Rasterization").
+//! Fixed-point window coordinates (`docs/architecture.md` "Rasterization").
 //!
 //! Window x and y are snapped to [`SUBPIXEL_BITS`] = 8 fractional bits, rounding half to even,
 //! after subtracting the 0.5 pixel-center offset, so that the sample of pixel i sits exactly at

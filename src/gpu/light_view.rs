@@ -1,7 +1,7 @@
-//! Rendering from a light (DESIGN.md "The emulated GPU": render targets seen from the light
-//! go through the same rasterizer): a camera at the light center with a render target of its
-//! own resolution and depth format, the shadow map drawn into it, and the one rule for reading
-//! such a map at a point ([`LightView::sample`]).
+//! Rendering from a light (`docs/architecture.md` "Projection": render targets seen from the
+//! light go through the same rasterizer): a camera at the light center with a render target of
+//! its own resolution and depth format, the shadow map drawn into it, and the one rule for
+//! reading such a map at a point ([`LightView::sample`]).
 //!
 //! # The light-view camera
 //!

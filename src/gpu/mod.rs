@@ -1,4 +1,5 @@
-//! The emulated GPU pipeline (DESIGN.md "The emulated GPU: the bit-exactness contract").
+//! The emulated GPU pipeline (`docs/architecture.md` "The emulated GPU: the
+//! bit-exactness contract").
 //!
 //! Each rule of the contract is defined once, here:
 //! [`transform`] (camera, infinite-far projection, viewport), [`clip`] (homogeneous clipping),

@@ -2,12 +2,12 @@
 //! fixed point, compute the facing, the exact i64 edge functions with the fill-rule bias, the
 //! bounding box and the depth plane. Traversal lives in [`super::raster`].
 //!
-//! Fill rule (DESIGN.md, measured on llvmpipe): a sample exactly on an edge belongs to the
-//! triangle for which that edge is a **left** edge (the interior lies toward +x); on a
-//! horizontal edge, to the triangle for which it is a **bottom** edge (the interior lies toward
-//! smaller image y, i.e. above it as displayed with row 0 at the top). Zero-area triangles are
-//! dropped. Facing is the sign of the fixed-point area: counter-clockwise in OpenGL window
-//! coordinates (y up) is front-facing.
+//! Fill rule (`docs/architecture.md` "Rasterization"; OpenGL's, as Mesa's llvmpipe implements it):
+//! a sample exactly on an edge belongs to the triangle for which that edge is a **left** edge (the
+//! interior lies toward +x); on a horizontal edge, to the triangle for which it is a **bottom**
+//! edge (the interior lies toward smaller image y, i.e. above it as displayed with row 0 at the
+//! top). Zero-area triangles are dropped. Facing is the sign of the fixed-point area:
+//! counter-clockwise in OpenGL window coordinates (y up) is front-facing.
 //!
 //! Depth: the window depths z_w (f32) of the three vertices define a plane over the snapped
 //! positions; it is evaluated at each sample in f64 and rounded once to f32

@@ -1,5 +1,5 @@
-//! The 8-bit stencil unit (DESIGN.md "Stencil"): two-sided state, every OpenGL op, reference
-//! value and masks exactly as `glStencilFuncSeparate` / `glStencilOpSeparate` /
+//! The 8-bit stencil unit (`docs/architecture.md` "Stencil"): two-sided state, every OpenGL op,
+//! reference value and masks exactly as `glStencilFuncSeparate` / `glStencilOpSeparate` /
 //! `glStencilMaskSeparate` define them.
 //!
 //! With saturating ops the result depends on the order fragments arrive in; the rasterizer

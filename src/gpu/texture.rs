@@ -1,5 +1,5 @@
-//! Texture addressing and filtering (DESIGN.md "Textures": nearest and bilinear sampling
-//! defined once, texel centers at +0.5).
+//! Texture addressing and filtering (`docs/architecture.md` "Textures": nearest and bilinear
+//! sampling defined once, texel centers at +0.5).
 //!
 //! Coordinates are in texels: texel i covers [i, i + 1) and its center is i + 0.5 (window
 //! coordinates of a render target read as a texture are already in these units). Nearest

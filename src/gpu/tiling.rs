@@ -1,5 +1,5 @@
-//! Screen tiling (DESIGN.md "Rasterization": triangles are traversed per tile; tile size is a
-//! power of two from 2 to 256, default 8×8).
+//! Screen tiling (`docs/architecture.md` "Rasterization": triangles are traversed per tile; tile
+//! size is a power of two from 2 to 256, default 8×8).
 //!
 //! Every per-pixel buffer is stored tile-major: tile t owns the contiguous slice
 //! `[t·T², (t+1)·T²)`, row-major inside the tile, padded at the image's right and bottom

@@ -1,4 +1,5 @@
-//! Camera and projection (DESIGN.md "Coordinates", "Projection", "Viewport").
+//! Camera and projection (`docs/architecture.md` "Coordinates", "Projection",
+//! "Viewport").
 //!
 //! * View matrix as `gluLookAt`, right-handed world.
 //! * Everitt–Kilgard infinite-far projection

@@ -3,7 +3,7 @@
 //!
 //! A V-buffer accumulates signed contributions — the ±1.0 of the hard shadow quads (pass 1,
 //! Paper III §3.2.1) and the signed coverages of the wedges (pass 2, §3.2.2) — in submission
-//! order within a tile (DESIGN.md "Determinism"). The formats:
+//! order within a tile (`docs/architecture.md` "Determinism"). The formats:
 //!
 //! - [`VBufferF32Tile`]: one f32 per pixel, cleared to 1.0 (§4.1, the default). Each
 //!   accumulation reads and writes the pixel (the GeForce FX read-as-texture + write of §4.1):

@@ -17,8 +17,8 @@
 //! building is deterministic (f64, no parallel sums).
 //!
 //! Choices where the paper is silent (each tested below):
-//! - Texel centers at +0.5 (DESIGN.md); texture coordinates wrap (GL_REPEAT) on the angle
-//!   axes of the area table.
+//! - Texel centers at +0.5 (`docs/architecture.md` "Textures"); texture coordinates wrap
+//!   (GL_REPEAT) on the angle axes of the area table.
 //! - The atan2 cube map is looked up with the direction (x, y, 0), i.e. on the four side
 //!   faces, where the face coordinate is y/x or x/y — a uniform angular resolution of at most
 //!   (π/2)/128 per texel, instead of the +Z face, whose resolution degrades near the center.

@@ -1,4 +1,4 @@
-//! Light shapes and their sampling (DESIGN.md "Layout": `light/`).
+//! Light shapes and their sampling (`docs/architecture.md` "Layout": `light/`).
 //!
 //! The shapes themselves are defined with the scene ([`crate::scene::LightShape`]); this module
 //! holds what the methods compute *on* a light:

@@ -1,6 +1,6 @@
 //! Stratified point samples on an area light: the sample positions of the papers' reference
 //! (`nsample`, "1024-sample shadows", Paper III §5.1) and of the ray-cast ground truth
-//! (`raycast`, DESIGN.md "Methods").
+//! (`raycast`, `docs/architecture.md` "Methods").
 //!
 //! # Representation
 //!

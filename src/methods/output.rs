@@ -1,5 +1,5 @@
-//! What every method hands back: a visibility buffer in [0, 1] (DESIGN.md "Methods": all
-//! methods are compared on the same footing), optional raw buffers for inspection, and the
+//! What every method hands back: a visibility buffer in [0, 1] (`docs/architecture.md` "Methods":
+//! all methods are compared on the same footing), optional raw buffers for inspection, and the
 //! stats that go into `stats.json`.
 
 use crate::gpu::counters::Counters;

@@ -1,4 +1,5 @@
-//! `raycast`: the ground truth by definition (DESIGN.md "Methods"; issue 2, `raycast`).
+//! `raycast`: the ground truth by definition (`docs/architecture.md` "Methods"; issue 2,
+//! `raycast`).
 //!
 //! For every pixel, the fraction of the light visible from the pixel's receiver point,
 //! estimated with stratified shadow rays: `samples` jittered samples from

@@ -1,4 +1,5 @@
-//! Writing a method's outputs to disk (DESIGN.md "The flow of one frame", issue 2 "Outputs").
+//! Writing a method's outputs to disk (`docs/architecture.md` "The flow of one frame", issue 2
+//! "Outputs").
 //!
 //! One method's results go to `DIR/METHOD/`:
 //!
@@ -12,11 +13,11 @@
 //! | `error.png` | when the reference ran: the signed error against it, on the fixed scale of [`error_colour`](crate::metrics::error_report::error_colour) (white 0, red too bright, blue too dark) |
 //! | `stats.json` | [`MethodStats`](crate::methods::output::MethodStats) as pretty-printed JSON, plus `"error"`: the [`ErrorReport`] against the reference (whole image and penumbra only), or null with `"error_note"` when no reference ran; the reference itself has `"reference_noise_floor"` |
 //!
-//! **No partial output** (DESIGN.md "Bad input"): a run's method folders are written into a
-//! hidden staging folder inside the output directory and moved into place only once every
-//! method's files were encoded and written ([`write_method_dirs`]); single files are written
-//! to a hidden temporary name and renamed ([`write_files_all_or_nothing`]). Every I/O error
-//! names the path it happened at.
+//! **No partial output** (`docs/architecture.md` "Bad input"): a run's method folders are
+//! written into a hidden staging folder inside the output directory and moved into place only
+//! once every method's files were encoded and written ([`write_method_dirs`]); single files are
+//! written to a hidden temporary name and renamed ([`write_files_all_or_nothing`]). Every I/O
+//! error names the path it happened at.
 //!
 //! All images are row-major with row 0 at the top, like [`Visibility`].
 

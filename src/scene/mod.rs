@@ -22,7 +22,7 @@ pub mod validate;
 use glam::{DVec3, Vec3};
 use std::collections::BTreeMap;
 
-/// The camera (DESIGN.md "Coordinates"): right-handed world, view matrix as gluLookAt,
+/// The camera (`docs/architecture.md` "Coordinates"): right-handed world, view matrix as gluLookAt,
 /// `vfov_deg` the full vertical angle. Kept in f64; clip coordinates are rounded to f32 once.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Camera {
@@ -61,7 +61,8 @@ pub struct RgbTexture {
     pub source: String,
 }
 
-/// The shape of the area light (DESIGN.md "Methods": which method supports which shape).
+/// The shape of the area light (`docs/architecture.md` "Methods": which method supports which
+/// shape).
 #[derive(Debug, Clone, PartialEq)]
 pub enum LightShape {
     /// A point light at the light center (hard shadows only).

@@ -1,5 +1,6 @@
 //! Scene validation: everything a renderer relies on is checked once, here, and reported as
-//! one [`InputError`] naming the scene, the object and the problem (DESIGN.md "Bad input").
+//! one [`InputError`] naming the scene, the object and the problem
+//! (`docs/architecture.md` "Bad input").
 //!
 //! Checked: image size in `1..=MAX_IMAGE_SIZE`; every number finite (camera, light, every
 //! vertex, colours); camera with `vfov_deg` from [`MIN_VFOV_DEG`] up to (not including) 180, `eye ≠ target`, `up` not parallel to

@@ -1,9 +1,9 @@
-//! The hard cases of DESIGN.md that apply to sphere lights, shared by the tests of the
-//! sphere-light methods (`penumbra_wedges`, `penumbra_map`): a light so large there is no
-//! umbra, the eye inside a shadow, overlapping boxes, zigzag silhouettes with high vertex
-//! degrees, contact between occluder and receiver, two lights, acute silhouette corners,
-//! silhouette edges nearly parallel to the light direction, geometry far from the origin —
-//! and the scene and buffer helpers those tests share.
+//! The hard cases (`docs/architecture.md` "The hard cases") that apply to sphere lights, shared by
+//! the tests of the sphere-light methods (`penumbra_wedges`, `penumbra_map`): a light so large
+//! there is no umbra, the eye inside a shadow, overlapping boxes, zigzag silhouettes with high
+//! vertex degrees, contact between occluder and receiver, two lights, acute silhouette corners,
+//! silhouette edges nearly parallel to the light direction, geometry far from the origin — and the
+//! scene and buffer helpers those tests share.
 
 use penumbra::methods::output::Visibility;
 use penumbra::scene::{builtin, LightShape, Scene};
