@@ -177,8 +177,8 @@ pub fn write_runs(
         crate::output::encode_method_outputs(
             &r.output,
             &r.shaded,
-            scene.width,
-            scene.height,
+            (scene.width, scene.height),
+            &scene.source,
             &comparison,
         )
     })

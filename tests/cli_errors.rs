@@ -427,6 +427,12 @@ fn small_render_writes_every_documented_output() {
     }
     let stats: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.join("stats.json")).unwrap()).unwrap();
+    assert_eq!(stats["scene"], "single-quad");
+    assert_eq!(
+        stats["version"],
+        concat!("penumbra ", env!("CARGO_PKG_VERSION"))
+    );
+    assert!(stats["plan"]["settings"].is_object(), "the options in force");
     for key in [
         "method",
         "width",

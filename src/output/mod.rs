@@ -490,11 +490,13 @@ pub fn write_method_dirs(
 /// Encodes every output file of one method in memory: `(file name, bytes)` in a fixed order
 /// (see the module table). Nothing is written; errors (wrong buffer sizes, a raw image name
 /// that is not a plain file stem or collides with a standard output) come out here.
+/// `stats.json` names `scene` (the built-in name or the scene file) and this program's version;
+/// the options in force are its plan's `settings`.
 pub fn encode_method_outputs(
     out: &MethodOutput,
     shaded: &[[f32; 3]],
-    width: u32,
-    height: u32,
+    (width, height): (u32, u32),
+    scene: &str,
     comparison: &Comparison,
 ) -> io::Result<Vec<(String, Vec<u8>)>> {
     check_len("shaded image", shaded.len(), width, height)?;
@@ -537,6 +539,8 @@ pub fn encode_method_outputs(
     }
     let encoding = |e: serde_json::Error| io::Error::other(format!("encoding stats.json: {e}"));
     let mut stats = serde_json::to_value(&out.stats).map_err(encoding)?;
+    stats["scene"] = scene.into();
+    stats["version"] = concat!("penumbra ", env!("CARGO_PKG_VERSION")).into();
     let error = match comparison {
         Comparison::NoReference => {
             stats["error_note"] = "no reference in this run: add raycast to the methods".into();
@@ -610,14 +614,19 @@ pub fn raw_image_file_name(raw: &RawImage8) -> io::Result<String> {
 /// The folder appears only once every file was encoded and written ([`write_method_dirs`]).
 pub fn write_method_outputs(
     dir: &Path,
-    method: &str,
+    (scene, method): (&str, &str),
     out: &MethodOutput,
     shaded: &[[f32; 3]],
-    width: u32,
-    height: u32,
+    (width, height): (u32, u32),
 ) -> io::Result<()> {
     write_method_dirs(dir, &[method], |_| {
-        encode_method_outputs(out, shaded, width, height, &Comparison::NoReference)
+        encode_method_outputs(
+            out,
+            shaded,
+            (width, height),
+            scene,
+            &Comparison::NoReference,
+        )
     })
     .map(|_| ())
 }
@@ -818,7 +827,7 @@ mod tests {
         let vis = Visibility::Gray(vec![0.0, 0.25, 0.5, 0.75, 1.0, 0.125]);
         let out = sample_output(vis.clone());
         let shaded = vec![[0.5f32, 0.25, 1.0]; 6];
-        write_method_outputs(&dir, "hard-sv", &out, &shaded, 3, 2).unwrap();
+        write_method_outputs(&dir, ("test", "hard-sv"), &out, &shaded, (3, 2)).unwrap();
         let m = dir.join("hard-sv");
         let mut names: Vec<String> = std::fs::read_dir(&m)
             .unwrap()
@@ -873,7 +882,7 @@ mod tests {
         let vis = Visibility::Rgb(vec![[0.0, 0.5, 1.0], [1.0, 0.0, 0.25]]);
         let mut out = sample_output(vis.clone());
         out.raw_images.clear();
-        write_method_outputs(&dir, "ssv", &out, &[[0.0; 3]; 2], 2, 1).unwrap();
+        write_method_outputs(&dir, ("test", "ssv"), &out, &[[0.0; 3]; 2], (2, 1)).unwrap();
         let m = dir.join("ssv");
         let image::DynamicImage::ImageRgb16(v16) = image::open(m.join("visibility.png")).unwrap()
         else {
@@ -894,25 +903,41 @@ mod tests {
         let mut out = sample_output(Visibility::Gray(vec![0.0; 6]));
         // Raw image of the wrong size: encoding fails before any file exists.
         out.raw_images[0].values.pop();
-        let err = write_method_outputs(&dir, "hard-sv", &out, &[[0.0; 3]; 6], 3, 2).unwrap_err();
+        let err = write_method_outputs(&dir, ("test", "hard-sv"), &out, &[[0.0; 3]; 6], (3, 2))
+            .unwrap_err();
         assert!(err.to_string().contains("stencil"), "{err}");
         assert!(!dir.exists());
         let out = sample_output(Visibility::Gray(vec![0.0; 6]));
-        assert!(write_method_outputs(&dir, "hard-sv", &out, &[[0.0; 3]; 5], 3, 2).is_err());
-        assert!(write_method_outputs(&dir, "../x", &out, &[[0.0; 3]; 6], 3, 2).is_err());
+        assert!(
+            write_method_outputs(&dir, ("test", "hard-sv"), &out, &[[0.0; 3]; 5], (3, 2)).is_err()
+        );
+        assert!(
+            write_method_outputs(&dir, ("test", "../x"), &out, &[[0.0; 3]; 6], (3, 2)).is_err()
+        );
         let mut out2 = out.clone();
         out2.raw_images[0].name = "../evil".into();
-        assert!(write_method_outputs(&dir, "hard-sv", &out2, &[[0.0; 3]; 6], 3, 2).is_err());
+        assert!(
+            write_method_outputs(&dir, ("test", "hard-sv"), &out2, &[[0.0; 3]; 6], (3, 2)).is_err()
+        );
         out2.raw_images[0].name = "visibility".into();
-        assert!(write_method_outputs(&dir, "hard-sv", &out2, &[[0.0; 3]; 6], 3, 2).is_err());
+        assert!(
+            write_method_outputs(&dir, ("test", "hard-sv"), &out2, &[[0.0; 3]; 6], (3, 2)).is_err()
+        );
         assert!(!dir.exists());
     }
 
     #[test]
     fn a_failing_method_leaves_nothing_behind() {
         let out = sample_output(Visibility::Gray(vec![0.5; 6]));
-        let good =
-            |_: usize| encode_method_outputs(&out, &[[0.0; 3]; 6], 3, 2, &Comparison::NoReference);
+        let good = |_: usize| {
+            encode_method_outputs(
+                &out,
+                &[[0.0; 3]; 6],
+                (3, 2),
+                "test",
+                &Comparison::NoReference,
+            )
+        };
         // A new output directory: not created at all.
         let dir = temp_dir("fail").join("new");
         let fail_second = |i: usize| {
