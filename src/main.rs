@@ -314,10 +314,12 @@ fn experiment(cmd: ExperimentCmd) -> Result<(), Box<dyn std::error::Error>> {
         ExperimentCmd::TileSize { scene, out } => {
             print!("{}", tile_size::run(&load_scene(&scene)?, &out)?);
             println!(
-                "outputs: {0}/{1}, {0}/{2}",
+                "outputs: {0}/{1}, {0}/{2}, {0}/{3}, {0}/{4}",
                 out.display(),
                 tile_size::CSV_FILE,
-                tile_size::SVG_FILE
+                tile_size::SVG_FILE,
+                tile_size::PNG_FILE,
+                tile_size::SUMMARY_FILE
             );
         }
         ExperimentCmd::WedgeBlending { scene, out, size } => {

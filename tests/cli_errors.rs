@@ -432,7 +432,10 @@ fn small_render_writes_every_documented_output() {
         stats["version"],
         concat!("penumbra ", env!("CARGO_PKG_VERSION"))
     );
-    assert!(stats["plan"]["settings"].is_object(), "the options in force");
+    assert!(
+        stats["plan"]["settings"].is_object(),
+        "the options in force"
+    );
     for key in [
         "method",
         "width",

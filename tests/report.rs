@@ -131,7 +131,11 @@ fn a_report_of_two_scenes_links_existing_files_and_shows_every_method() {
     let sweep = accuracy_time::run(&scenes, TINY, 1, Shard::WHOLE).unwrap();
     accuracy_time::write(&sweep, &out.join("experiment/accuracy-time")).unwrap();
     let pw = sized(builtin::load("pw-2002").unwrap(), 32);
-    tile_size::run(&pw, &out.join("experiment")).unwrap();
+    let summary = tile_size::run(&pw, &out.join("experiment")).unwrap();
+    // The tile-size experiment writes its summary next to its CSV, and its plot as SVG and PNG.
+    let written = std::fs::read_to_string(out.join("experiment").join(tile_size::SUMMARY_FILE));
+    assert_eq!(written.unwrap(), summary);
+    assert!(out.join("experiment").join(tile_size::PNG_FILE).is_file());
 
     let o = penumbra(&[
         "report",

@@ -3,11 +3,13 @@
 //! zmin+zmax. Per run: z-buffer reads, stencil/LI writes (the paper's "stencil buffer writes":
 //! 8-bit stencil writes of the three-pass umbra plus LI writes), their sum ("memory
 //! accesses"), (tile, triangle) pairs visited and culled, fragments shaded and the median wall time of [`TIMING_RUNS`] runs.
-//! Counts are in accesses (samples), not bytes. Output: `tile_size.csv`, `tile_size.svg`
-//! (total accesses per tile size, one line per variant; dashed with the tile zmin/zmax reads) and a summary of the paper's three
-//! findings.
+//! Counts are in accesses (samples), not bytes. Output: `tile_size.csv`, the plot
+//! `tile_size.svg` and `.png` (total accesses per tile size, both axes logarithmic, one line
+//! per variant; dashed with the tile zmin/zmax reads) and the summary of the paper's three
+//! findings, printed and written to `tile_size_summary.txt`.
 
 use crate::error::InputError;
+use crate::experiment::plotting::{png_and_svg, Plot};
 use crate::frame::{Frame, GpuSettings};
 use crate::methods::options::OptionReader;
 use crate::methods::pw2002::{frame_wedges, read_wedge_settings};
@@ -16,6 +18,8 @@ use crate::methods::pw_restructured::{
 };
 use crate::plan::{eye_in_shadow, representative_light_points};
 use crate::scene::Scene;
+use plotters::coord::Shift;
+use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
@@ -177,94 +181,103 @@ pub fn csv(rows: &[Row]) -> String {
     s
 }
 
-/// An SVG line plot of total memory accesses (millions) over log₂ tile size, one line per
-/// variant (Paper II Fig. 7); dashed lines add the tile zmin/zmax reads. Choice: the paper does
-/// not say whether its counts include reading the per-tile zmin/zmax, so both are shown.
-pub fn svg(scene: &str, rows: &[Row]) -> String {
-    let (w, h, m) = (640.0, 400.0, 60.0);
-    let ymax = rows.iter().map(|r| r.accesses()).max().unwrap_or(1).max(1) as f64 * 1.05;
-    let ymax = ymax.max(
-        rows.iter()
-            .map(|r| r.accesses_with_hiz())
-            .max()
-            .unwrap_or(1) as f64
-            * 1.05,
-    );
-    let x = |tile: u32| m + (tile.trailing_zeros() as f64 - 1.0) / 7.0 * (w - 2.0 * m);
-    let y = |v: u64| h - m - v as f64 / ymax * (h - 2.0 * m);
-    let colors = [
-        "#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b",
-    ];
-    let mut s = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"11\">\n<rect width=\"{w}\" height=\"{h}\" fill=\"white\"/>\n<text x=\"{m}\" y=\"20\" font-size=\"13\">{scene}: z-buffer reads + stencil/LI writes per frame (millions)</text>\n"
-    );
-    let _ = writeln!(
-        s,
-        "<line x1=\"{m}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"black\"/><line x1=\"{m}\" y1=\"{m}\" x2=\"{m}\" y2=\"{}\" stroke=\"black\"/>",
-        h - m,
-        w - m,
-        h - m,
-        h - m
-    );
-    for n in 1..=8u32 {
-        let _ = writeln!(
-            s,
-            "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{}</text>",
-            x(1 << n),
-            h - m + 16.0,
-            1u32 << n
-        );
+/// The plot of total memory accesses per frame over tile size, both axes logarithmic (the
+/// 2×2 tiles cost an order of magnitude more than the rest, which a linear axis squashed),
+/// one colour per variant (Paper II Fig. 7): solid lines z reads + stencil/LI writes, dashed
+/// lines plus the tile zmin/zmax reads. Choice: the paper does not say whether its counts
+/// include reading the per-tile zmin/zmax, so both are shown. PNG bytes and SVG text.
+pub fn plot(scene: &str, rows: &[Row]) -> Result<(Vec<u8>, String), String> {
+    if rows.is_empty() {
+        return Err("no rows to plot".into());
     }
-    for k in 0..=4 {
-        let v = ymax * k as f64 / 4.0;
-        let _ = writeln!(
-            s,
-            "<text x=\"{}\" y=\"{}\" text-anchor=\"end\">{:.2}</text>",
-            m - 4.0,
-            y(v as u64) + 4.0,
-            v / 1e6
-        );
-    }
-    let _ = writeln!(
-        s,
-        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">tile size (pixels)</text>",
-        w / 2.0,
-        h - 20.0
-    );
-    for (i, (p, c)) in VARIANTS.iter().enumerate() {
-        let pts: Vec<String> = rows
+    png_and_svg(&TileSizePlot { scene, rows }, (900, 560))
+}
+
+/// [`plot`]'s drawing.
+struct TileSizePlot<'a> {
+    scene: &'a str,
+    rows: &'a [Row],
+}
+
+impl Plot for TileSizePlot<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+        const COLOURS: [RGBColor; 6] = [
+            RGBColor(31, 119, 180),
+            RGBColor(255, 127, 14),
+            RGBColor(44, 160, 44),
+            RGBColor(214, 39, 40),
+            RGBColor(148, 103, 189),
+            RGBColor(140, 86, 75),
+        ];
+        let values = self
+            .rows
             .iter()
-            .filter(|r| r.passes == *p && r.culling == *c)
-            .map(|r| format!("{:.1},{:.1}", x(r.tile), y(r.accesses())))
-            .collect();
-        let _ = writeln!(
-            s,
-            "<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"2\" points=\"{}\"/>\n<text x=\"{}\" y=\"{}\" fill=\"{}\">{}</text>",
-            colors[i],
-            pts.join(" "),
-            w - m - 150.0,
-            m + 14.0 * i as f64,
-            colors[i],
-            variant_name(*p, *c)
-        );
-        let hiz: Vec<String> = rows
-            .iter()
-            .filter(|r| r.passes == *p && r.culling == *c)
-            .map(|r| format!("{:.1},{:.1}", x(r.tile), y(r.accesses_with_hiz())))
-            .collect();
-        let _ = writeln!(
-            s,
-            "<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"1\" stroke-dasharray=\"4 3\" points=\"{}\"/>",
-            colors[i],
-            hiz.join(" ")
-        );
+            .flat_map(|r| [r.accesses(), r.accesses_with_hiz()])
+            .map(|v| v.max(1) as f64);
+        let y_lo = values.clone().fold(f64::INFINITY, f64::min) / 1.3;
+        let y_hi = values.fold(0.0, f64::max) * 1.3;
+        let tiles = self.rows.iter().map(|r| f64::from(r.tile));
+        let x_lo = tiles.clone().fold(f64::INFINITY, f64::min) / 1.2;
+        let x_hi = tiles.fold(0.0, f64::max) * 1.2;
+        root.fill(&WHITE).map_err(err)?;
+        let mut chart = ChartBuilder::on(root)
+            .caption(
+                format!(
+                    "{}: z-buffer reads + stencil/LI writes per frame",
+                    self.scene
+                ),
+                ("sans-serif", 20),
+            )
+            .margin(14)
+            .x_label_area_size(44)
+            .y_label_area_size(70)
+            .build_cartesian_2d((x_lo..x_hi).log_scale(), (y_lo..y_hi).log_scale())
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("tile edge [pixels] (log)")
+            .y_desc("memory accesses [samples] (log)")
+            .x_label_formatter(&|v: &f64| format!("{v:.0}"))
+            .y_label_formatter(&|v: &f64| format!("{v:.0e}"))
+            .label_style(("sans-serif", 13))
+            .axis_desc_style(("sans-serif", 14))
+            .draw()
+            .map_err(err)?;
+        for (i, (p, c)) in VARIANTS.iter().enumerate() {
+            let colour = COLOURS[i % COLOURS.len()];
+            let of = |f: fn(&Row) -> u64| -> Vec<(f64, f64)> {
+                self.rows
+                    .iter()
+                    .filter(|r| r.passes == *p && r.culling == *c)
+                    .map(|r| (f64::from(r.tile), f(r).max(1) as f64))
+                    .collect()
+            };
+            chart
+                .draw_series(LineSeries::new(of(Row::accesses), colour.stroke_width(2)))
+                .map_err(err)?
+                .label(variant_name(*p, *c))
+                .legend(move |(x, y)| {
+                    PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(2))
+                });
+            chart
+                .draw_series(DashedLineSeries::new(
+                    of(Row::accesses_with_hiz),
+                    5,
+                    4,
+                    colour.stroke_width(1),
+                ))
+                .map_err(err)?;
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 13))
+            .draw()
+            .map_err(err)?;
+        root.present().map_err(err)
     }
-    let _ = writeln!(
-        s,
-        "<text x=\"{m}\" y=\"36\">solid: z reads + stencil/LI writes; dashed: plus tile zmin/zmax reads</text>"
-    );
-    s.push_str("</svg>\n");
-    s
 }
 
 fn find(rows: &[Row], tile: u32, p: Passes, c: Culling) -> Option<&Row> {
@@ -364,17 +377,25 @@ pub fn summary(scene: &str, rows: &[Row]) -> String {
 /// The CSV file the experiment writes ([`csv`]).
 pub const CSV_FILE: &str = "tile_size.csv";
 
-/// The plot the experiment writes ([`svg`]).
+/// The plot the experiment writes ([`plot`]), as SVG.
 pub const SVG_FILE: &str = "tile_size.svg";
+/// The same plot as PNG.
+pub const PNG_FILE: &str = "tile_size.png";
+/// The summary the experiment prints ([`summary`]), as a file next to the CSV.
+pub const SUMMARY_FILE: &str = "tile_size_summary.txt";
 
-/// Run the experiment on `scene` and write [`CSV_FILE`] and [`SVG_FILE`] into `out`;
-/// returns the summary.
+/// Run the experiment on `scene` and write [`CSV_FILE`], [`SVG_FILE`], [`PNG_FILE`] and
+/// [`SUMMARY_FILE`] into `out`; returns the summary.
 pub fn run(scene: &Scene, out: &Path) -> Result<String, Box<dyn std::error::Error>> {
     let rows = sweep(scene)?;
+    let (png, svg) = plot(&scene.source, &rows)?;
+    let summary = summary(&scene.source, &rows);
     std::fs::create_dir_all(out)?;
     std::fs::write(out.join(CSV_FILE), csv(&rows))?;
-    std::fs::write(out.join(SVG_FILE), svg(&scene.source, &rows))?;
-    Ok(summary(&scene.source, &rows))
+    std::fs::write(out.join(SVG_FILE), svg)?;
+    std::fs::write(out.join(PNG_FILE), png)?;
+    std::fs::write(out.join(SUMMARY_FILE), &summary)?;
+    Ok(summary)
 }
 
 #[cfg(test)]
@@ -410,7 +431,8 @@ mod tests {
         }
         let csv = csv(&rows);
         assert_eq!(csv.lines().count(), 1 + rows.len());
-        assert!(svg("pw-2002", &rows).starts_with("<svg"));
+        let (png, svg) = plot("pw-2002", &rows).unwrap();
+        assert!(png.starts_with(b"\x89PNG") && svg.starts_with("<svg"));
         let summary = summary("pw-2002", &rows);
         for f in ["finding 1", "finding 2", "finding 3"] {
             assert!(summary.contains(f), "{summary}");

@@ -6,15 +6,13 @@
 //! next is as fast), and the reference's own noise is a dashed line. A configuration whose
 //! RMSE is 0 (the reference itself, when listed) is drawn on the bottom edge.
 //!
-//! Drawn with `plotters` once per backend: into an RGB buffer (encoded as PNG with the
-//! crate's own encoder) and into an SVG string. Text uses DejaVu Sans, embedded (its licence
-//! is in `src/experiment/font/LICENSE`), so no system font library is needed.
+//! Drawn with `plotters` once per backend ([`crate::experiment::plotting`]).
 
 use super::{pareto_front, Row, Sweep};
+use crate::experiment::plotting::{png_and_svg, Plot};
 use crate::methods;
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use std::sync::OnceLock;
 
 /// Size of the plots in pixels: the chart on the left, the key on the right.
 pub const WIDTH: u32 = 1400;
@@ -26,19 +24,6 @@ const CHART_WIDTH: u32 = 900;
 const KEY_LINE: i32 = 18;
 /// Distinct marker shapes (circles, triangle, squares, cross, diamonds); knob settings beyond them repeat the shapes.
 pub const MARKERS: usize = 8;
-
-/// The embedded font (DejaVu Sans 2.37).
-const FONT: &[u8] = include_bytes!("../font/DejaVuSans.ttf");
-
-/// Registers [`FONT`] as plotters' `sans-serif` once per process.
-fn register_font() -> Result<(), String> {
-    static DONE: OnceLock<Result<(), String>> = OnceLock::new();
-    DONE.get_or_init(|| {
-        plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
-            .map_err(|_| "the embedded font cannot be read".to_string())
-    })
-    .clone()
-}
 
 /// The colour of `method` (Tableau 10, by its position in [`methods::ALL`]).
 pub fn method_colour(method: &str) -> RGBColor {
@@ -286,23 +271,21 @@ fn height(lines: usize) -> u32 {
 
 /// The Pareto plot of `scene` (module doc) as PNG bytes and SVG text.
 pub fn pareto_plot(sweep: &Sweep, scene: &str) -> Result<(Vec<u8>, String), String> {
-    register_font()?;
     let lines = sweep.rows.iter().filter(|r| r.item.scene == scene).count();
     if lines == 0 {
         return Err(format!("no rows of scene {scene} to plot"));
     }
-    let h = height(lines);
-    let mut rgb = vec![0u8; WIDTH as usize * h as usize * 3];
-    {
-        let root = BitMapBackend::with_buffer(&mut rgb, (WIDTH, h)).into_drawing_area();
-        draw(&root, sweep, scene)?;
+    png_and_svg(&ParetoPlot { sweep, scene }, (WIDTH, height(lines)))
+}
+
+/// [`draw`] as a [`Plot`].
+struct ParetoPlot<'a> {
+    sweep: &'a Sweep,
+    scene: &'a str,
+}
+
+impl Plot for ParetoPlot<'_> {
+    fn draw<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        draw(area, self.sweep, self.scene)
     }
-    let pixels: Vec<[u8; 3]> = rgb.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-    let png = crate::output::encode_rgb8_png(&pixels, WIDTH, h).map_err(|e| e.to_string())?;
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (WIDTH, h)).into_drawing_area();
-        draw(&root, sweep, scene)?;
-    }
-    Ok((png, svg))
 }
