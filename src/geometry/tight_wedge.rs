@@ -168,24 +168,30 @@ impl ConvexPolyhedron {
         self.split(plane).0
     }
 
-    /// Whether `x` is inside or on every face plane (within `eps`). Faces of no area — the
+    /// Whether `x` is inside or on every face plane (within `eps`). Faces of no width — the
     /// slivers clipping leaves where a cutting plane runs along an edge or through a vertex,
     /// whose vertices coincide or line up to rounding — have no meaningful plane and are
-    /// skipped: a face counts when its Newell normal (twice its area) exceeds 10⁻¹² of the
-    /// polyhedron's squared size. A polyhedron with no face that counts is flat (a sliver part
-    /// of a split, found by fuzzing) and contains nothing.
+    /// skipped: a face counts when its width, its Newell normal (twice its area) over half its
+    /// perimeter, exceeds [`MIN_FACE_WIDTH`] of the polyhedron's size. A polyhedron with no
+    /// face that counts is flat (a sliver part of a split, found by fuzzing) and contains
+    /// nothing.
     pub fn contains(&self, x: DVec3, eps: f64) -> bool {
         let Some(origin) = self.vertices().next().copied() else {
             return false;
         };
-        let size2 = self
+        let size = self
             .vertices()
-            .map(|v| (*v - origin).length_squared())
+            .map(|v| (*v - origin).length())
             .fold(0.0, f64::max);
         let mut counted = false;
         for f in &self.faces {
             let n = newell_normal(f);
-            if n.length() <= 1e-12 * size2 {
+            let half_perimeter = 0.5
+                * (0..f.len())
+                    .map(|k| (f[(k + 1) % f.len()] - f[k]).length())
+                    .sum::<f64>();
+            // NaN widths (NaN vertices) count, so their NaN distance makes x outside.
+            if n.length() <= MIN_FACE_WIDTH * size * half_perimeter {
                 continue;
             }
             // A NaN distance is unordered, so it counts as outside.
@@ -201,6 +207,18 @@ impl ConvexPolyhedron {
         counted
     }
 }
+
+/// Narrowest face, relative to its polyhedron's size, whose plane [`ConvexPolyhedron::contains`]
+/// tests: 10⁻⁹, the tolerance within which this module counts a point as on a plane
+/// ([`wedge_halfspaces`]' facet test, [`bounding_planes`]). A face's plane is found from its
+/// vertices, so vertex errors δ tilt it by about δ / its width and move it by δ·size / width
+/// across the polyhedron; a face narrower than that tolerance lines up to within it and has no
+/// plane worth testing. Found by fuzzing: splitting a 10⁻⁶ rad thin wedge by the hard shadow
+/// quad's plane, which runs along the wedge's edge, cut it at crossings of edges lying in the
+/// plane to rounding and left a triangle 3·10⁻⁴ wide and 3·10⁷ long (10⁻¹¹ of the size, but above
+/// the 10⁻¹² area test used before) whose rounded plane cut off the edge's own end by 424
+/// units, so that end was in neither half.
+pub const MIN_FACE_WIDTH: f64 = 1e-9;
 
 /// Newell's normal of a polygon (unnormalized, outward for a counter-clockwise face).
 fn newell_normal(f: &[DVec3]) -> DVec3 {
@@ -590,6 +608,37 @@ mod tests {
         );
         for x in [a, a.lerp(b, 0.5), penumbra] {
             assert!(w.contains(x, 1e-3), "{x}");
+        }
+    }
+
+    /// An edge end on the hard shadow quad's plane (a penumbra receiver at the edge itself)
+    /// is in one of the halves of a wedge 10⁻⁶ rad thin, 5·10⁷ from the light (found by
+    /// fuzzing): the split along the wedge's edge leaves sliver triangles (3·10⁻⁴ wide, 3·10⁷
+    /// long) whose rounded planes cut the end off both halves by over 40 units.
+    #[test]
+    fn edge_end_on_the_split_plane_is_in_a_half() {
+        let (u, v) = (
+            DVec3::splat(28.0),
+            DVec3::new(28.0, -9.313225746154785e-10, 2.0),
+        );
+        let r = (u + v).length().max((u - v).length());
+        let corners: Vec<DVec3> = (0..8)
+            .map(|i| {
+                let s = |b: usize| if i & b == 0 { -r } else { r };
+                DVec3::new(s(1), s(2), s(4))
+            })
+            .collect();
+        let a = DVec3::new(0.0, -47374336.0, -47374336.0);
+        let b = DVec3::new(-47374336.0, -47190016.0, -4096.0);
+        let (lo, hi) = (
+            DVec3::new(-48194883.601, -48194883.601, -48194883.601),
+            DVec3::new(820548.101, 820560.601, 820547.601),
+        );
+        let [inner, outer] = wedge_halves_and_planes(DVec3::ZERO, &corners, a, b, lo, hi).0;
+        let whole = whole_wedge(DVec3::ZERO, &corners, a, b, lo, hi);
+        for x in [b, a.lerp(b, 0.5)] {
+            assert!(whole.contains(x, 1.0), "{x}");
+            assert!(inner.contains(x, 1.0) || outer.contains(x, 1.0), "{x}");
         }
     }
 
