@@ -419,7 +419,7 @@ const PIN_SHADED: [[u64; 3]; 2] = [[5583, 8292, 10965], [4708, 5569, 5569]];
 /// `wedge = bounding-sphere` the visibility is the same except at a few pixels (receivers within
 /// depth rounding of a hard-quad plane, where the half they fall in is decided by the
 /// rasterized cut polygon, §4.4). Measured at 256²: rectangle 157,733 (tight), 235,902
-/// (`ssv`), 311,655 (bounding sphere); sphere 134,154, 157,526, 157,532. The counts at 48²
+/// (`ssv`), 311,655 (bounding sphere); sphere 134,160, 157,526, 157,532. The counts at 48²
 /// are pinned ([`PIN_SHADED`]).
 #[test]
 fn tight_wedges_shade_fewer_fragments() {

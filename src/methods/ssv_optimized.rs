@@ -38,7 +38,7 @@
 //! points, cut by Paper III's planes ([`tight_wedge`], "Spheres"); `bounding-sphere` is the
 //! paper's baseline, Paper III's wedge of the light's bounding sphere (the sphere through a
 //! rectangle's corners; a sphere light itself). On `cube-of-spheres-sphere` at 256² the tight
-//! wedges shade 134,154 fragments where Paper III's (`ssv`) shade 157,526; on `cube-of-spheres`
+//! wedges shade 134,160 fragments where Paper III's (`ssv`) shade 157,526; on `cube-of-spheres`
 //! 157,733 where `ssv` shades 235,902 and `bounding-sphere` 311,655.
 //!
 //! Options: `coverage = tables|exact`, `filter = bilinear|nearest` (area table), `split =
@@ -77,7 +77,6 @@ use crate::frame::{setup_all, Frame, BACKGROUND};
 use crate::geometry::loops::silhouette_loops;
 use crate::geometry::shadow_volume::{shadow_volume_triangles, silhouette_quad, Capping};
 use crate::geometry::silhouette::{light_facing, possible_silhouettes};
-use crate::geometry::ssv_wedge::WedgeLight;
 use crate::geometry::tight_wedge::{
     self, halves_from_planes, polyhedron_from_planes, wedge_clip_box, ConvexPolyhedron, HalfSpace,
     DEFAULT_SPHERE_SIDES,
@@ -195,9 +194,12 @@ impl LightModel {
     ///   intersected with Paper III's wedge of the sphere
     ///   ([`tight_wedge::sphere_wedge_halfspaces`]);
     /// - not `tight` (`wedge = bounding-sphere`): Paper III's wedge of the light's bounding
-    ///   sphere ([`LightModel::bounding_sphere`], [`tight_wedge::paper3_halfspaces`]) — "our
-    ///   previously presented method created wedges from bounding spheres surrounding the
-    ///   light source" (Paper IV §4.1); for a sphere light, Paper III's wedge of the sphere.
+    ///   sphere ([`LightModel::bounding_sphere`], [`tight_wedge::bounding_sphere_halfspaces`])
+    ///   — "our previously presented method created wedges from bounding spheres surrounding
+    ///   the light source" (Paper IV §4.1); for a sphere light, Paper III's wedge of the sphere.
+    ///
+    /// A sphere narrower than 10⁻³ rad seen from the edge gets the hull over its bounding
+    /// cube in both cases ([`tight_wedge::thin_light_cube`]).
     pub fn wedge_halfspaces(
         &self,
         tight: bool,
@@ -214,7 +216,7 @@ impl LightModel {
             }
             _ => {
                 let (center, radius) = self.bounding_sphere();
-                tight_wedge::paper3_halfspaces(&WedgeLight::Sphere { center, radius }, e0, e1)
+                tight_wedge::bounding_sphere_halfspaces(center, radius, e0, e1)
             }
         }
     }
