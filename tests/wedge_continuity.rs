@@ -8,7 +8,10 @@
 
 use glam::DVec3;
 use penumbra::geometry::ssv_wedge::{SsvWedge, WedgeLight};
-use penumbra::geometry::tight_wedge::{wedge_halves_and_planes, whole_wedge};
+use penumbra::geometry::tight_wedge::{
+    halves_from_planes, polyhedron_from_planes, sphere_wedge_halfspaces, wedge_halves_and_planes,
+    whole_wedge, DEFAULT_SPHERE_SIDES,
+};
 use penumbra::light::coverage::{edge_coverage_exact, sphere_edge_coverage_exact, RectLight};
 use proptest::prelude::*;
 
@@ -74,6 +77,34 @@ proptest! {
         if !in_half {
             let c = edge_coverage_exact(&l, p, b, a);
             prop_assert!(c.abs() <= 1e-12, "coverage {c} outside both halves");
+        }
+    }
+
+    /// Paper IV's tight wedge of a sphere (`ssv-optimized`, the hull of the end pyramids over
+    /// the circumscribed polygons of the silhouette disks, cut by Paper III's planes), with
+    /// the default and the smallest polygon: outside the wedge and outside both halves the
+    /// sphere's exact coverage is 0, and the wedge lies within Paper III's wedge.
+    #[test]
+    fn tight_sphere_wedges_hold_all_coverage((a, b) in edge(), p in point()) {
+        let (lo, hi) = (DVec3::splat(-4.0), DVec3::splat(4.0));
+        let c = SPHERE_CENTER;
+        for sides in [DEFAULT_SPHERE_SIDES, 3] {
+            let planes = sphere_wedge_halfspaces(c, SPHERE_RADIUS, sides, a, b);
+            let wedge = polyhedron_from_planes(&planes, lo, hi);
+            let cov = sphere_edge_coverage_exact(c, SPHERE_RADIUS, p, b, a);
+            if !wedge.contains(p, 1e-9) {
+                prop_assert!(cov.abs() <= 1e-12, "{sides} sides: coverage {cov} outside the wedge");
+            }
+            let [inner, outer] = halves_from_planes(&planes, c, a, b, lo, hi);
+            if !(inner.contains(p, 1e-9) || outer.contains(p, 1e-9)) {
+                prop_assert!(cov.abs() <= 1e-12, "{sides} sides: coverage {cov} outside both halves");
+            }
+            let light = WedgeLight::Sphere { center: c, radius: SPHERE_RADIUS };
+            if let Some(w) = SsvWedge::new(&light, a, b) {
+                if wedge.contains(p, -1e-9) {
+                    prop_assert!(w.contains_within(p, 1e-9), "{sides} sides: {p} beyond Paper III's wedge");
+                }
+            }
         }
     }
 }

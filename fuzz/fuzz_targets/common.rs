@@ -19,8 +19,8 @@ use penumbra::geometry::shadow_volume::{shadow_volume_triangles, Capping};
 use penumbra::geometry::silhouette::{light_facing, possible_silhouettes};
 use penumbra::geometry::ssv_wedge::{SsvWedge, WedgeLight, WedgeVertex};
 use penumbra::geometry::tight_wedge::{
-    adjusted_edge, bounding_planes, wedge_clip_box, wedge_halfspaces, wedge_halves_and_planes,
-    whole_wedge, HalfSpace,
+    adjusted_edge, bounding_planes, halves_from_planes, polyhedron_from_planes, wedge_clip_box,
+    HalfSpace,
 };
 use penumbra::gpu::counters::Counters;
 use penumbra::gpu::raster::{bin, draw, no_tile_culling};
@@ -1034,11 +1034,11 @@ pub fn ssv_wedge(data: &[u8]) {
 }
 
 /// The `tight_wedge` path: Paper IV's tight wedge of the edge (see [`EdgeInput`]; selector bit
-/// 1: the rectangle's own corners, else the cube around its bounding sphere, as
-/// `ssv-optimized`'s `wedge` option; a sphere always uses its cube, [`LightModel::corners`])
-/// clipped to the box of a scene holding the light, the edge and the receivers
-/// ([`wedge_clip_box`]): [`wedge_halfspaces`], [`whole_wedge`], [`wedge_halves_and_planes`],
-/// [`bounding_planes`], and [`ConvexPolyhedron::split`] by a plane from the input. Checked:
+/// 1: `wedge = tight`, else `bounding-sphere`, as `ssv-optimized`'s `wedge` option; bits 2–7
+/// pick a sphere's `sphere_sides`, 3…64; [`LightModel::wedge_halfspaces`]) clipped to the box
+/// of a scene holding the light, the edge and the receivers ([`wedge_clip_box`]): the wedge's
+/// half-spaces, [`polyhedron_from_planes`], [`halves_from_planes`], [`bounding_planes`], and
+/// [`ConvexPolyhedron::split`] by a plane from the input. Checked:
 /// - planes have finite unit normals, polyhedra finite vertices and faces of ≥ 3 vertices,
 ///   bounding planes are among the wedge's planes;
 /// - for an edge apart from the light, inside the box (beyond the margin): every penumbra
@@ -1060,7 +1060,8 @@ pub fn tight_wedge(data: &[u8]) {
     let (cut_normal, cut_point) = (r.vec3().as_dvec3(), r.vec3().as_dvec3());
     let model = LightModel::from_shape(input.light.center, &input.light.shape)
         .expect("a rect or sphere light");
-    let corners = model.corners(input.select & 2 != 0);
+    let tight = input.select & 2 != 0;
+    let sides = 3 + usize::from(input.select >> 2) % 62;
     let c = model.center();
     let mut positions = vec![a.as_vec3(), b.as_vec3()];
     positions.extend(input.receivers.iter().map(|rcv| rcv.p.as_vec3()));
@@ -1082,9 +1083,10 @@ pub fn tight_wedge(data: &[u8]) {
         ambient: 0.0,
     };
     let (lo, hi) = wedge_clip_box(&scene);
-    let at = || format!("edge {a} {b}, corners {corners:?}, box {lo} {hi}");
+    let at =
+        || format!("edge {a} {b}, light {model:?}, tight {tight}, {sides} sides, box {lo} {hi}");
 
-    let planes = wedge_halfspaces(c, &corners, a, b);
+    let planes = model.wedge_halfspaces(tight, sides, a, b);
     for h in &planes {
         assert!(
             is_unit(h.normal) && h.offset.is_finite(),
@@ -1092,8 +1094,8 @@ pub fn tight_wedge(data: &[u8]) {
             at()
         );
     }
-    let whole = whole_wedge(c, &corners, a, b, lo, hi);
-    let ([inner, outer], _) = wedge_halves_and_planes(c, &corners, a, b, lo, hi);
+    let whole = polyhedron_from_planes(&planes, lo, hi);
+    let [inner, outer] = halves_from_planes(&planes, c, a, b, lo, hi);
     for poly in [&whole, &inner, &outer] {
         assert!(
             poly.faces
@@ -1108,7 +1110,8 @@ pub fn tight_wedge(data: &[u8]) {
             assert!(planes.contains(&h), "bounding plane {h:?}: {}", at());
         }
     }
-    let box_magnitude = magnitude([&lo, &hi]).max(magnitude(&corners));
+    let (bound_center, bound_radius) = model.bounding_sphere();
+    let box_magnitude = magnitude([&lo, &hi]).max(bound_center.abs().max_element() + bound_radius);
     let margin = REL_MARGIN * box_magnitude;
     let wedge_margin = input.wedge_margin(box_magnitude);
     let quad_plane = (a - c).cross(b - c) != DVec3::ZERO;

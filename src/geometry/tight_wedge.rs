@@ -1,5 +1,6 @@
-//! Tighter penumbra wedges for rectangular lights (Paper IV §4.1) and their split into an inner
-//! and an outer half by the plane of the hard shadow quad (Paper IV §4.2 Fig. 2, §4.4).
+//! Tighter penumbra wedges (Paper IV §4.1) for rectangular and spherical lights, and their split
+//! into an inner and an outer half by the plane of the hard shadow quad (Paper IV §4.2 Fig. 2,
+//! §4.4).
 //!
 //! # Construction
 //! The edge vertex farther from the light center `c` is moved toward `c` to the other vertex's
@@ -14,10 +15,15 @@
 //! the 2·k ray directions) and keeping those with every generator on one side.
 //!
 //! Choices where the paper is silent:
-//! - **Spherical lights** use the same construction with the 8 corners of the sphere's bounding
-//!   cube as "light corners": a looser but still enclosing wedge (the sphere lies in the cube,
-//!   so its penumbra volume lies in the cube's). Paper III §3.1's tangent-plane wedge belongs
-//!   to the `ssv` method.
+//! - **Spherical lights** (module section "Spheres" below). Paper IV §4.1 builds the wedge from
+//!   "the two end pyramids that are formed by the reflection of the light source through the
+//!   edge end points" and describes the swept circular cone of a sphere (its Fig. 1a), but
+//!   gives the construction for rectangles only.
+//! - **`bounding-sphere`.** Paper IV §4.1's baseline, "our previously presented method created
+//!   wedges from bounding spheres surrounding the light source", is read as Paper III's wedge
+//!   ([`SsvWedge`]: front and back planes tangent to the sphere, one side plane per end) of the
+//!   light's bounding sphere: for a rectangle the sphere through its corners, for a sphere
+//!   light the sphere itself ([`bounding_sphere_halfspaces`]).
 //! - **Finite wedges.** Receivers lie inside the scene's bounding box, so a wedge is the
 //!   intersection of its facet half-spaces with that box (slightly enlarged), built by clipping
 //!   the box polyhedron plane by plane. Wedges are never drawn beyond the box; none of their
@@ -26,7 +32,40 @@
 //!   Both halves share one cut polygon (the "wedge center polygons" of Fig. 2) with bit-identical
 //!   vertices, listed in opposite winding with the same fan, so the rasterizer gives both the
 //!   same pixels and depths and every receiver point falls in exactly one half.
+//!
+//! # Spheres
+//! For a sphere (center `c`, radius `r`) the end pyramid at an adjusted end point `e` becomes
+//! the cone of the sphere reflected through `e`. Every ray from a point of the ball through `e`
+//! crosses the plane of the sphere's silhouette circle seen from `e` inside that circle's disk
+//! (the tangent cone from `e` is the cone over the disk), so the pyramid over a polygon
+//! **circumscribing** that disk holds the cone ([`sphere_silhouette_polygon`]): a regular
+//! `N`-gon, `N` = [`DEFAULT_SPHERE_SIDES`] (`ssv-optimized`'s `sphere_sides`). The convex hull
+//! of the two end pyramids, each over its own end's polygon ([`hull_halfspaces`]; one corner
+//! set for both ends would add the rays from the other end's polygon and be looser), encloses
+//! the penumbra volume and is at most `1/cos(π/N)` wider (in the tangent of the angle seen
+//! from the edge) than the hull of the two cones. It is then intersected with Paper III's
+//! wedge of the sphere ([`paper3_halfspaces`]), which encloses the penumbra volume too, so the
+//! result never exceeds Paper III's wedge: the hull's facets along the edge are replaced by
+//! Paper III's front and back planes (the exact tangent planes through the edge; planes
+//! through one line a small angle apart would only leave sliver faces), and each end is the
+//! tighter of the polygon hull's facets and Paper III's side plane
+//! ([`sphere_wedge_halfspaces`]).
+//!
+//! `N` trades fragments for triangles. Measured on `cube-of-spheres-sphere` at 256², fragments
+//! shaded by the wedge pass (Paper III's wedges, `ssv`: 157,526; the bounding cube's hull
+//! `ssv-optimized` used before: 237,973), triangles submitted and the pass's time (best of
+//! three): N = 4: 142,463, 35,974, 0.056 s; 8: 134,160, 48,282, 0.070 s; 16: 131,305, 74,412,
+//! 0.097 s; 32: 130,483, 126,482, 0.213 s. This rasterizer's time follows the triangles, so
+//! the default is 8: 97% of the fragment saving of N = 32 for 38% of its triangles.
+//!
+//! A sphere narrower than [`MIN_SPHERE_WEDGE_ANGLE`] (10⁻³ rad) seen from the edge gets the
+//! hull over its bounding cube's corners instead ([`thin_light_cube`]), in both `tight` and
+//! `bounding-sphere`: every plane of so thin a wedge meets the hard-quad plane, which runs
+//! through the same edge, within that angle, and the halves cut from the polygon or tangent
+//! planes lost receivers on the edge itself (found by fuzzing), while the cube's hull splits
+//! as before.
 
+use super::ssv_wedge::{SsvWedge, WedgeLight};
 use glam::DVec3;
 use std::cmp::Ordering;
 
@@ -301,10 +340,18 @@ pub const MIN_CANDIDATE_SINE: f64 = 1e-6;
 /// edge) — so the wedge may be larger than the hull but cuts into it by no more than that
 /// tolerance.
 pub fn wedge_halfspaces(center: DVec3, corners: &[DVec3], e0: DVec3, e1: DVec3) -> Vec<HalfSpace> {
-    let apex = adjusted_edge(center, e0, e1);
+    hull_halfspaces(adjusted_edge(center, e0, e1), [corners, corners])
+}
+
+/// The facet half-spaces of the convex hull of the end pyramids with apexes `apex[i]` over the
+/// corners `corners[i]` (rays `apex[i] + λ(apex[i] − l)`, `l ∈ corners[i]`, `λ ≥ 0`):
+/// [`wedge_halfspaces`] with a corner set per end (a sphere's circumscribed polygons,
+/// [`sphere_wedge_halfspaces`]). The same tolerances apply.
+pub fn hull_halfspaces(apex: [DVec3; 2], corners: [&[DVec3]; 2]) -> Vec<HalfSpace> {
     let dirs: Vec<DVec3> = apex
         .iter()
-        .flat_map(|a| corners.iter().map(move |l| *a - *l))
+        .zip(corners)
+        .flat_map(|(a, ls)| ls.iter().map(move |l| *a - *l))
         .collect();
     let scale = dirs
         .iter()
@@ -338,27 +385,48 @@ pub fn wedge_halfspaces(center: DVec3, corners: &[DVec3], e0: DVec3, e1: DVec3) 
         // lets near-facets cut into a hull thinner than it (found by fuzzing: two such planes
         // of opposite sides left nothing of the wedge of a light 3·10⁻¹⁰ rad wide).
         let eps = (64.0 * f64::EPSILON * lengths / len).min(1e-9);
+        // The generators' signed distances along n, as the range [lo, hi] of the values:
+        // the directions' part does not depend on the apex, and directions on both sides
+        // beyond eps rule the candidate out for both apexes (then it stops early).
+        let mut dir_range = (f64::INFINITY, f64::NEG_INFINITY);
+        let mut nan = false;
+        for d in &dirs {
+            let v = n.dot(*d) / scale;
+            nan |= v.is_nan();
+            dir_range = (dir_range.0.min(v), dir_range.1.max(v));
+            if dir_range.0 < -eps && dir_range.1 > eps {
+                break;
+            }
+        }
+        // A NaN value satisfies none of the tests below (each needs every value compared true).
+        if nan || (dir_range.0 < -eps && dir_range.1 > eps) {
+            continue;
+        }
         for a in apex {
-            let dir_vals = dirs.iter().map(|d| n.dot(*d) / scale);
             // The apexes' side is measured against the edge's length: against the light's
             // distance, a plane could cut off a whole apex within the tolerance when the light
             // is 10⁹ edge lengths away (found by fuzzing: an empty wedge).
-            let apex_vals = apex
-                .iter()
-                .map(|p| n.dot(*p - a) / edge_len.max(f64::MIN_POSITIVE));
-            let vals: Vec<f64> = dir_vals.chain(apex_vals).collect();
+            let mut range = dir_range;
+            for p in apex {
+                let v = n.dot(p - a) / edge_len.max(f64::MIN_POSITIVE);
+                nan |= v.is_nan();
+                range = (range.0.min(v), range.1.max(v));
+            }
+            if nan {
+                break;
+            }
             // A plane every generator lies on within eps separates nothing it can be sure of:
             // the generators may lie on both sides (a light whose angular size seen from the
             // edge is below eps). Keeping it, and the same plane found again with the opposite
             // normal, cut the wedge to nothing (found by fuzzing: a light of radius 0.003 at
             // 10⁹ from the edge lost its whole penumbra). Leaving it out can only make the
             // wedge larger.
-            if vals.iter().all(|v| v.abs() <= eps) {
+            if range.0 >= -eps && range.1 <= eps {
                 continue;
             }
-            let sign = if vals.iter().all(|v| *v <= eps) {
+            let sign = if range.1 <= eps {
                 1.0
-            } else if vals.iter().all(|v| *v >= -eps) {
+            } else if range.0 >= -eps {
                 -1.0
             } else {
                 continue;
@@ -367,15 +435,183 @@ pub fn wedge_halfspaces(center: DVec3, corners: &[DVec3], e0: DVec3, e1: DVec3) 
                 normal: n * sign,
                 offset: (n * sign).dot(a),
             };
-            let dup = out.iter().any(|o| {
-                o.normal.dot(h.normal) > 1.0 - 1e-12 && (o.offset - h.offset).abs() < 1e-9
-            });
-            if !dup {
+            if !out.iter().any(|o| nearly_parallel(o, &h)) {
                 out.push(h);
             }
         }
     }
     out
+}
+
+/// Whether two half-spaces' outward normals are within 1.4·10⁻⁶ rad (`n·n' > 1 − 10⁻¹²`). Two
+/// supporting planes of one convex set with normals that close are the same plane to within
+/// that angle over the set; keeping both leaves a sliver face between them whose Newell normal
+/// is off by about ε/angle, enough to put the edge itself outside the wedge (found by fuzzing:
+/// a sphere 1.8·10⁻⁴ wide, 8 units from the edge, whose two end polygons gave front planes
+/// 8·10⁻⁸ rad apart through the same edge, and Paper III's front plane 5·10⁻⁷ rad from them).
+/// The later one is left out, which can only make the wedge larger, by at most that angle.
+fn nearly_parallel(a: &HalfSpace, b: &HalfSpace) -> bool {
+    a.normal.dot(b.normal) > 1.0 - 1e-12
+}
+
+/// Default number of sides of the polygons circumscribing a sphere's silhouette disks
+/// ([`sphere_wedge_halfspaces`], module doc "Spheres"): the end pyramids are at most
+/// `1/cos(π/8)` ≈ 1.082 times as wide (in the tangent of the half angle) as the end cones.
+pub const DEFAULT_SPHERE_SIDES: usize = 8;
+
+/// The corners of the regular `sides`-gon circumscribing the silhouette disk of the sphere
+/// (`center`, `radius`) seen from `apex` (module doc, "Spheres"): the disk of the tangent
+/// points, at distance `(d² − r²)/d` from `apex` toward the center, of radius `r·√(d² − r²)/d`
+/// (`d = |center − apex|`). Every ray from a point of the ball through `apex` crosses that
+/// disk's plane inside the disk, hence inside the polygon, so the pyramid over the polygon
+/// reflected through `apex` holds the reflected cone of the sphere. `None` when `apex` is not
+/// outside the sphere (no cone: the wedge is the whole space) or `sides < 3`. The polygon's
+/// first vertex is in the direction `u.any_orthonormal_vector()` from the disk's center,
+/// `u` the unit direction from `apex` to `center`.
+pub fn sphere_silhouette_polygon(
+    center: DVec3,
+    radius: f64,
+    apex: DVec3,
+    sides: usize,
+) -> Option<Vec<DVec3>> {
+    let to_center = center - apex;
+    let d = to_center.length();
+    if sides < 3 || d.is_nan() || d <= radius {
+        return None;
+    }
+    let u = to_center / d;
+    let along = (d - radius) * (d + radius) / d;
+    let disk = (radius / d) * ((d - radius) * (d + radius)).sqrt();
+    let half = std::f64::consts::PI / sides as f64;
+    let vertex_radius = disk / libm::cos(half);
+    let m = apex + u * along;
+    let b1 = u.any_orthonormal_vector();
+    let b2 = u.cross(b1);
+    Some(
+        (0..sides)
+            .map(|k| {
+                let t = 2.0 * half * k as f64;
+                m + (b1 * libm::cos(t) + b2 * libm::sin(t)) * vertex_radius
+            })
+            .collect(),
+    )
+}
+
+/// Paper IV §4.1's tight wedge of edge `e0 e1` for a **sphere** light (module doc, "Spheres"):
+/// Paper III's front and back planes (tangent to the sphere through the adjusted edge,
+/// [`paper3_halfspaces`]), the facet half-spaces of the convex hull of the two end pyramids
+/// over the `sides`-gons circumscribing the sphere's silhouette disks seen from the adjusted
+/// end points ([`sphere_silhouette_polygon`], [`hull_halfspaces`]) except its facets along the
+/// edge (normal within [`MIN_SIDE_FACET_SINE`] of perpendicular to it: its own front and back,
+/// looser than Paper III's, and the facets between them and the ends, within the wedge's angle
+/// of Paper III's), then Paper III's two side planes unless nearly parallel to a plane already
+/// kept. Every one of these holds the penumbra volume, so the wedge does, and it is never
+/// larger than Paper III's wedge. The hull alone when Paper III's wedge has no planes; the
+/// bounding cube's hull for a sphere narrower than [`MIN_SPHERE_WEDGE_ANGLE`]
+/// ([`thin_light_cube`]); empty (the whole space) when an end point is not outside the
+/// sphere.
+pub fn sphere_wedge_halfspaces(
+    center: DVec3,
+    radius: f64,
+    sides: usize,
+    e0: DVec3,
+    e1: DVec3,
+) -> Vec<HalfSpace> {
+    let apex = adjusted_edge(center, e0, e1);
+    if let Some(cube) = thin_light_cube(center, radius, apex[0]) {
+        return wedge_halfspaces(center, &cube, e0, e1);
+    }
+    let polygon = |a: DVec3| sphere_silhouette_polygon(center, radius, a, sides);
+    let (Some(p0), Some(p1)) = (polygon(apex[0]), polygon(apex[1])) else {
+        return Vec::new();
+    };
+    let hull = hull_halfspaces(apex, [&p0, &p1]);
+    let paper3 = paper3_halfspaces(&WedgeLight::Sphere { center, radius }, e0, e1);
+    if paper3.is_empty() {
+        return hull;
+    }
+    // The hull's facets along the edge (its front and back, tangent to the polygons, and those
+    // next to them) give way to Paper III's front and back planes (tangent to the sphere):
+    // planes through one line, or one end, a small angle apart cut the box into sliver faces
+    // whose rounding put the edge itself 10⁻⁶ outside the wedge or its halves (found by
+    // fuzzing, at 3, 11 and 64 sides).
+    let along = (apex[1] - apex[0]).normalize_or_zero();
+    let side = |h: &HalfSpace| h.normal.dot(along).abs() >= MIN_SIDE_FACET_SINE;
+    let mut planes: Vec<HalfSpace> = paper3[..2].to_vec();
+    planes.extend(hull.into_iter().filter(side));
+    for h in &paper3[2..] {
+        if !planes.iter().any(|o| nearly_parallel(o, h)) {
+            planes.push(*h);
+        }
+    }
+    planes
+}
+
+/// Smallest sine of the angle between a hull facet of a sphere's tight wedge and the edge for
+/// [`sphere_wedge_halfspaces`] to keep it: facets closer to the edge's direction run along the
+/// wedge's front or back, within the wedge's angle of Paper III's front and back planes.
+const MIN_SIDE_FACET_SINE: f64 = 0.05;
+
+/// Narrowest sphere (its radius over its distance from the adjusted edge) that gets the
+/// wedges of [`sphere_wedge_halfspaces`] and [`bounding_sphere_halfspaces`]; a narrower one
+/// gets the hull over the 8 corners of its bounding cube ([`thin_light_cube`]).
+pub const MIN_SPHERE_WEDGE_ANGLE: f64 = 1e-3;
+
+/// The 8 corners of the cube around the sphere when it is narrower than
+/// [`MIN_SPHERE_WEDGE_ANGLE`] seen from the adjusted end point `apex` (else `None`). Every
+/// plane of a wedge that thin is within that angle of the hard-quad plane, which runs through
+/// the same edge: Paper III's tangent planes and the polygons' facets then meet it and each
+/// other so obliquely that the halves cut from the wedge lost receivers on the edge itself
+/// (by 10⁻⁶ of the scene for a sphere 10⁻⁵ rad wide; found by fuzzing), while the cube's hull
+/// (the construction `ssv-optimized` used for every sphere before) splits cleanly. The cube's
+/// wedge is at most `√3` times as wide, here less than 2·10⁻³ rad: a few pixels at most.
+pub fn thin_light_cube(center: DVec3, radius: f64, apex: DVec3) -> Option<Vec<DVec3>> {
+    if radius > MIN_SPHERE_WEDGE_ANGLE * (apex - center).length() {
+        return None;
+    }
+    Some(
+        (0..8)
+            .map(|i| {
+                let s = |b: usize| if i & b == 0 { -radius } else { radius };
+                center + DVec3::new(s(1), s(2), s(4))
+            })
+            .collect(),
+    )
+}
+
+/// Paper III's wedge of the sphere (`center`, `radius`) for edge `e0 e1`
+/// ([`paper3_halfspaces`]): `ssv-optimized`'s `wedge = bounding-sphere`, "our previously
+/// presented method created wedges from bounding spheres surrounding the light source" (Paper
+/// IV §4.1) — except for a sphere narrower than [`MIN_SPHERE_WEDGE_ANGLE`], which gets the
+/// hull over its bounding cube ([`thin_light_cube`]).
+pub fn bounding_sphere_halfspaces(
+    center: DVec3,
+    radius: f64,
+    e0: DVec3,
+    e1: DVec3,
+) -> Vec<HalfSpace> {
+    let apex = adjusted_edge(center, e0, e1);
+    match thin_light_cube(center, radius, apex[0]) {
+        Some(cube) => wedge_halfspaces(center, &cube, e0, e1),
+        None => paper3_halfspaces(&WedgeLight::Sphere { center, radius }, e0, e1),
+    }
+}
+
+/// The four planes (front, back, left, right) of Paper III's wedge of edge `e0 e1`
+/// ([`SsvWedge`], §3.1) as outward half-spaces; empty when that wedge is degenerate (Paper
+/// III's whole space, [`SsvWedge::new`] returns `None`). With a sphere around a light this is
+/// "the previously presented method [that] created wedges from bounding spheres" of Paper IV
+/// §4.1 ([`bounding_sphere_halfspaces`]).
+pub fn paper3_halfspaces(light: &WedgeLight, e0: DVec3, e1: DVec3) -> Vec<HalfSpace> {
+    SsvWedge::new(light, e0, e1).map_or_else(Vec::new, |w| {
+        w.planes
+            .iter()
+            .map(|h| HalfSpace {
+                normal: -h.normal,
+                offset: -h.normal.dot(h.origin),
+            })
+            .collect()
+    })
 }
 
 /// The plane of the hard shadow quad of the silhouette edge `a → b` (oriented as in its
@@ -422,15 +658,39 @@ pub fn wedge_halves_and_planes(
     hi: DVec3,
 ) -> ([ConvexPolyhedron; 2], Vec<HalfSpace>) {
     let planes = wedge_halfspaces(c, corners, a, b);
-    let mut wedge = ConvexPolyhedron::aabb(lo, hi);
-    for h in &planes {
-        wedge = wedge.clip(h);
-        if wedge.is_empty() {
-            return ([wedge.clone(), wedge], planes);
-        }
+    (halves_from_planes(&planes, c, a, b, lo, hi), planes)
+}
+
+/// The inner (umbra side) and outer halves of the wedge with the facet half-spaces `planes` of
+/// silhouette edge `a → b` for a light with center `c`, clipped to the box `[lo, hi]`
+/// ([`polyhedron_from_planes`], split by [`quad_inner_halfspace`]).
+pub fn halves_from_planes(
+    planes: &[HalfSpace],
+    c: DVec3,
+    a: DVec3,
+    b: DVec3,
+    lo: DVec3,
+    hi: DVec3,
+) -> [ConvexPolyhedron; 2] {
+    let wedge = polyhedron_from_planes(planes, lo, hi);
+    if wedge.is_empty() {
+        return [wedge.clone(), wedge];
     }
     let (inner, outer, _) = wedge.split(&quad_inner_halfspace(c, a, b));
-    ([inner, outer], planes)
+    [inner, outer]
+}
+
+/// The box `[lo, hi]` clipped by every half-space of `planes`, in order (empty as soon as a
+/// clip leaves nothing).
+pub fn polyhedron_from_planes(planes: &[HalfSpace], lo: DVec3, hi: DVec3) -> ConvexPolyhedron {
+    let mut wedge = ConvexPolyhedron::aabb(lo, hi);
+    for h in planes {
+        wedge = wedge.clip(h);
+        if wedge.is_empty() {
+            break;
+        }
+    }
+    wedge
 }
 
 /// The planes among `planes` that bound `half`: those holding at least three of its vertices
@@ -466,11 +726,7 @@ pub fn whole_wedge(
     lo: DVec3,
     hi: DVec3,
 ) -> ConvexPolyhedron {
-    let mut wedge = ConvexPolyhedron::aabb(lo, hi);
-    for h in wedge_halfspaces(c, corners, a, b) {
-        wedge = wedge.clip(&h);
-    }
-    wedge
+    polyhedron_from_planes(&wedge_halfspaces(c, corners, a, b), lo, hi)
 }
 
 #[cfg(test)]
@@ -640,6 +896,141 @@ mod tests {
             assert!(whole.contains(x, 1.0), "{x}");
             assert!(inner.contains(x, 1.0) || outer.contains(x, 1.0), "{x}");
         }
+    }
+
+    /// Points of the sphere (center `c`, radius `r`): a latitude-longitude grid of its
+    /// surface, poles included, and its center.
+    fn sphere_points(c: DVec3, r: f64) -> Vec<DVec3> {
+        let mut out = vec![c];
+        for i in 0..=12 {
+            let theta = std::f64::consts::PI * i as f64 / 12.0;
+            for j in 0..24 {
+                let phi = std::f64::consts::TAU * j as f64 / 24.0;
+                out.push(
+                    c + DVec3::new(
+                        libm::sin(theta) * libm::cos(phi),
+                        libm::cos(theta),
+                        libm::sin(theta) * libm::sin(phi),
+                    ) * r,
+                );
+            }
+        }
+        out
+    }
+
+    /// The circumscribed polygon holds the silhouette disk: every ray from a point of the
+    /// sphere through the apex, reflected, crosses the polygon's plane inside the polygon.
+    #[test]
+    fn silhouette_polygon_holds_every_ray_through_the_apex() {
+        let (c, r) = (DVec3::new(0.3, 3.0, -0.2), 0.6);
+        let apex = DVec3::new(-0.4, 1.1, 0.5);
+        for sides in [3, 8, 16] {
+            let poly = sphere_silhouette_polygon(c, r, apex, sides).unwrap();
+            let n = (c - apex).normalize();
+            let m = poly.iter().copied().sum::<DVec3>() / sides as f64;
+            for l in sphere_points(c, r) {
+                // The ray from l through the apex, met where it crosses the plane on l's side.
+                let d = apex - l;
+                let t = n.dot(m - apex) / n.dot(-d);
+                let x = apex - d * t;
+                // Inside every side of the polygon (counter-clockwise around n or not).
+                let inside = (0..sides).all(|k| {
+                    let (p, q) = (poly[k], poly[(k + 1) % sides]);
+                    let s = (q - p).cross(x - p).dot(n);
+                    let orient = (poly[1] - poly[0]).cross(poly[2] - poly[1]).dot(n);
+                    s * orient.signum() >= -1e-12
+                });
+                assert!(inside, "{sides} sides: {l} crosses the plane at {x}");
+            }
+        }
+        assert!(sphere_silhouette_polygon(c, r, c + DVec3::X * 0.5, 8).is_none());
+        assert!(sphere_silhouette_polygon(c, r, apex, 2).is_none());
+    }
+
+    /// Paper IV §4.1 for a sphere: the wedge holds every ray from a point of the sphere through
+    /// a point of the edge (beyond the edge), for an edge whose far vertex is adjusted; it lies
+    /// within Paper III's wedge, and is tighter than the hull over the bounding cube's corners.
+    #[test]
+    fn sphere_wedge_contains_every_ray_and_lies_in_paper_iii() {
+        let (c, r) = (DVec3::new(0.0, 3.0, 0.0), 0.5);
+        let (lo, hi) = (DVec3::splat(-5.0), DVec3::splat(5.0));
+        let light = WedgeLight::Sphere {
+            center: c,
+            radius: r,
+        };
+        let cube: Vec<DVec3> = (0..8)
+            .map(|i| {
+                let s = |b: usize| if i & b == 0 { -r } else { r };
+                c + DVec3::new(s(1), s(2), s(4))
+            })
+            .collect();
+        for (a, b) in [
+            (DVec3::new(-0.4, 1.0, 0.3), DVec3::new(0.5, 1.3, 0.2)),
+            (DVec3::new(-0.6, 1.5, -0.5), DVec3::new(0.4, 0.8, 0.6)),
+        ] {
+            for sides in [3, DEFAULT_SPHERE_SIDES, 16] {
+                let planes = sphere_wedge_halfspaces(c, r, sides, a, b);
+                let w = polyhedron_from_planes(&planes, lo, hi);
+                for l in sphere_points(c, r) {
+                    for k in 0..=8 {
+                        let e = a.lerp(b, k as f64 / 8.0);
+                        for lambda in [0.0, 0.3, 1.0, 2.0] {
+                            let x = e + (e - l) * lambda;
+                            assert!(w.contains(x, 1e-9), "{sides} sides: {x}");
+                        }
+                    }
+                }
+            }
+            // Grid points: inside the tight wedge ⇒ inside Paper III's; fewer than the cube's.
+            let paper3 = SsvWedge::new(&light, a, b).unwrap();
+            let tight = polyhedron_from_planes(
+                &sphere_wedge_halfspaces(c, r, DEFAULT_SPHERE_SIDES, a, b),
+                lo,
+                hi,
+            );
+            let cube_wedge = whole_wedge(c, &cube, a, b, lo, hi);
+            let (mut n_tight, mut n_paper3, mut n_cube) = (0, 0, 0);
+            for i in 0..40 {
+                for j in 0..20 {
+                    for k in 0..40 {
+                        let x = DVec3::new(i as f64, j as f64, k as f64) * 0.1
+                            - DVec3::new(2.0, 1.0, 2.0);
+                        if tight.contains(x, 0.0) {
+                            n_tight += 1;
+                            assert!(paper3.contains_within(x, 1e-9), "{x}");
+                        }
+                        n_paper3 += paper3.contains(x) as u32;
+                        n_cube += cube_wedge.contains(x, 0.0) as u32;
+                    }
+                }
+            }
+            assert!(
+                n_tight <= n_paper3 && n_tight < n_cube,
+                "{n_tight} {n_paper3} {n_cube}"
+            );
+        }
+    }
+
+    /// A sphere narrower than 10⁻³ rad seen from the edge gets its bounding cube's hull, in
+    /// both constructions; a wider one does not.
+    #[test]
+    fn thin_spheres_get_the_bounding_cube() {
+        let (a, b) = (DVec3::new(-0.4, 1.0, 0.3), DVec3::new(0.5, 1.3, 0.2));
+        let c = DVec3::new(0.0, 3.0, 0.0);
+        let r = 0.9e-3 * (adjusted_edge(c, a, b)[0] - c).length();
+        let cube = thin_light_cube(c, r, adjusted_edge(c, a, b)[0]).unwrap();
+        let hull = wedge_halfspaces(c, &cube, a, b);
+        assert_eq!(sphere_wedge_halfspaces(c, r, 8, a, b), hull);
+        assert_eq!(bounding_sphere_halfspaces(c, r, a, b), hull);
+        assert!(thin_light_cube(c, 0.5, a).is_none());
+        let light = WedgeLight::Sphere {
+            center: c,
+            radius: 0.5,
+        };
+        assert_eq!(
+            bounding_sphere_halfspaces(c, 0.5, a, b),
+            paper3_halfspaces(&light, a, b)
+        );
     }
 
     #[test]

@@ -197,7 +197,7 @@ pub const VARIANTS: &[GoldenCase] = &[
     GoldenCase::new("scenes/fire.toml", "ssv").sized(32),
     GoldenCase::new("scenes/fire.toml", "raycast").sized(32),
     // ssv-optimized: overlap approximation, light split, plane split, exact coverage, filter,
-    // bounding-sphere wedges.
+    // bounding-sphere wedges, a sphere's tight wedges over squares.
     GoldenCase::variant(
         "cube-of-spheres",
         "ssv-optimized",
@@ -233,6 +233,12 @@ pub const VARIANTS: &[GoldenCase] = &[
         "ssv-optimized",
         "bounding-sphere",
         &[("wedge", "bounding-sphere")],
+    ),
+    GoldenCase::variant(
+        "cylinder",
+        "ssv-optimized",
+        "sides4",
+        &[("sphere_sides", "4")],
     ),
     // pw2002 / pw-restructured: LI formats and overflow, falloff, corner wedges, the parallel
     // rule, side planes, several lights, three passes, culling, z-fail with the eye in shadow.
