@@ -19,6 +19,20 @@ fn register_font() -> Result<(), String> {
     .clone()
 }
 
+/// The colours of every plot's series, in order (Tableau 10).
+pub const PALETTE: [RGBColor; 10] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(127, 127, 127),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(23, 190, 207),
+    RGBColor(188, 189, 34),
+    RGBColor(227, 119, 194),
+];
+
 /// A plot that can draw itself on any plotters backend.
 pub trait Plot {
     /// Draws the whole plot on `area`.

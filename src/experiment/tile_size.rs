@@ -9,7 +9,7 @@
 //! findings, printed and written to `tile_size_summary.txt`.
 
 use crate::error::InputError;
-use crate::experiment::plotting::{png_and_svg, Plot};
+use crate::experiment::plotting::{png_and_svg, Plot, PALETTE};
 use crate::frame::{Frame, GpuSettings};
 use crate::methods::options::OptionReader;
 use crate::methods::pw2002::{frame_wedges, read_wedge_settings};
@@ -202,14 +202,6 @@ struct TileSizePlot<'a> {
 impl Plot for TileSizePlot<'_> {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
         let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
-        const COLOURS: [RGBColor; 6] = [
-            RGBColor(31, 119, 180),
-            RGBColor(255, 127, 14),
-            RGBColor(44, 160, 44),
-            RGBColor(214, 39, 40),
-            RGBColor(148, 103, 189),
-            RGBColor(140, 86, 75),
-        ];
         let values = self
             .rows
             .iter()
@@ -245,7 +237,7 @@ impl Plot for TileSizePlot<'_> {
             .draw()
             .map_err(err)?;
         for (i, (p, c)) in VARIANTS.iter().enumerate() {
-            let colour = COLOURS[i % COLOURS.len()];
+            let colour = PALETTE[i % PALETTE.len()];
             let of = |f: fn(&Row) -> u64| -> Vec<(f64, f64)> {
                 self.rows
                     .iter()

@@ -9,7 +9,7 @@
 //! Drawn with `plotters` once per backend ([`crate::experiment::plotting`]).
 
 use super::{pareto_front, Row, Sweep};
-use crate::experiment::plotting::{png_and_svg, Plot};
+use crate::experiment::plotting::{png_and_svg, Plot, PALETTE};
 use crate::methods;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -27,18 +27,6 @@ pub const MARKERS: usize = 8;
 
 /// The colour of `method` (Tableau 10, by its position in [`methods::ALL`]).
 pub fn method_colour(method: &str) -> RGBColor {
-    const PALETTE: [RGBColor; 10] = [
-        RGBColor(31, 119, 180),
-        RGBColor(255, 127, 14),
-        RGBColor(127, 127, 127),
-        RGBColor(148, 103, 189),
-        RGBColor(140, 86, 75),
-        RGBColor(44, 160, 44),
-        RGBColor(214, 39, 40),
-        RGBColor(23, 190, 207),
-        RGBColor(188, 189, 34),
-        RGBColor(227, 119, 194),
-    ];
     let k = methods::ALL
         .iter()
         .position(|m| *m == method)
