@@ -502,7 +502,7 @@ pub fn sphere_silhouette_polygon(
 /// [`paper3_halfspaces`]), the facet half-spaces of the convex hull of the two end pyramids
 /// over the `sides`-gons circumscribing the sphere's silhouette disks seen from the adjusted
 /// end points ([`sphere_silhouette_polygon`], [`hull_halfspaces`]) except its facets along the
-/// edge (normal within [`MIN_SIDE_FACET_SINE`] of perpendicular to it: its own front and back,
+/// edge (normal within `MIN_SIDE_FACET_SINE`, 0.05, of perpendicular to it: its own front and back,
 /// looser than Paper III's, and the facets between them and the ends, within the wedge's angle
 /// of Paper III's), then Paper III's two side planes unless nearly parallel to a plane already
 /// kept. Every one of these holds the penumbra volume, so the wedge does, and it is never
@@ -600,7 +600,7 @@ pub fn bounding_sphere_halfspaces(
 /// The four planes (front, back, left, right) of Paper III's wedge of edge `e0 e1`
 /// ([`SsvWedge`], §3.1) as outward half-spaces; empty when that wedge is degenerate (Paper
 /// III's whole space, [`SsvWedge::new`] returns `None`). With a sphere around a light this is
-/// "the previously presented method [that] created wedges from bounding spheres" of Paper IV
+/// "the previously presented method \[that\] created wedges from bounding spheres" of Paper IV
 /// §4.1 ([`bounding_sphere_halfspaces`]).
 pub fn paper3_halfspaces(light: &WedgeLight, e0: DVec3, e1: DVec3) -> Vec<HalfSpace> {
     SsvWedge::new(light, e0, e1).map_or_else(Vec::new, |w| {
