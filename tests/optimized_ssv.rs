@@ -220,11 +220,7 @@ fn render(scene: &str, size: u32, opts: &[(&str, &str)]) -> (Vec<f32>, u64) {
     s.methods = Some(vec!["ssv-optimized".into()]);
     let table = s.options.entry("ssv-optimized".into()).or_default();
     for (k, v) in opts {
-        let value = match v.parse::<i64>() {
-            Ok(i) => penumbra::scene::OptionValue::Int(i),
-            Err(_) => penumbra::scene::OptionValue::Str(v.to_string()),
-        };
-        table.insert(k.to_string(), value);
+        table.insert(k.to_string(), penumbra::scene::OptionValue::parse_cli(v));
     }
     let runs = penumbra::render::render_scene(&s).unwrap();
     let out = &runs[0].output;
@@ -464,11 +460,7 @@ fn sphere_sides_must_act() {
         s.methods = Some(vec!["ssv-optimized".into()]);
         let table = s.options.entry("ssv-optimized".into()).or_default();
         for (k, v) in opts {
-            let value = match v.parse::<i64>() {
-                Ok(i) => penumbra::scene::OptionValue::Int(i),
-                Err(_) => penumbra::scene::OptionValue::Str(v.to_string()),
-            };
-            table.insert(k.to_string(), value);
+            table.insert(k.to_string(), penumbra::scene::OptionValue::parse_cli(v));
         }
         penumbra::render::render_scene(&s).map(|_| ())
     };
