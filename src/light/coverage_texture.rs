@@ -215,6 +215,47 @@ impl CoverageTexture {
     }
 }
 
+/// An upper bound on `|lookup(p1, p2, filter) − segment_coverage(p1, p2)|` for a **uniform**
+/// light with `n` texel positions per side, derived from the grid alone (no measurement), or
+/// `None` where no bound holds.
+///
+/// Derivation. A lookup reads texels whose endpoints `a′, b′` lie within `r₁` of `a = p1` and
+/// `r₂` of `b = p2`: `r = h/√2` for a rounded endpoint and `r = h√2` for a bilinearly filtered
+/// one (a corner of its grid cell), with the spacing `h = 2/(n − 1)`. Filtering is a convex
+/// combination of such texels, so it suffices to bound one texel. Each texel stores
+/// `segment_coverage(a′, b′)` rounded to 8 bits (error ≤ ½/255). The region of
+/// [`segment_coverage`](crate::light::coverage::segment_coverage) is the part of the light
+/// square beyond the segment inside the cone from the center through its endpoints, so the
+/// symmetric difference of the regions of `a b` and `a′ b′` lies in
+/// - the two sectors between the rays through `a, a′` and through `b, b′`: inside the square
+///   (radius ≤ √2) each has area ≤ ½·2·Δθ, with `Δθ ≤ asin(r/|p|)`;
+/// - the part between the two segments, inside the stadium `a b ⊕ disk(max r)`:
+///   area ≤ 2·max r·|a b| + π·(max r)².
+///
+/// Coverage is area / 4. This holds only while `a′ b′` keeps the orientation of `a b` (else
+/// the region switches to the other side of the center: the jump of module doc "Lookup",
+/// where filtered lookups blend both sides). `|a′×b′ − a×b| ≤ r₁|b| + r₂|a| + r₁r₂`, so the
+/// bound is returned only where `|a×b|` exceeds that (which also gives `|a| > r₁`,
+/// `|b| > r₂`).
+pub fn lookup_error_bound(n: u32, filter: CoverageFilter, p1: DVec2, p2: DVec2) -> Option<f64> {
+    let h = 2.0 / (n as f64 - 1.0);
+    let rounded = h * std::f64::consts::FRAC_1_SQRT_2;
+    let filtered = h * std::f64::consts::SQRT_2;
+    let (r1, r2) = match filter {
+        CoverageFilter::Nearest => (rounded, rounded),
+        CoverageFilter::Bilinear => (rounded, filtered),
+        CoverageFilter::Quadrilinear => (filtered, filtered),
+    };
+    let (la, lb) = (p1.length(), p2.length());
+    if p1.perp_dot(p2).abs() <= r1 * lb + r2 * la + r1 * r2 {
+        return None;
+    }
+    let sectors = libm::asin(r1 / la) + libm::asin(r2 / lb);
+    let r = r1.max(r2);
+    let between = 2.0 * r * (p2 - p1).length() + std::f64::consts::PI * r * r;
+    Some(0.5 / 255.0 + (sectors + between) / 4.0)
+}
+
 /// The process-wide cached texture for `key` (module doc, "Cache"), computed on first use.
 pub fn coverage_texture(key: &CoverageTextureKey) -> Arc<CoverageTexture> {
     static CACHE: OnceLock<Mutex<HashMap<CoverageTextureKey, Arc<CoverageTexture>>>> =
