@@ -96,11 +96,23 @@ fn exact_sector_minus_triangle_equals_clipping() {
     assert!(worst < 1e-12, "{worst}");
 }
 
-/// Table lookups (atan2 cube map 6×128² 16-bit nearest, area table 256² 8-bit) against exact
-/// arithmetic, measured over the segment grid. Measured: max 0.00261 (bilinear area table),
-/// 0.00570 (nearest) for the square; 0.00232 / 0.00466 for the disk. Bounds stated with ~20%
-/// margin. (The atan2 map alone is off by ≤ 1/128 rad; the area derivative is ≤ 1/4 per rad
-/// for the square and 1/2π for the disk, plus the 8-bit or 16-bit area quantization.)
+/// Table lookups (atan2 cube map 6×128² 16-bit nearest, area table 256² 8-bit square /
+/// 16-bit disk) against exact arithmetic over the segment grid.
+///
+/// Correctness bound, derived from the tables' sizes (`src/light/lookup_tables.rs`): each
+/// angle from the cube map is off by at most half a face texel in the face coordinate `y/x`
+/// (1/128, and dθ/du ≤ 1) plus the 16-bit angle quantization (π/65535). The area table is
+/// read with each angle off by at most half its texel (π/256) for nearest, and bilinear is no
+/// worse: linear interpolation of an L-Lipschitz function between taps h apart is off by at
+/// most 2t(1−t)·L·h ≤ L·h/2, the same π/256 (the tabulated function is continuous, also
+/// across the minor-arc switch at |θ1 − θ0| = π and the wrap). The sector fraction changes by
+/// at most L = ½ r_max² / area per radian of either angle: 1/4 for the square (r_max = √2,
+/// area 4), 1/(2π) for the unit disk. Stored values are relative to ½: quantization ≤
+/// ¼/(2^bits − 1). The triangle is exact and the final clamp cannot add error. Bound:
+/// 2·L·(1/128 + π/65535 + π/256) + ¼/(2^bits − 1) — 0.01105 (square), 0.00641 (disk).
+///
+/// PINS next to it (measured, then ~20% margin; not derived): max 0.00261 (bilinear) and
+/// 0.00570 (nearest) for the square; 0.00232 / 0.00466 for the disk.
 #[test]
 fn tables_vs_exact_bounds() {
     let cases = [
@@ -109,7 +121,13 @@ fn tables_vs_exact_bounds() {
         (AreaShape::Disk, TableFilter::Bilinear, 0.0028),
         (AreaShape::Disk, TableFilter::Nearest, 0.0056),
     ];
-    for (shape, filter, bound) in cases {
+    for (shape, filter, pin) in cases {
+        let (lipschitz, bits) = match shape {
+            AreaShape::Square => (0.25, 8),
+            AreaShape::Disk => (0.5 / std::f64::consts::PI, 16),
+        };
+        let angle = 1.0 / 128.0 + std::f64::consts::PI / 65535.0 + std::f64::consts::PI / 256.0;
+        let derived = 2.0 * lipschitz * angle + 0.25 / ((1u32 << bits) - 1) as f64;
         let mut worst = 0.0f64;
         for (a, b) in segments() {
             let (a, b) = match shape {
@@ -121,8 +139,14 @@ fn tables_vs_exact_bounds() {
             let e = sector_minus_triangle(a, b, shape, CoverageMode::Exact);
             worst = worst.max((t - e).abs());
         }
-        eprintln!("{shape:?} {filter:?}: max |tables − exact| = {worst:.5}");
-        assert!(worst <= bound, "{shape:?} {filter:?}: {worst} > {bound}");
+        eprintln!(
+            "{shape:?} {filter:?}: max |tables − exact| = {worst:.5} (derived bound {derived:.5})"
+        );
+        assert!(
+            worst <= derived,
+            "{shape:?} {filter:?}: {worst} > derived {derived}"
+        );
+        assert!(worst <= pin, "pin: {shape:?} {filter:?}: {worst} > {pin}");
     }
 }
 
