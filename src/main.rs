@@ -1,6 +1,6 @@
 //! The `penumbra` command line: `render`, `report`, `list`, `experiment`, `golden`. With no
-//! arguments it renders the built-in default scene with every available method into `out/`
-//! and its companions into `out/NAME/`, prints the error/time tables, and writes the HTML
+//! arguments it renders the built-in default scene with every available method into
+//! `out/cube-of-spheres/` and its companions into `out/NAME/`, prints the error/time tables, and writes the HTML
 //! report `out/index.html`. Bad input prints one line naming the file and the problem and exits with code 2,
 //! before any output is written.
 
@@ -131,9 +131,10 @@ struct RenderArgs {
     scene: String,
     #[command(flatten)]
     overrides: SceneOverrides,
-    /// Output directory.
-    #[arg(long, default_value = penumbra::render::DEFAULT_OUT)]
-    out: PathBuf,
+    /// Output directory: DIR/METHOD/…. Default: out/SCENE (SCENE: the built-in name or the
+    /// scene file's stem).
+    #[arg(long)]
+    out: Option<PathBuf>,
 }
 
 #[derive(clap::Args, Debug)]
@@ -209,7 +210,7 @@ struct Rendered {
     files: Vec<Vec<String>>,
 }
 
-/// Writes `scene`'s runs into `out/METHOD/` and prints its table and the outputs written.
+/// Writes `scene`'s runs into `out/METHOD/` (`out` = the scene's folder) and prints its table and the outputs written.
 fn write_and_print(
     out: &Path,
     scene: Scene,
@@ -234,8 +235,11 @@ fn write_and_print(
 
 fn render(a: &RenderArgs) -> Result<Rendered, Box<dyn std::error::Error>> {
     let scene = prepare(&a.scene, &a.overrides)?;
+    let out = a.out.clone().unwrap_or_else(|| {
+        Path::new(penumbra::render::DEFAULT_OUT).join(scene_dir_name(&scene.source))
+    });
     let runs = render_scene(&scene)?;
-    write_and_print(&a.out, scene, runs)
+    write_and_print(&out, scene, runs)
 }
 
 /// Writes the report page for `rendered` scenes, whose method folders are `dirs` (relative to
@@ -276,7 +280,7 @@ fn report(a: &ReportArgs) -> Result<(), Box<dyn std::error::Error>> {
     let mut dirs: Vec<PathBuf> = Vec::new();
     let mut rendered = Vec::new();
     for (scene, runs) in scenes.into_iter().zip(runs) {
-        let stem = penumbra::experiment::accuracy_time::plot_stem(&scene.source);
+        let stem = scene_dir_name(&scene.source);
         let dir = (1..)
             .map(|k| match k {
                 1 => PathBuf::from(&stem),
@@ -288,6 +292,12 @@ fn report(a: &ReportArgs) -> Result<(), Box<dyn std::error::Error>> {
         dirs.push(dir);
     }
     write_report(&a.out, &rendered, &dirs)
+}
+
+/// The folder a scene's methods are written to under the output directory: the built-in
+/// name or the scene file's stem, reduced to `[A-Za-z0-9_-]`.
+fn scene_dir_name(source: &str) -> String {
+    penumbra::experiment::accuracy_time::plot_stem(source)
 }
 
 /// A scene argument, loaded and validated.
@@ -434,9 +444,9 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
             let mut rendered = vec![render(&RenderArgs {
                 scene: builtin::DEFAULT.into(),
                 overrides: SceneOverrides::default(),
-                out: out.clone(),
+                out: Some(out.join(builtin::DEFAULT)),
             })?];
-            let mut dirs = vec![PathBuf::new()];
+            let mut dirs = vec![PathBuf::from(builtin::DEFAULT)];
             for name in builtin::DEFAULT_COMPANIONS {
                 let scene = builtin::load(name).ok_or("missing built-in companion scene")?;
                 let methods = penumbra::methods::ALL
@@ -450,7 +460,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
                         methods: Some(methods),
                         ..SceneOverrides::default()
                     },
-                    out: out.join(name),
+                    out: Some(out.join(name)),
                 })?);
                 dirs.push(PathBuf::from(name));
             }

@@ -752,3 +752,32 @@ fn width_alone_keeps_the_aspect_ratio() {
     assert_eq!(stats["height"].as_f64(), Some(expected));
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+/// Without `--out`, `render` writes `out/SCENE/METHOD/` in the current directory: SCENE is the
+/// built-in name or the scene file's stem, so two scenes never share a folder.
+#[test]
+fn render_without_out_writes_out_scene_method() {
+    let dir = fresh_out("default-layout");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene_file = root().join("scenes/receiver-only-floor.toml");
+    for scene in ["single-quad", scene_file.to_str().unwrap()] {
+        let output = Command::new(env!("CARGO_BIN_EXE_penumbra"))
+            .args(["render", scene, "--methods", "hard-sv", "--width", "16"])
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(0), "{stderr}");
+    }
+    for folder in ["single-quad", "receiver-only-floor"] {
+        let image = dir.join("out").join(folder).join("hard-sv/image.png");
+        assert!(image.is_file(), "{} missing", image.display());
+    }
+    assert_eq!(
+        entries(&dir.join("out")).len(),
+        2,
+        "{:?}",
+        entries(&dir.join("out"))
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

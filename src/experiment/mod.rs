@@ -2,6 +2,7 @@
 //! "Experiments and reports": sweeps, CSV, summaries, plots).
 
 pub mod accuracy_time;
+pub mod panels;
 pub mod plotting;
 pub mod tile_size;
 pub mod wedge_blending;

@@ -10,7 +10,7 @@ use std::sync::OnceLock;
 const FONT: &[u8] = include_bytes!("font/DejaVuSans.ttf");
 
 /// Registers [`FONT`] as plotters' `sans-serif` once per process.
-fn register_font() -> Result<(), String> {
+pub(crate) fn register_font() -> Result<(), String> {
     static DONE: OnceLock<Result<(), String>> = OnceLock::new();
     DONE.get_or_init(|| {
         plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
