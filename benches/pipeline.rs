@@ -17,7 +17,8 @@
 //!
 //! Sample counts and measurement times are kept small so that `cargo bench --bench pipeline`
 //! finishes well within three minutes on a shared two-core machine. Run with
-//! `cargo bench --bench pipeline`; `cargo test` does not build or run this target.
+//! `cargo bench --bench pipeline`; `cargo test` does not build or run this target. Criterion
+//! writes its HTML report to `target/criterion/report/index.html`.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, SamplingMode};
 use penumbra::frame::{Frame, GpuSettings};
@@ -114,8 +115,11 @@ fn pipeline(c: &mut Criterion) {
 }
 
 /// Small samples and short measurement windows: the whole file runs in well under three
-/// minutes, at the price of wider confidence intervals.
+/// minutes, at the price of wider confidence intervals. The HTML report
+/// (`target/criterion/report/index.html`) is drawn by plotters with the crate's embedded
+/// font.
 fn config() -> Criterion {
+    penumbra::experiment::plotting::register_font().expect("the embedded font");
     Criterion::default()
         .sample_size(10)
         .warm_up_time(Duration::from_millis(500))

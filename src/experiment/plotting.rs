@@ -9,8 +9,10 @@ use std::sync::OnceLock;
 /// The embedded font (DejaVu Sans 2.37).
 const FONT: &[u8] = include_bytes!("font/DejaVuSans.ttf");
 
-/// Registers [`FONT`] as plotters' `sans-serif` once per process.
-pub(crate) fn register_font() -> Result<(), String> {
+/// Registers [`FONT`] as plotters' `sans-serif` once per process. Every plot of this crate
+/// calls it; a program that draws with plotters through another crate (the benchmarks'
+/// criterion HTML reports) calls it first, since no system font is looked up.
+pub fn register_font() -> Result<(), String> {
     static DONE: OnceLock<Result<(), String>> = OnceLock::new();
     DONE.get_or_init(|| {
         plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)

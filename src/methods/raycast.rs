@@ -101,7 +101,6 @@ use bvh::aabb::{Aabb, Bounded};
 use bvh::bounding_hierarchy::BHShape;
 use bvh::bvh::{Bvh, BvhNode};
 use glam::{DVec3, Vec3};
-use nalgebra::Point3;
 use rayon::prelude::*;
 
 /// Ray-origin offset along the receiver normal, relative to the scene diagonal (module doc,
@@ -481,10 +480,9 @@ impl ShadowRayCaster {
                 let lo = (a.min(b).min(c) - pad).as_vec3();
                 let hi = (a.max(b).max(c) + pad).as_vec3();
                 shapes.push(BoxedTriangle {
-                    aabb: Aabb::with_bounds(
-                        Point3::new(lo.x, lo.y, lo.z),
-                        Point3::new(hi.x, hi.y, hi.z),
-                    ),
+                    // bvh's points are nalgebra's; built from arrays so that this crate
+                    // does not name nalgebra (bvh 0.10 depends on it regardless).
+                    aabb: Aabb::with_bounds(lo.to_array().into(), hi.to_array().into()),
                     triangle: triangles.len(),
                     node_index: 0,
                 });
