@@ -38,6 +38,12 @@ impl Progress {
         self.bar.set_message(what.to_string());
     }
 
+    /// `n` more steps are done (for bars counting work items rather than named steps; safe
+    /// to call from several threads).
+    pub fn advance(&self, n: u64) {
+        self.bar.inc(n);
+    }
+
     /// Every step is done: the bar disappears, leaving the terminal to the results.
     pub fn finish(&self) {
         self.bar.finish_and_clear();

@@ -36,15 +36,19 @@
 //!
 //! A texture is computed once per shape key — `n` and, for textured lights, the resampled
 //! light texture — and kept for the life of the process ([`coverage_texture`]); a video
-//! sequence that shows the same frame again re-uses its texture. The computation is a pure
-//! function of the key (texels computed in parallel, each independently), so the cache cannot
-//! change any bit.
+//! sequence that shows the same frame again re-uses its texture. It is also kept on disk
+//! across processes ([`crate::light::texture_cache`], keyed by the exact inputs and a
+//! fingerprint of this computation's source). The computation is a pure function of the key
+//! (texels computed in parallel, each independently), so neither cache can change any bit.
 
 use crate::light::coverage::{polygon_area, segment_region};
+use crate::light::texture_cache;
+use crate::progress::Progress;
 use crate::scene::RgbTexture;
 use glam::DVec2;
 use rayon::prelude::*;
 use std::collections::HashMap;
+use std::path::Path;
 use std::sync::{Arc, Mutex, OnceLock};
 
 /// Smallest selectable `n`.
@@ -118,6 +122,14 @@ pub struct CoverageTexture {
 impl CoverageTexture {
     /// Compute the texture for `key` (module doc). `key.n` must be in `MIN_N..=MAX_N`.
     pub fn compute(key: &CoverageTextureKey) -> CoverageTexture {
+        Self::compute_with_progress(key, None)
+    }
+
+    /// [`Self::compute`], advancing `progress` by one per row of the big texture (n² rows).
+    fn compute_with_progress(
+        key: &CoverageTextureKey,
+        progress: Option<&Progress>,
+    ) -> CoverageTexture {
         let n = key.n as usize;
         assert!((MIN_N as usize..=MAX_N as usize).contains(&n));
         let side = n * n;
@@ -128,6 +140,9 @@ impl CoverageTexture {
             .flat_map_iter(|row| {
                 let (b, j) = (row / n, row % n);
                 let weights = &weights;
+                if let Some(p) = progress {
+                    p.advance(1);
+                }
                 (0..side).flat_map(move |col| {
                     let (a, i) = (col / n, col % n);
                     let region = segment_region(grid_point(n, a, b), grid_point(n, i, j));
@@ -256,7 +271,9 @@ pub fn lookup_error_bound(n: u32, filter: CoverageFilter, p1: DVec2, p2: DVec2) 
     Some(0.5 / 255.0 + (sectors + between) / 4.0)
 }
 
-/// The process-wide cached texture for `key` (module doc, "Cache"), computed on first use.
+/// The cached texture for `key` (module doc, "Cache"): from this process's cache, else from
+/// the disk cache ([`crate::light::texture_cache`]), else computed — with a progress bar on a
+/// terminal — and stored in both.
 pub fn coverage_texture(key: &CoverageTextureKey) -> Arc<CoverageTexture> {
     static CACHE: OnceLock<Mutex<HashMap<CoverageTextureKey, Arc<CoverageTexture>>>> =
         OnceLock::new();
@@ -264,15 +281,36 @@ pub fn coverage_texture(key: &CoverageTextureKey) -> Arc<CoverageTexture> {
     if let Some(t) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(key) {
         return t.clone();
     }
-    // Computed outside the lock (it takes a while); a concurrent computation of the same key
-    // yields the same bits, and the first one stored wins.
-    let t = Arc::new(CoverageTexture::compute(key));
+    // Loaded or computed outside the lock (it takes a while); a concurrent computation of the
+    // same key yields the same bits, and the first one stored wins.
+    let t = Arc::new(load_or_compute(key, texture_cache::cache_dir().as_deref()));
     cache
         .lock()
         .unwrap_or_else(|e| e.into_inner())
         .entry(key.clone())
         .or_insert(t)
         .clone()
+}
+
+/// The texture of `key` from the disk cache in `dir`, or computed and stored there (a failed
+/// store is ignored: it only costs the next process the computation). `dir = None`: computed.
+pub fn load_or_compute(key: &CoverageTextureKey, dir: Option<&Path>) -> CoverageTexture {
+    if let Some(t) = dir.and_then(|d| texture_cache::load(d, key)) {
+        return t;
+    }
+    let kind = if key.light_texels.is_some() {
+        "RGB"
+    } else {
+        "grey"
+    };
+    let rows = (key.n as usize).pow(2);
+    let progress = Progress::new(rows, &format!("coverage texture n = {} ({kind})", key.n));
+    let t = CoverageTexture::compute_with_progress(key, Some(&progress));
+    progress.finish();
+    if let Some(d) = dir {
+        let _ = texture_cache::store(d, key, &t);
+    }
+    t
 }
 
 /// Grid position `(s_a, t_b)` (module doc).

@@ -11,7 +11,8 @@
 //!   shadow quad of one silhouette edge, by homogeneous clipping (Paper III §3.2.2).
 //!
 //! - [`coverage_texture`]: the 4D coverage texture of Paper III §3.3 (grey and RGB for textured
-//!   lights), computed once per light shape and cached.
+//!   lights), computed once per light shape and cached in the process and on disk
+//!   ([`texture_cache`]).
 //!
 //! - [`radial_parts`]: the light split into four radial parts and the occluded area and
 //!   bounding rectangle of one edge per part (Forest et al. 2006 §3.1, §4.2, §4.3).
@@ -24,3 +25,4 @@ pub mod coverage_texture;
 pub mod lookup_tables;
 pub mod radial_parts;
 pub mod sampling;
+pub mod texture_cache;
