@@ -72,9 +72,9 @@ option_names!(DepthFormat {
 option_table! {
     /// `[options.gpu]`: the pipeline settings of every pass ([`GpuSettings`]).
     pub struct GpuOptions["gpu"] {
-        /// edge of a screen tile in pixels (binning, traversal and hierarchical Z)
+        /// edge of a screen tile in pixels (binning, traversal, hierarchical Z)
         tile_size: PowerOfTwo [2..=256] = PowerOfTwo(crate::limits::DEFAULT_TILE_SIZE);
-        /// depth format of the frame (and by default of the targets seen from a light)
+        /// depth format of every pass (the maps seen from a light default to it too)
         depth: DepthFormat = DepthFormat::D24;
     }
 }

@@ -423,13 +423,13 @@ fn unknown_key(table: &str, key: &str, keys: &[KeyDoc]) -> String {
 }
 
 /// The valid key `key` most likely means: the same key in kebab-case and lower case, else the
-/// nearest within two edits when that is at most a third of the key.
+/// nearest within two edits (a swap of two letters is two) when that is at most half the key.
 fn closest<'a>(key: &str, valid: &[&'a str]) -> Option<&'a str> {
     let written = key.to_lowercase().replace('_', "-");
     valid
         .iter()
         .map(|v| (edit_distance(&written, v), *v))
-        .filter(|&(d, _)| d == 0 || (d <= 2 && 3 * d <= written.chars().count()))
+        .filter(|&(d, _)| d <= 2 && 2 * d <= written.chars().count())
         .min_by_key(|&(d, _)| d)
         .map(|(_, v)| v)
 }
@@ -474,4 +474,239 @@ pub fn listing(tables: &[(&str, Vec<KeyDoc>)]) -> String {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{builtin, OptionValue};
+
+    /// A choice whose spellings are numbers, as `li`'s.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum Bits {
+        B16,
+        B12,
+        B8,
+    }
+
+    option_names!(Bits {
+        B16 = "16",
+        B12 = "12",
+        B8 = "8",
+    });
+
+    option_table! {
+        /// A group of keys.
+        pub struct Group {
+            /// a switch
+            corner_wedges: Switch = Switch::On;
+        }
+    }
+
+    option_table! {
+        /// A table of every kind of key.
+        pub struct Table["test"] {
+            ..group: Group,
+            /// bits
+            li: Bits [&[Bits::B16, Bits::B12]] = Bits::B16;
+            /// a number
+            bias: f64 [0.0..=10.0] = 4.0;
+            /// an integer
+            n: u32 [1..=64] = 8;
+            /// a tile
+            tile_size: PowerOfTwo [2..=256] = PowerOfTwo(8);
+            /// from the scene
+            map_size: Option<u32> [8..=4096] = None, scene "the image's side";
+        }
+    }
+
+    /// A scene whose `[options.test]` holds `pairs`.
+    fn scene(pairs: &[(&str, OptionValue)]) -> Scene {
+        let mut s = builtin::load("single-quad").unwrap();
+        let t = s.options.entry("test".into()).or_default();
+        for (k, v) in pairs {
+            t.insert(k.to_string(), v.clone());
+        }
+        s
+    }
+
+    fn read(pairs: &[(&str, OptionValue)]) -> Result<Table, String> {
+        Table::read(&scene(pairs)).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn values_written_naturally_read_alike() {
+        use OptionValue::{Float, Int, Str};
+        for v in [Int(12), Str("12".into()), OptionValue::parse_cli("12")] {
+            assert_eq!(read(&[("li", v)]).unwrap().li, Bits::B12);
+        }
+        for (v, x) in [
+            (Int(4), 4.0),
+            (Str("4".into()), 4.0),
+            (Float(2.5), 2.5),
+            (OptionValue::parse_cli("1e1"), 10.0),
+            (Float(0.1), 0.1),
+        ] {
+            assert_eq!(
+                read(&[("bias", v)]).unwrap().bias.to_bits(),
+                f64::to_bits(x)
+            );
+        }
+        let t = read(&[
+            ("n", Str("64".into())),
+            ("tile-size", Int(256)),
+            ("map-size", Int(512)),
+            ("corner-wedges", Str("off".into())),
+        ])
+        .unwrap();
+        assert_eq!(
+            (t.n, t.tile_size, t.map_size, t.group.corner_wedges),
+            (64, PowerOfTwo(256), Some(512), Switch::Off)
+        );
+        assert_eq!(read(&[]).unwrap(), Table::default());
+        assert_eq!(Table::default().map_size, None);
+    }
+
+    #[test]
+    fn bad_values_name_the_key_the_value_and_what_is_accepted() {
+        use OptionValue::{Bool, Float, Int, Str};
+        let at = "single-quad: options.test.";
+        for (key, v, says) in [
+            ("li", Int(8), "li: invalid value 8; expected one of 16, 12"),
+            (
+                "li",
+                Str("16 ".into()),
+                "li: invalid value \"16 \"; expected one of 16, 12",
+            ),
+            (
+                "bias",
+                Float(10.5),
+                "bias: invalid value 10.5; expected a number in 0..=10",
+            ),
+            (
+                "bias",
+                Str("nan".into()),
+                "bias: invalid value \"nan\"; expected a number",
+            ),
+            (
+                "n",
+                Float(8.0),
+                "n: invalid value 8.0; expected an integer in 1..=64",
+            ),
+            (
+                "n",
+                Int(-1),
+                "n: invalid value -1; expected an integer in 1..=64",
+            ),
+            (
+                "n",
+                Bool(true),
+                "n: invalid value true; expected an integer in 1..=64",
+            ),
+            (
+                "n",
+                Int(65),
+                "n: invalid value 65; expected an integer in 1..=64",
+            ),
+            ("tile-size", Int(24), "expected a power of two in 2..=256"),
+            (
+                "map-size",
+                Int(4),
+                "map-size: invalid value 4; expected an integer in 8..=4096",
+            ),
+            ("corner-wedges", Bool(true), "expected one of on, off"),
+        ] {
+            let e = read(&[(key, v)]).unwrap_err();
+            assert!(e.starts_with(at) && e.contains(says), "{key}: {e}");
+        }
+    }
+
+    #[test]
+    fn unknown_keys_name_the_valid_ones_and_the_one_meant() {
+        let valid = "valid: corner-wedges, li, bias, n, tile-size, map-size";
+        for (key, meant) in [
+            ("map_size", Some("map-size")),
+            ("Tile_Size", Some("tile-size")),
+            ("corner_wedges", Some("corner-wedges")),
+            ("bais", Some("bias")),
+            ("lii", Some("li")),
+            ("x", None),
+            ("bogus", None),
+        ] {
+            let e = read(&[(key, OptionValue::Int(1))]).unwrap_err();
+            let hint = meant.map_or(String::new(), |m| format!("did you mean {m}? "));
+            assert_eq!(
+                e,
+                format!(
+                    "single-quad: options.test.{key}: unknown option {key} for test; {hint}{valid}"
+                )
+            );
+        }
+    }
+
+    /// An option set with `--opt` is named by the argument, one from the file by the file and
+    /// the key; `--opt` replaces the file's value.
+    #[test]
+    fn errors_name_where_the_value_was_written() {
+        let mut s = scene(&[("n", OptionValue::Int(0))]);
+        let e = Table::read(&s).unwrap_err();
+        assert_eq!(
+            (e.file.as_str(), e.object.as_deref()),
+            ("single-quad", Some("options.test.n"))
+        );
+        s.set_cli_option("test.n=99").unwrap();
+        let e = Table::read(&s).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "--opt test.n=99: invalid value 99; expected an integer in 1..=64"
+        );
+        s.set_cli_option("test.n=9").unwrap();
+        assert_eq!(Table::read(&s).unwrap().n, 9);
+        for bad in ["test.n", "test=1", ".n=1", "test.=1"] {
+            let e = s.set_cli_option(bad).unwrap_err();
+            assert_eq!(
+                e.to_string(),
+                format!("--opt {bad}: expected METHOD.KEY=VALUE")
+            );
+        }
+    }
+
+    #[test]
+    fn written_keys_are_known() {
+        let s = scene(&[("n", OptionValue::Int(2))]);
+        assert!(Table::is_written(&s, "n"));
+        assert!(!Table::is_written(&s, "bias"));
+    }
+
+    #[test]
+    fn the_listing_shows_every_key_its_values_default_and_meaning() {
+        assert_eq!(
+            listing(&[("test", Table::keys())]),
+            "[options.test]\n\
+             \x20 corner-wedges = on | off  (default: on)\n      a switch\n\
+             \x20 li = 16 | 12  (default: 16)\n      bits\n\
+             \x20 bias = number 0..=10  (default: 4)\n      a number\n\
+             \x20 n = integer 1..=64  (default: 8)\n      an integer\n\
+             \x20 tile-size = power of two 2..=256  (default: 8)\n      a tile\n\
+             \x20 map-size = integer 8..=4096  (default: the image's side)\n      from the scene\n"
+        );
+    }
+
+    #[test]
+    fn edit_distances() {
+        for (a, b, d) in [
+            ("", "", 0),
+            ("li", "", 2),
+            ("bias", "bais", 2),
+            ("kitten", "sitting", 3),
+            ("map-size", "map-size", 0),
+            ("√n", "n", 1),
+        ] {
+            assert_eq!(
+                (edit_distance(a, b), edit_distance(b, a)),
+                (d, d),
+                "{a} {b}"
+            );
+        }
+    }
 }

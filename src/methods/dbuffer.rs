@@ -195,7 +195,7 @@ option_table! {
         ..maps: ShadowMapKeys,
         /// storage of the four distance channels
         storage: ColorFormat [&[ColorFormat::F32, ColorFormat::F16]] = ColorFormat::F32;
-        /// V(t): 3t² − 2t³ (eq. 4) or √t (§6.2, for occluders smaller than the light)
+        /// V(t): 3t² − 2t³ (CGI 2004 eq. 4) or √t (§6.2, for occluders smaller than the light)
         falloff: Falloff [&[Falloff::Smoothstep, Falloff::Sqrt]] = Falloff::Smoothstep;
         /// eq. 3's denominator: (|cx| − |cx_s|), t = ½ at the light center's shadow line, or as printed
         eq3: Eq3 = Eq3::Corrected;

@@ -171,9 +171,9 @@ option_table! {
             scene format!("the image's larger side, at most {MAX_MAP_SIZE}");
         /// depth format of the maps rendered from the light
         depth: Option<DepthFormat> = None, scene "the frame's, [options.gpu] depth";
-        /// polygon-offset units of the shadow-map depth, in steps of the depth format (module doc)
+        /// polygon-offset units of the shadow-map depth, in resolvable steps of its depth format
         bias: f64 [0.0..=16_777_215.0] = DEFAULT_BIAS_UNITS;
-        /// slope-scaled polygon-offset factor of the shadow-map depth (module doc)
+        /// slope-scaled polygon-offset factor of the shadow-map depth (glPolygonOffset's factor)
         slope_bias: f64 [0.0..=1000.0] = DEFAULT_SLOPE_BIAS;
     }
 }
@@ -208,7 +208,7 @@ option_table! {
         bias_stage: BiasStage = BiasStage::Render;
         /// triangles per cone at a silhouette vertex
         cone_segments: u32 [3..=1024] = DEFAULT_CONE_SEGMENTS;
-        /// I′ = 3I² − 2I³ (§3, the Bernstein interpolant) or I′ = I
+        /// I′ = 3I² − 2I³ (Wyman & Hansen §3, the Bernstein interpolant) or I′ = I
         falloff: Falloff [&[Falloff::Smoothstep, Falloff::Linear]] = Falloff::Smoothstep;
         /// storage of the penumbra map's colour channel
         storage: ColorFormat = ColorFormat::Unorm8;

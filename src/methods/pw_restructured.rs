@@ -142,11 +142,11 @@ option_table! {
     /// `[options.pw-restructured]` (module doc).
     pub struct PwRestructuredOptions["pw-restructured"] {
         ..wedges: WedgeKeys,
-        /// umbra and penumbra in one pass (§6.2), or stencil, stencil, penumbra (§6.1)
+        /// umbra and penumbra in one pass (Paper II §6.2), or stencil, stencil, penumbra (§6.1)
         passes: Passes = Passes::Single;
-        /// tile occlusion culling (§4): zmin and zmax with the box test, zmax only, or none
+        /// tile occlusion culling (Paper II §4): zmin and zmax with the box test, zmax only, or none
         culling: Culling = Culling::ZminZmax;
-        /// count z-pass or z-fail (§5); auto: z-fail when the near plane is in the light's shadow
+        /// count z-pass or z-fail (Paper II §5); auto: z-fail when the near plane is in the light's shadow
         mode: CountMode = CountMode::Auto;
     }
 }

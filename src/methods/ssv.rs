@@ -143,13 +143,13 @@ option_table! {
     pub struct SsvOptions["ssv"] {
         /// count pass 1 z-pass or z-fail; auto: z-fail when the near plane is in the light center's shadow
         mode: CountMode = CountMode::Auto;
-        /// coverage of an edge: exact clipping (§3.2.2) or the 4D coverage texture (§3.3; rectangle lights)
+        /// coverage of an edge: exact clipping (Paper III §3.2.2) or the 4D coverage texture (§3.3; rectangle lights)
         coverage: Option<CoverageKind> = None, scene "texture for a textured light, else exact";
         /// texel positions per light side of the coverage texture (coverage = texture only)
         texture_n: u32 [MIN_N..=MAX_N] = DEFAULT_N;
         /// lookup filter of the coverage texture (coverage = texture only)
         filter: CoverageFilter = CoverageFilter::Nearest;
-        /// V-buffer format: f32, f16, or the 8-bit stencil and channels of §4.2 (textured lights: f32)
+        /// V-buffer format: f32, f16, or the 8-bit stencil and channels of Paper III §4.2 (textured lights: f32)
         vbuffer: VBufferKind = VBufferKind::F32;
     }
 }

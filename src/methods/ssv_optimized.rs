@@ -336,21 +336,21 @@ option_names!(WedgeShape {
 option_table! {
     /// `[options.ssv-optimized]` (module doc).
     pub struct SsvOptimizedOptions["ssv-optimized"] {
-        /// coverage in the shaders: the paper's lookup tables (§4.2) or exact arithmetic
+        /// coverage in the shaders: the paper's lookup tables (Paper IV §4.2) or exact arithmetic
         coverage: CoverageKind = CoverageKind::Tables;
         /// filter of the area table (coverage = tables)
         filter: TableFilter = TableFilter::Bilinear;
-        /// wedge halves: rendered apart with stencil and depth tests (§4.4), or split by the hard-quad plane in the shader
+        /// wedge halves: rendered apart with stencil and depth tests (Paper IV §4.4), or split by the hard-quad plane in the shader
         split: HalfSplit = HalfSplit::Stencil;
-        /// the overlap approximation: one V-buffer per silhouette loop, combined by eq. 1 (§5.1)
+        /// the overlap approximation: one V-buffer per silhouette loop, combined by eq. 1 (Paper IV §5.1)
         overlap: Overlap = Overlap::Off;
-        /// wedges: the tight hull of the end pyramids (§4.1), or Paper III's wedge of the light's bounding sphere
+        /// wedges: the tight hull of the end pyramids (Paper IV §4.1), or Paper III's wedge of the light's bounding sphere
         wedge: WedgeShape = WedgeShape::Tight;
         /// sides of the polygons around a sphere light's silhouette disks (sphere lights with wedge = tight only)
         sphere_sides: u32 [3..=64] = DEFAULT_SPHERE_SIDES as u32;
-        /// a rectangle light split into k×k pieces, each with its own silhouettes (§5.2)
+        /// a rectangle light split into k×k pieces, each with its own silhouettes (Paper IV §5.2)
         light_split: u32 [1..=4] = 1;
-        /// carry bits per channel of the split V-buffer (§4.3)
+        /// carry bits per channel of the split V-buffer (Paper IV §4.3)
         reserved_bits: u32 [1..=7] = 5;
         /// count pass 1 z-pass or z-fail; auto: z-fail when the near plane is in the shadow of a light center
         mode: CountMode = CountMode::Auto;

@@ -198,13 +198,13 @@ option_names!(Order {
 option_table! {
     /// `[options.wedge-blending]` (module doc).
     pub struct WedgeBlendingOptions["wedge-blending"] {
-        /// vBuffer storage: PK4UB-packed 8-bit values in two RGBA32F targets (§4.3), or f32
+        /// vBuffer storage: PK4UB-packed 8-bit values in two RGBA32F targets (Forest et al. §4.3), or f32
         packing: Packing = Packing::Bit8;
         /// how the RGBA32F targets store packed patterns (packing = 8bit only)
         target: FloatTarget = FloatTarget::Raw;
-        /// the center of gravity per radial part (§6)
+        /// the center of gravity per radial part (Forest et al. §6)
         centroid: Switch = Switch::Off;
-        /// when the inner rectangle adjustment of Fig. 10 applies
+        /// when the inner rectangle adjustment of Forest et al. Fig. 10 applies
         adjust: InnerAdjust = InnerAdjust::Checked;
         /// the order the silhouettes are blended in (the result depends on it)
         order: Order = Order::Forward;
