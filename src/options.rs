@@ -155,9 +155,25 @@ impl OptionType for PowerOfTwo {
     }
 }
 
-/// Declares the option spellings of an enum's variants (`option_names!(Switch { On = "on", Off
-/// = "off" })`): its [`OptionType`], every variant allowed unless a key restricts them.
+/// Declares the option spellings of an enum's variants, `option_names!(Filter { Nearest =
+/// "nearest", Bilinear = "bilinear" })`: its [`OptionType`], every variant allowed unless a key
+/// restricts them. Given a whole enum declaration with a spelling after each variant, it
+/// declares the enum too (`Debug, Clone, Copy, PartialEq, Eq`).
 macro_rules! option_names {
+    (
+        $(#[$meta:meta])*
+        pub enum $name:ident {
+            $($(#[doc = $doc:literal])* $variant:ident = $text:literal,)+
+        }
+    ) => {
+        $(#[$meta])*
+        #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+        pub enum $name {
+            $($(#[doc = $doc])* $variant,)+
+        }
+
+        $crate::options::option_names!($name { $($variant = $text),+ });
+    };
     ($ty:ty { $($variant:ident = $text:literal),+ $(,)? }) => {
         impl $crate::options::OptionType for $ty {
             type Allowed = &'static [$ty];
@@ -189,16 +205,15 @@ macro_rules! option_names {
 }
 pub(crate) use option_names;
 
-/// An `on | off` key.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-pub enum Switch {
-    /// On.
-    On,
-    /// Off.
-    Off,
+option_names! {
+    /// An `on | off` key.
+    pub enum Switch {
+        /// On.
+        On = "on",
+        /// Off.
+        Off = "off",
+    }
 }
-
-option_names!(Switch { On = "on", Off = "off" });
 
 impl Switch {
     /// Whether it is on.

@@ -7,23 +7,18 @@ use crate::options::option_names;
 use crate::scene::{LightShape, Scene};
 use glam::{DVec3, Vec3};
 
-/// The `mode` option of the methods that count shadow-volume boundaries: z-pass, z-fail, or
-/// `auto`, decided from the frame ([`CountMode::zfail`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-pub enum CountMode {
-    /// z-fail when the near plane is in shadow ([`eye_in_shadow`]), else z-pass.
-    Auto,
-    /// Count between the eye and the receiver.
-    ZPass,
-    /// Count between the receiver and infinity (caps needed).
-    ZFail,
+option_names! {
+    /// The `mode` option of the methods that count shadow-volume boundaries: z-pass, z-fail, or
+    /// `auto`, decided from the frame ([`CountMode::zfail`]).
+    pub enum CountMode {
+        /// z-fail when the near plane is in shadow ([`eye_in_shadow`]), else z-pass.
+        Auto = "auto",
+        /// Count between the eye and the receiver.
+        ZPass = "zpass",
+        /// Count between the receiver and infinity (caps needed).
+        ZFail = "zfail",
+    }
 }
-
-option_names!(CountMode {
-    Auto = "auto",
-    ZPass = "zpass",
-    ZFail = "zfail",
-});
 
 impl CountMode {
     /// Whether to count z-fail: as asked, or with `Auto` when the near plane at distance `near`

@@ -541,33 +541,25 @@ pub fn reference_noise_floor(
     Ok(crate::metrics::compare(&merged, reference))
 }
 
-/// How `raycast` sees a sphere light (`[options.raycast] sphere`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SphereAs {
-    /// The disk through the center facing each receiver (the papers' definition).
-    FacingReceiver,
-    /// `nsample`'s one disk, facing the center of the mesh bounds.
-    FixedDisk,
+option_names! {
+    /// How `raycast` sees a sphere light (`[options.raycast] sphere`).
+    pub enum SphereAs {
+        /// The disk through the center facing each receiver (the papers' definition).
+        FacingReceiver = "facing-receiver",
+        /// `nsample`'s one disk, facing the center of the mesh bounds.
+        FixedDisk = "fixed-disk",
+    }
 }
 
-option_names!(SphereAs {
-    FacingReceiver = "facing-receiver",
-    FixedDisk = "fixed-disk",
-});
-
-/// Which point of a pixel `raycast` computes the visibility of (`[options.raycast] receiver`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ReceiverPoint {
-    /// The pixel center un-projected at its stored depth, the point the rasterized methods see.
-    DepthBuffer,
-    /// The exact hit of the ray through the pixel center with the visible triangle's plane.
-    PrimaryRay,
+option_names! {
+    /// Which point of a pixel `raycast` computes the visibility of (`[options.raycast] receiver`).
+    pub enum ReceiverPoint {
+        /// The pixel center un-projected at its stored depth, the point the rasterized methods see.
+        DepthBuffer = "depth-buffer",
+        /// The exact hit of the ray through the pixel center with the visible triangle's plane.
+        PrimaryRay = "primary-ray",
+    }
 }
-
-option_names!(ReceiverPoint {
-    DepthBuffer = "depth-buffer",
-    PrimaryRay = "primary-ray",
-});
 
 option_table! {
     /// `[options.raycast]`: the reference's samples and definitions.

@@ -101,19 +101,15 @@ pub struct SsvSettings {
     pub test: ShadowTest,
 }
 
-/// How `ssv` computes coverage (`[options.ssv] coverage`; module doc, "Coverage").
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum CoverageKind {
-    /// Exact clipping (§3.2.2).
-    Exact,
-    /// The 4D coverage texture (§3.3).
-    Texture,
+option_names! {
+    /// How `ssv` computes coverage (`[options.ssv] coverage`; module doc, "Coverage").
+    pub enum CoverageKind {
+        /// Exact clipping (§3.2.2).
+        Exact = "exact",
+        /// The 4D coverage texture (§3.3).
+        Texture = "texture",
+    }
 }
-
-option_names!(CoverageKind {
-    Exact = "exact",
-    Texture = "texture",
-});
 
 option_names!(CoverageFilter {
     Nearest = "nearest",
@@ -121,22 +117,17 @@ option_names!(CoverageFilter {
     Quadrilinear = "quadrilinear",
 });
 
-/// The V-buffer `ssv` renders into (`[options.ssv] vbuffer`; module doc, "V-buffer").
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum VBufferKind {
-    /// f32 (RGB f32 for a textured light).
-    F32,
-    /// f16.
-    F16,
-    /// The 8-bit stencil and R/G channels of §4.2.
-    Bit8,
+option_names! {
+    /// The V-buffer `ssv` renders into (`[options.ssv] vbuffer`; module doc, "V-buffer").
+    pub enum VBufferKind {
+        /// f32 (RGB f32 for a textured light).
+        F32 = "f32",
+        /// f16.
+        F16 = "f16",
+        /// The 8-bit stencil and R/G channels of §4.2.
+        Bit8 = "8bit",
+    }
 }
-
-option_names!(VBufferKind {
-    F32 = "f32",
-    F16 = "f16",
-    Bit8 = "8bit",
-});
 
 option_table! {
     /// `[options.ssv]` (module doc).

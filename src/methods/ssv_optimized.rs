@@ -286,52 +286,40 @@ pub fn sector_minus_triangle(a: DVec2, b: DVec2, shape: AreaShape, mode: Coverag
     }
 }
 
-/// How the shaders compute coverage (`[options.ssv-optimized] coverage`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum CoverageKind {
-    /// The paper's lookup tables.
-    Tables,
-    /// Exact arithmetic.
-    Exact,
+option_names! {
+    /// How the shaders compute coverage (`[options.ssv-optimized] coverage`).
+    pub enum CoverageKind {
+        /// The paper's lookup tables.
+        Tables = "tables",
+        /// Exact arithmetic.
+        Exact = "exact",
+    }
 }
-
-option_names!(CoverageKind {
-    Tables = "tables",
-    Exact = "exact",
-});
 
 option_names!(HalfSplit {
     Stencil = "stencil",
     Plane = "plane",
 });
 
-/// The overlap approximation (`[options.ssv-optimized] overlap`, §5.1).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Overlap {
-    /// One V-buffer for all silhouettes.
-    Off,
-    /// One V-buffer per silhouette loop, combined by eq. 1.
-    Loops,
+option_names! {
+    /// The overlap approximation (`[options.ssv-optimized] overlap`, §5.1).
+    pub enum Overlap {
+        /// One V-buffer for all silhouettes.
+        Off = "off",
+        /// One V-buffer per silhouette loop, combined by eq. 1.
+        Loops = "loops",
+    }
 }
 
-option_names!(Overlap {
-    Off = "off",
-    Loops = "loops",
-});
-
-/// The wedges (`[options.ssv-optimized] wedge`, §4.1).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum WedgeShape {
-    /// The hull of the end pyramids.
-    Tight,
-    /// Paper III's wedge of the light's bounding sphere.
-    BoundingSphere,
+option_names! {
+    /// The wedges (`[options.ssv-optimized] wedge`, §4.1).
+    pub enum WedgeShape {
+        /// The hull of the end pyramids.
+        Tight = "tight",
+        /// Paper III's wedge of the light's bounding sphere.
+        BoundingSphere = "bounding-sphere",
+    }
 }
-
-option_names!(WedgeShape {
-    Tight = "tight",
-    BoundingSphere = "bounding-sphere",
-});
 
 option_table! {
     /// `[options.ssv-optimized]` (module doc).

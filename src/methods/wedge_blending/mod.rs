@@ -181,19 +181,15 @@ option_names!(Grouping {
     Meshes = "meshes",
 });
 
-/// The order the silhouettes are blended in (`[options.wedge-blending] order`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Order {
-    /// Meshes in scene order, loops in the order they are found (module doc).
-    Forward,
-    /// The opposite.
-    Reverse,
+option_names! {
+    /// The order the silhouettes are blended in (`[options.wedge-blending] order`).
+    pub enum Order {
+        /// Meshes in scene order, loops in the order they are found (module doc).
+        Forward = "forward",
+        /// The opposite.
+        Reverse = "reverse",
+    }
 }
-
-option_names!(Order {
-    Forward = "forward",
-    Reverse = "reverse",
-});
 
 option_table! {
     /// `[options.wedge-blending]` (module doc).
