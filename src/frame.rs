@@ -16,6 +16,7 @@ use crate::gpu::setup::CullMode;
 use crate::gpu::tiling::Tiling;
 use crate::gpu::transform::{ClipVertex, Projection};
 use crate::methods::output::PassStats;
+use crate::options::{option_names, option_table, OptionTable, PowerOfTwo};
 use crate::scene::{Mesh, Scene};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -58,9 +59,32 @@ pub struct GpuSettings {
 
 impl Default for GpuSettings {
     fn default() -> Self {
-        Self {
-            tile_size: crate::limits::DEFAULT_TILE_SIZE,
-            depth: DepthFormat::D24,
+        GpuOptions::default().settings()
+    }
+}
+
+option_names!(DepthFormat {
+    D16 = "d16",
+    D24 = "d24",
+    D32F = "d32f",
+});
+
+option_table! {
+    /// `[options.gpu]`: the pipeline settings of every pass ([`GpuSettings`]).
+    pub struct GpuOptions["gpu"] {
+        /// edge of a screen tile in pixels (binning, traversal, hierarchical Z)
+        tile_size: PowerOfTwo [2..=256] = PowerOfTwo(crate::limits::DEFAULT_TILE_SIZE);
+        /// depth format of every pass (the maps seen from a light default to it too)
+        depth: DepthFormat = DepthFormat::D24;
+    }
+}
+
+impl GpuOptions {
+    /// The pipeline settings these options ask for.
+    pub fn settings(&self) -> GpuSettings {
+        GpuSettings {
+            tile_size: self.tile_size.0,
+            depth: self.depth,
         }
     }
 }
@@ -129,7 +153,7 @@ impl<'s> Frame<'s> {
             })
             .collect::<Result<Vec<_>, InputError>>()?;
         let tiling = Tiling::new(scene.width, scene.height, gpu.tile_size)
-            .map_err(|e| InputError::at(&scene.source, "options.gpu.tile_size", e))?;
+            .map_err(|e| scene.option_error(GpuOptions::NAME, "tile-size", e))?;
         let proj = Projection::for_scene(scene);
         check_camera_outside_geometry(scene, proj.near)?;
         let start = Instant::now();

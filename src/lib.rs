@@ -56,6 +56,7 @@ pub mod limits;
 pub mod memory;
 pub mod methods;
 pub mod metrics;
+pub mod options;
 pub mod output;
 pub mod plan;
 pub mod progress;

@@ -11,7 +11,7 @@ use penumbra::memory;
 use penumbra::progress::Progress;
 use penumbra::render::MethodRun;
 use penumbra::report::SceneRuns;
-use penumbra::scene::{builtin, file, validate, OptionValue, Scene};
+use penumbra::scene::{builtin, file, validate, Scene};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -36,7 +36,11 @@ enum Cmd {
     /// Render scenes like `render` and write an HTML page showing them all, DIR/index.html.
     Report(ReportArgs),
     /// Print the built-in scenes and the methods, one per line.
-    List,
+    List {
+        /// Print instead every option table's keys: values, default and meaning.
+        #[arg(long)]
+        options: bool,
+    },
     /// Run an experiment, or merge the shards of an accuracy–time sweep.
     #[command(subcommand)]
     Experiment(ExperimentCmd),
@@ -115,7 +119,8 @@ struct SceneOverrides {
     /// Override the image height (alone, the width follows the scene's aspect ratio).
     #[arg(long)]
     height: Option<u32>,
-    /// A method option, METHOD.KEY=VALUE (repeatable), e.g. nsample.n=256 or gpu.tile_size=16.
+    /// A method option, METHOD.KEY=VALUE (repeatable), e.g. nsample.n=256 or gpu.tile-size=16;
+    /// `penumbra list --options` lists every key with its values and default.
     #[arg(long = "opt")]
     opts: Vec<String>,
     /// Refuse a render whose estimated memory exceeds this many bytes (suffix K, M, G, T:
@@ -155,19 +160,10 @@ fn apply_overrides(scene: &mut Scene, a: &SceneOverrides) -> Result<(), InputErr
     }
     scene.resize(a.width, a.height);
     for o in &a.opts {
-        let bad = || InputError::at("--opt", o.as_str(), "expected METHOD.KEY=VALUE");
-        let (lhs, value) = o.split_once('=').ok_or_else(bad)?;
-        let (method, key) = lhs.split_once('.').ok_or_else(bad)?;
-        if method.is_empty() || key.is_empty() {
-            return Err(bad());
-        }
-        scene
-            .options
-            .entry(method.to_string())
-            .or_default()
-            .insert(key.to_string(), OptionValue::parse_cli(value));
+        scene.set_cli_option(o)?;
     }
-    validate::validate(scene)
+    validate::validate(scene)?;
+    penumbra::methods::check_option_tables(scene)
 }
 
 /// The scene argument `arg` with the overrides applied, validated, and checked against the
@@ -300,10 +296,11 @@ fn scene_dir_name(source: &str) -> String {
     penumbra::experiment::accuracy_time::plot_stem(source)
 }
 
-/// A scene argument, loaded and validated.
+/// A scene argument, loaded and validated, its option tables checked.
 fn load_scene(arg: &str) -> Result<Scene, InputError> {
     let scene = file::resolve(arg)?;
     validate::validate(&scene)?;
+    penumbra::methods::check_option_tables(&scene)?;
     Ok(scene)
 }
 
@@ -469,7 +466,14 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
         Some(Cmd::Experiment(e)) => experiment(e),
         Some(Cmd::Render(a)) => render(&a).map(|_| ()),
         Some(Cmd::Report(a)) => report(&a),
-        Some(Cmd::List) => {
+        Some(Cmd::List { options: true }) => {
+            print!(
+                "{}",
+                penumbra::options::listing(&penumbra::methods::option_docs())
+            );
+            Ok(())
+        }
+        Some(Cmd::List { options: false }) => {
             println!("# built-in scenes");
             for n in builtin::names() {
                 println!("{n}");

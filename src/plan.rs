@@ -3,8 +3,34 @@
 //! before anything is allocated — which methods run, which passes and buffers each needs, and
 //! whether z-fail is needed because the eye sits inside a shadow volume (detected, not asked).
 
+use crate::options::option_names;
 use crate::scene::{LightShape, Scene};
 use glam::{DVec3, Vec3};
+
+option_names! {
+    /// The `mode` option of the methods that count shadow-volume boundaries: z-pass, z-fail, or
+    /// `auto`, decided from the frame ([`CountMode::zfail`]).
+    pub enum CountMode {
+        /// z-fail when the near plane is in shadow ([`eye_in_shadow`]), else z-pass.
+        Auto = "auto",
+        /// Count between the eye and the receiver.
+        ZPass = "zpass",
+        /// Count between the receiver and infinity (caps needed).
+        ZFail = "zfail",
+    }
+}
+
+impl CountMode {
+    /// Whether to count z-fail: as asked, or with `Auto` when the near plane at distance `near`
+    /// is in the shadow of one of `lights` ([`eye_in_shadow`]).
+    pub fn zfail(self, scene: &Scene, near: f64, lights: &[Vec3]) -> bool {
+        match self {
+            CountMode::ZPass => false,
+            CountMode::ZFail => true,
+            CountMode::Auto => eye_in_shadow(scene, near, lights),
+        }
+    }
+}
 
 /// Grid of near-plane points tested for shadow (per side).
 const NEAR_GRID: u32 = 9;

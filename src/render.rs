@@ -4,11 +4,11 @@
 //! outputs).
 
 use crate::error::InputError;
-use crate::frame::{Frame, GpuSettings, BACKGROUND};
-use crate::gpu::depth::DepthFormat;
-use crate::methods::{self, options::OptionReader, output::MethodOutput, output::Visibility};
+use crate::frame::{Frame, GpuOptions, GpuSettings, BACKGROUND};
+use crate::methods::{self, output::MethodOutput, output::Visibility};
 use crate::metrics::error_report::{error_report, ErrorReport};
 use crate::metrics::ErrorStats;
+use crate::options::OptionTable;
 use crate::output::Comparison;
 use crate::scene::Scene;
 use std::path::Path;
@@ -36,25 +36,9 @@ pub struct MethodRun {
     pub noise_floor: Option<ErrorStats>,
 }
 
-/// Read `[options.gpu]`: `tile_size` (power of two 2…256, default 8) and `depth`
-/// (`d16` | `d24` | `d32f`, default `d24`).
+/// The pipeline settings `[options.gpu]` of `scene` asks for ([`GpuOptions`]).
 pub fn gpu_settings(scene: &Scene) -> Result<GpuSettings, InputError> {
-    let mut r = OptionReader::new(scene, "gpu");
-    let tile_size = r.uint(
-        "tile_size",
-        crate::limits::DEFAULT_TILE_SIZE as u64,
-        2..=256,
-    )? as u32;
-    if !tile_size.is_power_of_two() {
-        return Err(InputError::at(
-            &scene.source,
-            "options.gpu.tile_size",
-            format!("{tile_size} is not a power of two"),
-        ));
-    }
-    let depth = r.depth_format("depth", DepthFormat::D24)?;
-    r.finish()?;
-    Ok(GpuSettings { tile_size, depth })
+    Ok(GpuOptions::read(scene)?.settings())
 }
 
 /// The shaded image (`docs/architecture.md` "The flow of one frame"): `albedo · (ambient +

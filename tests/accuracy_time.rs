@@ -30,14 +30,14 @@ fn scene(name: &str, size: u32) -> Scene {
 
 /// A tiny list: on `single-quad` (rect light) and `cylinder` (sphere light) it has items of
 /// both scenes, methods that support only one of the lights, and a configuration the method
-/// refuses on the sphere (`light_split`).
+/// refuses on the sphere (`light-split`).
 const TINY: &[Configuration] = &[
     ("hard-sv", &[]),
     ("nsample", &[("n", "4")]),
     ("raycast", &[("samples", "16")]),
     ("pw2002", &[("li", "8")]),
     ("ssv", &[("coverage", "exact"), ("vbuffer", "f16")]),
-    ("ssv-optimized", &[("light_split", "2")]),
+    ("ssv-optimized", &[("light-split", "2")]),
     ("wedge-blending", &[("packing", "f32")]),
 ];
 

@@ -198,66 +198,97 @@ fn unknown_scene_name_or_path() {
 fn bad_options_and_methods() {
     let scene = "single-quad";
     let small = ["--width", "32", "--height", "32"];
-    let cases: &[(&str, &[&str], &[&str])] = &[
+    // (what, arguments, what the error line names: the scene or the `--opt` argument, keywords)
+    let cases: &[(&str, &[&str], &str, &[&str])] = &[
         (
             "unknown option",
             &["--methods", "nsample", "--opt", "nsample.bogus=1"],
-            &["nsample.bogus", "unknown option"],
+            "--opt nsample.bogus=1",
+            &["unknown option bogus for nsample; valid: mode, stencil, submission, n"],
         ),
         (
             "not a perfect square",
             &["--methods", "nsample", "--opt", "nsample.n=1000"],
+            "--opt nsample.n=1000",
             &["perfect square"],
         ),
         (
             "option of a method not rendered",
             &["--methods", "hard-sv", "--opt", "nsample.n=1000"],
+            "--opt nsample.n=1000",
             &["perfect square"],
         ),
         (
             "unknown key of a method not rendered",
             &["--methods", "hard-sv", "--opt", "ssv.bogus=1"],
-            &["ssv.bogus", "unknown option"],
+            "--opt ssv.bogus=1",
+            &["unknown option bogus for ssv"],
         ),
         (
             "tile size",
-            &["--methods", "hard-sv", "--opt", "gpu.tile_size=3"],
-            &["tile_size"],
+            &["--methods", "hard-sv", "--opt", "gpu.tile-size=3"],
+            "--opt gpu.tile-size=3",
+            &["invalid value 3; expected a power of two in 2..=256"],
+        ),
+        (
+            "snake-case key",
+            &["--methods", "hard-sv", "--opt", "gpu.tile_size=16"],
+            "--opt gpu.tile_size=16",
+            &["unknown option tile_size for gpu; did you mean tile-size? valid: tile-size, depth"],
         ),
         (
             "unknown method",
             &["--methods", "nosuch"],
+            scene,
             &["unknown method"],
         ),
         (
             "unknown option table",
             &["--methods", "hard-sv", "--opt", "bogus.x=1"],
-            &["unknown method"],
+            "--opt bogus.x=1",
+            &["unknown method \"bogus\"; known: gpu, raycast, nsample"],
         ),
         (
             "option without a value",
             &["--methods", "hard-sv", "--opt", "hard-sv"],
+            "--opt hard-sv",
             &["METHOD.KEY=VALUE"],
         ),
         (
             "hard-sv option",
             &["--methods", "hard-sv", "--opt", "hard-sv.bogus=1"],
+            "--opt hard-sv.bogus=1",
             &["unknown option"],
+        ),
+        (
+            "hard-sv value",
+            &["--methods", "hard-sv", "--opt", "hard-sv.mode=z-fail"],
+            "--opt hard-sv.mode=z-fail",
+            &["invalid value \"z-fail\"; expected one of auto, zpass, zfail"],
         ),
         (
             "unknown key of a method that cannot render the light",
             &["--methods", "hard-sv", "--opt", "pw2002.bogus=1"],
-            &["options.pw2002.bogus", "does not support rect lights"],
+            "--opt pw2002.bogus=1",
+            &["unknown option bogus for pw2002"],
+        ),
+        (
+            "bad value of a method that cannot render the light",
+            &["--methods", "hard-sv", "--opt", "pw2002.li=9"],
+            "--opt pw2002.li=9",
+            &["invalid value 9; expected one of 16, 12, 8"],
         ),
         (
             "known key of a method that cannot render the light",
             &["--methods", "hard-sv", "--opt", "pw2002.li=8"],
-            &["options.pw2002.li", "does not support rect lights"],
+            "--opt pw2002.li=8",
+            &["method pw2002 does not support rect lights"],
         ),
         (
             "ssv filter with exact coverage",
             &["--methods", "ssv", "--opt", "ssv.filter=bilinear"],
-            &["options.ssv.filter", "coverage = \"texture\""],
+            "--opt ssv.filter=bilinear",
+            &["coverage = \"texture\""],
         ),
         (
             "ssv texture-n with exact coverage",
@@ -269,7 +300,8 @@ fn bad_options_and_methods() {
                 "--opt",
                 "ssv.texture-n=16",
             ],
-            &["options.ssv.texture-n", "coverage = \"texture\""],
+            "--opt ssv.texture-n=16",
+            &["coverage = \"texture\""],
         ),
         (
             "wedge-blending packing",
@@ -279,7 +311,8 @@ fn bad_options_and_methods() {
                 "--opt",
                 "wedge-blending.packing=4bit",
             ],
-            &["wedge-blending.packing", "8bit, f32"],
+            "--opt wedge-blending.packing=4bit",
+            &["expected one of 8bit, f32"],
         ),
         (
             "wedge-blending target without packing",
@@ -291,27 +324,24 @@ fn bad_options_and_methods() {
                 "--opt",
                 "wedge-blending.target=flush-denormals",
             ],
-            &["wedge-blending.target", "8bit"],
+            "--opt wedge-blending.target=flush-denormals",
+            &["8bit"],
         ),
         (
             "penumbra maps need a sphere light",
             &["--methods", "penumbra-map"],
+            scene,
             &["method penumbra-map does not support rect lights"],
         ),
         (
             "the D-buffer needs a disk light",
             &["--methods", "dbuffer"],
+            scene,
             &["method dbuffer does not support rect lights"],
         ),
     ];
-    for (what, args, keywords) in cases {
+    for (what, args, file, keywords) in cases {
         let all: Vec<&str> = [&[scene][..], &small, args].concat();
-        // A bad --opt names the option; everything else names the scene.
-        let file = if what.starts_with("option without") {
-            "--opt"
-        } else {
-            scene
-        };
         assert_bad_input(what, &render(what, &all), file, keywords);
     }
     // dbuffer's own options, on a disk-light scene.
@@ -319,23 +349,28 @@ fn bad_options_and_methods() {
         (
             "dbuffer eq3",
             &["--opt", "dbuffer.eq3=exact"],
-            &["dbuffer.eq3", "corrected, printed"],
+            &["--opt dbuffer.eq3=exact: invalid value \"exact\"; expected one of corrected, printed"],
         ),
         (
             "dbuffer storage",
             &["--opt", "dbuffer.storage=unorm8"],
-            &["dbuffer.storage", "f32, f16"],
+            &["expected one of f32, f16"],
         ),
         (
             "dbuffer map size",
-            &["--opt", "dbuffer.map_size=4"],
-            &["dbuffer.map_size"],
+            &["--opt", "dbuffer.map-size=4"],
+            &["--opt dbuffer.map-size=4: invalid value 4; expected an integer in 8..=4096"],
+        ),
+        (
+            "dbuffer map size, snake case",
+            &["--opt", "dbuffer.map_size=64"],
+            &["unknown option map_size for dbuffer; did you mean map-size? valid: map-size, depth"],
         ),
     ];
     for (what, args, keywords) in disk_cases {
         let all: Vec<&str> =
             [&["disk-block"][..], &small, &["--methods", "dbuffer"], args].concat();
-        assert_bad_input(what, &render(what, &all), "disk-block", keywords);
+        assert_bad_input(what, &render(what, &all), "--opt dbuffer.", keywords);
     }
     for size in ["0", "100000"] {
         assert_bad_input(
@@ -355,6 +390,83 @@ fn bad_options_and_methods() {
             scene,
             &["width"],
         );
+    }
+}
+
+/// An option written in a scene file: its errors name the file and `options.METHOD.KEY`; the
+/// same option from `--opt` names the argument instead, and `--opt` overrides the file.
+#[test]
+fn scene_file_option_errors_name_the_file_and_the_key() {
+    let dir = fresh_out("option-file");
+    std::fs::create_dir_all(&dir).unwrap();
+    let base = std::fs::read_to_string(root().join("scenes/tetra-on-floor.toml")).unwrap();
+    let write = |name: &str, table: &str| {
+        let path = dir.join(name);
+        let models = root().join("scenes/models");
+        let text = base.replace("\"models/", &format!("\"{}/", models.display()));
+        std::fs::write(&path, format!("{text}\n{table}\n")).unwrap();
+        path
+    };
+    let bad_value = write("li.toml", "[options.hard-sv]\nmode = \"z-fail\"");
+    let file = bad_value.to_str().unwrap();
+    assert_bad_input(
+        "bad value in the file",
+        &render("file-value", &[&[file][..], SMALL].concat()),
+        &format!("{file}: options.hard-sv.mode: "),
+        &["invalid value \"z-fail\"; expected one of auto, zpass, zfail"],
+    );
+    // The same key from the command line overrides the file's value: a good one renders.
+    let (ok, out) = render(
+        "file-value-overridden",
+        &[&[file][..], SMALL, &["--opt", "hard-sv.mode=zfail"]].concat(),
+    );
+    assert_eq!(ok.status.code(), Some(0), "{ok:?}");
+    assert!(out.join("hard-sv/stats.json").is_file());
+    let snake = write("snake.toml", "[options.gpu]\ntile_size = 16");
+    let file = snake.to_str().unwrap();
+    assert_bad_input(
+        "snake-case key in the file",
+        &render("file-snake", &[&[file][..], SMALL].concat()),
+        &format!("{file}: options.gpu.tile_size: "),
+        &["did you mean tile-size?"],
+    );
+    let table = write("table.toml", "[options.hardsv]\nmode = \"zfail\"");
+    let file = table.to_str().unwrap();
+    assert_bad_input(
+        "unknown table in the file",
+        &render("file-table", &[&[file][..], SMALL].concat()),
+        &format!("{file}: options.hardsv: "),
+        &["unknown method \"hardsv\"; known: gpu, raycast, nsample, hard-sv"],
+    );
+}
+
+/// Values written naturally are read alike from a scene file and from `--opt`: `li = 12`,
+/// `li = "12"`, `--opt pw2002.li=12`, and a number key written as an integer.
+#[test]
+fn natural_spellings_render() {
+    let small = ["--width", "16", "--height", "16"];
+    for opts in [
+        &[
+            "--opt",
+            "pw2002.li=12",
+            "--opt",
+            "pw2002.side-planes=cancel",
+        ][..],
+        &[
+            "--opt",
+            "penumbra-map.bias=4",
+            "--opt",
+            "penumbra-map.slope-bias=2.5",
+        ][..],
+        &["--opt", "gpu.tile-size=16", "--opt", "gpu.depth=d32f"][..],
+    ] {
+        let methods = ["--methods", "pw2002,penumbra-map"];
+        let (output, out) = render(
+            "natural",
+            &[&["cube-of-spheres-sphere"][..], &small, &methods, opts].concat(),
+        );
+        assert_eq!(output.status.code(), Some(0), "{opts:?}: {output:?}");
+        assert!(out.join("pw2002/stats.json").is_file(), "{opts:?}");
     }
 }
 

@@ -129,8 +129,7 @@ fn shared_li_buffer_scales_by_255_over_n_and_overlapping_umbrae_of_one_light_cut
 fn pw2002_and_restructured_agree_on_the_shared_li_buffer_of_two_lights() {
     let scene = two_lights(64);
     let frame = Frame::render(&scene, GpuSettings::default()).unwrap();
-    let mut r = penumbra::methods::options::OptionReader::new(frame.scene, "pw2002");
-    let mut w = pw2002::read_wedge_settings(&mut r, &frame).unwrap();
+    let mut w = pw2002::options(&frame).unwrap();
     assert_eq!(w.lights, 2);
     w.side_planes = SidePlanes::Cancel;
     let set = pw2002::frame_wedges(&frame, &w).unwrap();
@@ -162,8 +161,7 @@ fn pw2002_and_restructured_agree_on_the_shared_li_buffer_of_two_lights() {
     for k in 0..2 {
         let one = scene.with_only_light(k);
         let f = frame.lit_by(&one);
-        let mut r = penumbra::methods::options::OptionReader::new(&one, "pw2002");
-        let w1 = pw2002::read_wedge_settings(&mut r, &f).unwrap();
+        let w1 = pw2002::options(&f).unwrap();
         assert_eq!(w1.lights, 1);
         assert!(pw2002::frame_wedges(&f, &w1).unwrap().wedges.len() < set.wedges.len());
     }

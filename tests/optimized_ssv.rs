@@ -273,7 +273,7 @@ fn deterministic_for_any_thread_count_and_in_range() {
         ("cube-of-spheres", &[], PIN_CLAMPED[0]),
         (
             "cube-of-spheres",
-            &[("overlap", "loops"), ("light_split", "2")],
+            &[("overlap", "loops"), ("light-split", "2")],
             PIN_CLAMPED[1],
         ),
         ("cylinder", &[], 0),
@@ -311,9 +311,9 @@ fn unsupported_combinations_are_errors() {
     s.options
         .entry("ssv-optimized".into())
         .or_default()
-        .insert("light_split".into(), penumbra::scene::OptionValue::Int(2));
+        .insert("light-split".into(), penumbra::scene::OptionValue::Int(2));
     let e = penumbra::render::render_scene(&s).expect_err("an error");
-    assert!(e.to_string().contains("light_split"), "{e}");
+    assert!(e.to_string().contains("light-split"), "{e}");
     let mut s = builtin::load("eye-in-shadow").unwrap();
     s.width = 16;
     s.height = 16;
@@ -473,7 +473,7 @@ fn tight_wedges_shade_fewer_fragments() {
     }
 }
 
-/// `sphere_sides` shapes only a sphere's tight wedges: with a rectangle light, or with
+/// `sphere-sides` shapes only a sphere's tight wedges: with a rectangle light, or with
 /// `wedge = bounding-sphere`, it cannot act and is an error naming the option; out of 3…64 too.
 #[test]
 fn sphere_sides_must_act() {
@@ -488,19 +488,19 @@ fn sphere_sides_must_act() {
         }
         penumbra::render::render_scene(&s).map(|_| ())
     };
-    assert!(run("cube-of-spheres-sphere", &[("sphere_sides", "12")]).is_ok());
+    assert!(run("cube-of-spheres-sphere", &[("sphere-sides", "12")]).is_ok());
     for (scene, opts) in [
-        ("cube-of-spheres", &[("sphere_sides", "12")][..]),
+        ("cube-of-spheres", &[("sphere-sides", "12")][..]),
         (
             "cube-of-spheres-sphere",
-            &[("sphere_sides", "12"), ("wedge", "bounding-sphere")][..],
+            &[("sphere-sides", "12"), ("wedge", "bounding-sphere")][..],
         ),
-        ("cube-of-spheres-sphere", &[("sphere_sides", "2")][..]),
-        ("cube-of-spheres-sphere", &[("sphere_sides", "65")][..]),
+        ("cube-of-spheres-sphere", &[("sphere-sides", "2")][..]),
+        ("cube-of-spheres-sphere", &[("sphere-sides", "65")][..]),
     ] {
         let e = run(scene, opts).expect_err("an error");
         assert!(
-            e.to_string().contains("sphere_sides"),
+            e.to_string().contains("sphere-sides"),
             "{scene} {opts:?}: {e}"
         );
     }

@@ -15,8 +15,7 @@ mod sphere_hard_cases;
 use sphere_hard_cases::{gray, small, with_sphere};
 
 fn wedge_settings(frame: &Frame) -> WedgeSettings {
-    let mut r = penumbra::methods::options::OptionReader::new(frame.scene, "pw2002");
-    pw2002::read_wedge_settings(&mut r, frame).expect("settings")
+    pw2002::options(frame).expect("settings")
 }
 
 fn li_pw2002(frame: &Frame, s: &WedgeSettings) -> Vec<i32> {

@@ -121,6 +121,7 @@ fn two_bars() -> Scene {
         ],
         methods: None,
         options: Default::default(),
+        cli_options: Default::default(),
         ambient: 0.15,
     }
 }

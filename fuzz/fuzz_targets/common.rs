@@ -1035,7 +1035,7 @@ pub fn ssv_wedge(data: &[u8]) {
 
 /// The `tight_wedge` path: Paper IV's tight wedge of the edge (see [`EdgeInput`]; selector bit
 /// 1: `wedge = tight`, else `bounding-sphere`, as `ssv-optimized`'s `wedge` option; bits 2–7
-/// pick a sphere's `sphere_sides`, 3…64; [`LightModel::wedge_halfspaces`]) clipped to the box
+/// pick a sphere's `sphere-sides`, 3…64; [`LightModel::wedge_halfspaces`]) clipped to the box
 /// of a scene holding the light, the edge and the receivers ([`wedge_clip_box`]): the wedge's
 /// half-spaces, [`polyhedron_from_planes`], [`halves_from_planes`], [`bounding_planes`], and
 /// [`ConvexPolyhedron::split`] by a plane from the input. Checked:
@@ -1080,6 +1080,7 @@ pub fn tight_wedge(data: &[u8]) {
         }],
         methods: None,
         options: Default::default(),
+        cli_options: Default::default(),
         ambient: 0.0,
     };
     let (lo, hi) = wedge_clip_box(&scene);
@@ -1242,6 +1243,7 @@ pub fn pw_wedges(data: &[u8]) {
         }],
         methods: None,
         options: Default::default(),
+        cli_options: Default::default(),
         ambient: 0.0,
     };
     if validate(&scene).is_err() {

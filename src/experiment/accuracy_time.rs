@@ -6,7 +6,7 @@
 //! **The list.** For each scene in the order given, every configuration of the table in
 //! table order whose method supports the scene's lights ([`methods::supports_scene`]) and
 //! whose options the method accepts on that scene ([`methods::check_options`]; e.g.
-//! `ssv-optimized`'s `light_split` is for rectangular lights only, `overlap = loops` refuses
+//! `ssv-optimized`'s `light-split` is for rectangular lights only, `overlap = loops` refuses
 //! z-fail). A configuration the method refuses is listed under `skipped` with the reason. The
 //! knobs are set on top of the scene's own `[options.METHOD]` table; the scene's `methods`
 //! list is ignored. Item `k` of this (scene × configuration) list is the sweep's `k`-th row.
@@ -194,9 +194,9 @@ pub const CONFIGURATIONS: &[Configuration] = &[
     ("ssv-optimized", &[]),
     ("ssv-optimized", &[("filter", "nearest")]),
     ("ssv-optimized", &[("coverage", "exact")]),
-    ("ssv-optimized", &[("light_split", "2")]),
-    ("ssv-optimized", &[("light_split", "3")]),
-    ("ssv-optimized", &[("light_split", "4")]),
+    ("ssv-optimized", &[("light-split", "2")]),
+    ("ssv-optimized", &[("light-split", "3")]),
+    ("ssv-optimized", &[("light-split", "4")]),
     ("ssv-optimized", &[("overlap", "loops")]),
     ("wedge-blending", &[]),
     ("wedge-blending", &[("packing", "f32")]),

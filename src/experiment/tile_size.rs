@@ -11,11 +11,11 @@
 use crate::error::InputError;
 use crate::experiment::plotting::{png_and_svg, Plot, PALETTE};
 use crate::frame::{Frame, GpuSettings};
-use crate::methods::options::OptionReader;
-use crate::methods::pw2002::{frame_wedges, read_wedge_settings};
+use crate::methods::pw2002::frame_wedges;
 use crate::methods::pw_restructured::{
-    render_li, Culling, Passes, RestructuredSettings, WedgeTest,
+    render_li, Culling, Passes, PwRestructuredOptions, RestructuredSettings, WedgeTest,
 };
+use crate::options::OptionTable;
 use crate::plan::{eye_in_shadow, representative_light_points};
 use crate::scene::Scene;
 use plotters::coord::Shift;
@@ -86,8 +86,9 @@ pub fn sweep(scene: &Scene) -> Result<Vec<Row>, InputError> {
             ..GpuSettings::default()
         };
         let frame = Frame::render(scene, gpu)?;
-        let mut r = OptionReader::new(scene, "pw-restructured");
-        let wedge = read_wedge_settings(&mut r, &frame)?;
+        let wedge = PwRestructuredOptions::read(scene)?
+            .wedges
+            .settings(&frame)?;
         let set = frame_wedges(&frame, &wedge)?;
         let pts = representative_light_points(scene);
         let test = if eye_in_shadow(scene, frame.proj.near, &pts) {

@@ -39,7 +39,7 @@
 //! crosses the plane of the sphere's silhouette circle seen from `e` inside that circle's disk
 //! (the tangent cone from `e` is the cone over the disk), so the pyramid over a polygon
 //! **circumscribing** that disk holds the cone ([`sphere_silhouette_polygon`]): a regular
-//! `N`-gon, `N` = [`DEFAULT_SPHERE_SIDES`] (`ssv-optimized`'s `sphere_sides`). The convex hull
+//! `N`-gon, `N` = [`DEFAULT_SPHERE_SIDES`] (`ssv-optimized`'s `sphere-sides`). The convex hull
 //! of the two end pyramids, each over its own end's polygon ([`hull_halfspaces`]; one corner
 //! set for both ends would add the rays from the other end's polygon and be looser), encloses
 //! the penumbra volume and is at most `1/cos(π/N)` wider (in the tangent of the angle seen

@@ -98,7 +98,7 @@
 //!   crack between them for a ray to pass through;
 //! * otherwise they **diverge** and the gap is closed by a fan of triangles (v, f(p(θ_k)),
 //!   f(p(θ_k+1))) with p(θ) the rim point at angle θ, interpolating from p1 to p2 along the
-//!   shorter arc in ⌈|Δθ|·`fan_segments`/2π⌉ steps ("in the case of a circular light source,
+//!   shorter arc in ⌈|Δθ|·`fan-segments`/2π⌉ steps ("in the case of a circular light source,
 //!   it is preferable to extrude more triangles using interpolation between pp for each of the
 //!   two adjacent edges"). The ends are p1 and p2 themselves, so the fan meets both quads.
 //!

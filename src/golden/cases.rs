@@ -208,7 +208,7 @@ pub const VARIANTS: &[GoldenCase] = &[
         "single-quad",
         "ssv-optimized",
         "split2",
-        &[("light_split", "2")],
+        &[("light-split", "2")],
     ),
     GoldenCase::variant(
         "single-quad",
@@ -238,7 +238,7 @@ pub const VARIANTS: &[GoldenCase] = &[
         "cylinder",
         "ssv-optimized",
         "sides4",
-        &[("sphere_sides", "4")],
+        &[("sphere-sides", "4")],
     ),
     // pw2002 / pw-restructured: LI formats and overflow, falloff, corner wedges, the parallel
     // rule, side planes, several lights, three passes, culling, z-fail with the eye in shadow.
@@ -255,19 +255,19 @@ pub const VARIANTS: &[GoldenCase] = &[
         "pw-columns",
         "pw2002",
         "no-corners",
-        &[("corner_wedges", "off")],
+        &[("corner-wedges", "off")],
     ),
     GoldenCase::variant(
         "cylinder",
         "pw2002",
         "no-parallel-rule",
-        &[("parallel_rule", "off")],
+        &[("parallel-rule", "off")],
     ),
     GoldenCase::variant(
         "pw-columns",
         "pw2002",
         "cancel",
-        &[("side_planes", "cancel")],
+        &[("side-planes", "cancel")],
     ),
     GoldenCase::variant(
         "two-lights",
@@ -325,10 +325,10 @@ pub const VARIANTS: &[GoldenCase] = &[
     GoldenCase::variant("cube-of-spheres", "hard-sv", "d32f", &[]).gpu(&[("depth", "d32f")]),
     GoldenCase::variant("cube-of-spheres", "hard-sv", "d16", &[]).gpu(&[("depth", "d16")]),
     GoldenCase::variant("cube-of-spheres", "ssv", "d32f", &[]).gpu(&[("depth", "d32f")]),
-    GoldenCase::variant("cube-of-spheres", "ssv", "tile16", &[]).gpu(&[("tile_size", "16")]),
-    GoldenCase::variant("cube-of-spheres", "ssv", "tile2", &[]).gpu(&[("tile_size", "2")]),
+    GoldenCase::variant("cube-of-spheres", "ssv", "tile16", &[]).gpu(&[("tile-size", "16")]),
+    GoldenCase::variant("cube-of-spheres", "ssv", "tile2", &[]).gpu(&[("tile-size", "2")]),
     GoldenCase::variant("cube-of-spheres", "wedge-blending", "tile32", &[])
-        .gpu(&[("tile_size", "32")]),
+        .gpu(&[("tile-size", "32")]),
     // wedge-blending (Forest et al. 2006): packing, knobs, float targets, order.
     GoldenCase::variant("forest-spheres", "wedge-blending", "packed", &[]),
     GoldenCase::variant(
@@ -401,25 +401,25 @@ pub const VARIANTS: &[GoldenCase] = &[
         "pw-columns",
         "penumbra-map",
         "map32-unorm8",
-        &[("map_size", "32"), ("storage", "unorm8")],
+        &[("map-size", "32"), ("storage", "unorm8")],
     ),
     GoldenCase::variant(
         "pw-columns",
         "penumbra-map",
         "map32-f32",
-        &[("map_size", "32"), ("storage", "f32")],
+        &[("map-size", "32"), ("storage", "f32")],
     ),
     GoldenCase::variant(
         "pw-columns",
         "penumbra-map",
         "map128-unorm8",
-        &[("map_size", "128"), ("storage", "unorm8")],
+        &[("map-size", "128"), ("storage", "unorm8")],
     ),
     GoldenCase::variant(
         "pw-columns",
         "penumbra-map",
         "map128-f32",
-        &[("map_size", "128"), ("storage", "f32")],
+        &[("map-size", "128"), ("storage", "f32")],
     ),
 ];
 

@@ -29,19 +29,6 @@ pub enum ColorFormat {
 }
 
 impl ColorFormat {
-    /// The names of the formats in option values, in the order of [`ColorFormat::from_option`].
-    pub const OPTION_NAMES: [&'static str; 3] = ["unorm8", "f16", "f32"];
-
-    /// The format an option value names (one of [`ColorFormat::OPTION_NAMES`]).
-    pub fn from_option(name: &str) -> Option<Self> {
-        match name {
-            "unorm8" => Some(ColorFormat::Unorm8),
-            "f16" => Some(ColorFormat::F16),
-            "f32" => Some(ColorFormat::F32),
-            _ => None,
-        }
-    }
-
     /// Bytes one sample occupies.
     pub fn bytes(self) -> u64 {
         match self {
@@ -176,9 +163,6 @@ mod tests {
         assert!(F16.encode(1e6).1);
         assert_eq!(F32.decode(F32.encode(0.1).0), 0.1f32);
         assert!(!F32.encode(-0.25).1);
-        for (k, n) in ColorFormat::OPTION_NAMES.iter().enumerate() {
-            assert_eq!(ColorFormat::from_option(n), Some([Unorm8, F16, F32][k]));
-        }
     }
 
     #[test]

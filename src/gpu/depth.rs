@@ -27,29 +27,6 @@ pub enum DepthFormat {
 }
 
 impl DepthFormat {
-    /// The names of the formats in option values (`depth = "d16" | "d24" | "d32f"`), in the
-    /// order of [`DepthFormat::from_option`].
-    pub const OPTION_NAMES: [&'static str; 3] = ["d16", "d24", "d32f"];
-
-    /// The format an option value names (one of [`DepthFormat::OPTION_NAMES`]).
-    pub fn from_option(name: &str) -> Option<Self> {
-        match name {
-            "d16" => Some(DepthFormat::D16),
-            "d24" => Some(DepthFormat::D24),
-            "d32f" => Some(DepthFormat::D32F),
-            _ => None,
-        }
-    }
-
-    /// The option value naming this format.
-    pub fn option_name(self) -> &'static str {
-        match self {
-            DepthFormat::D16 => "d16",
-            DepthFormat::D24 => "d24",
-            DepthFormat::D32F => "d32f",
-        }
-    }
-
     /// Bytes one sample occupies (used by the traffic counters).
     pub fn bytes(self) -> u64 {
         match self {
@@ -226,15 +203,6 @@ mod tests {
         assert_eq!(f.quantize(1.5 / 65535.0), 2);
         assert_eq!(f.to_window(D16_MAX), 1.0);
         assert_eq!(f.bytes(), 2);
-        for (k, name) in DepthFormat::OPTION_NAMES.iter().enumerate() {
-            let parsed = DepthFormat::from_option(name).unwrap();
-            assert_eq!(
-                parsed,
-                [DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F][k]
-            );
-            assert_eq!(parsed.option_name(), *name);
-        }
-        assert_eq!(DepthFormat::from_option("d8"), None);
     }
 
     #[test]

@@ -5,8 +5,8 @@
 //!
 //! # The light-view camera
 //!
-//! A square `map_size`×`map_size` target (Wyman & Hansen §5 render their maps at the image
-//! size; the penumbra-map method defaults `map_size` to the frame's larger side) seen through
+//! A square `map-size`×`map-size` target (Wyman & Hansen §5 render their maps at the image
+//! size; the penumbra-map method defaults `map-size` to the frame's larger side) seen through
 //! one perspective frustum ([`Projection::frustum`], finite far plane) from the light center.
 //! The frustum covers the receivers by covering the scene: every mesh vertex is inside it,
 //! hence every triangle (the frustum is convex), every receiver and every occluder between a

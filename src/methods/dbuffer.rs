@@ -10,7 +10,7 @@
 //!    circle, trimmed or closed with fans at the corners, and the silhouette faces that do not
 //!    face c appended to the umbra volume (§3.3) — [`crate::geometry::umbra_penumbra`], every
 //!    choice documented there.
-//! 2. **D-buffer** (§2.2, §3): one RGBA render target of `map_size`² texels
+//! 2. **D-buffer** (§2.2, §3): one RGBA render target of `map-size`² texels
 //!    (`storage = f32|f16` per channel, [`RgbaTile`]) seen from the light center through the
 //!    light view ([`crate::gpu::light_view`]; fitted around the scene, depth format `depth`),
 //!    filled by three draws that each own some of its channels by colour masking
@@ -28,7 +28,7 @@
 //!      umbra region |cx_o| and |cx| will be the same", §3.1, so receivers are drawn too).
 //!      The paper gives no bias; without one the lit side of every occluder shadows itself
 //!      wherever the texel's ray meets the surface farther than the receiver. We add the
-//!      shadow maps' polygon offset ([`PolygonOffset`], `bias` units and `slope_bias`, as
+//!      shadow maps' polygon offset ([`PolygonOffset`], `bias` units and `slope-bias`, as
 //!      `penumbra-map`) to the fragment's depth and, in distance units (× range), to the
 //!      stored distance.
 //!    * **G = |cx_uv|, A = |cx_s|** (`dbuffer-umbra`): the umbra volume, both facings, depth
@@ -108,8 +108,8 @@
 //! no umbra (§4 case 2: V too low, √t better), acute silhouette corners — are measured and
 //! pinned in `tests/dbuffer.rs`; the findings are in `docs/dbuffer.md`.
 
-use super::options::OptionReader;
 use super::output::{MethodOutput, PassStats, Visibility};
+use super::penumbra_map::ShadowMapKeys;
 use crate::error::InputError;
 use crate::frame::Frame;
 use crate::geometry::umbra_penumbra::{build_volumes, Disk, Extrusion, VolumeStats, VolumeVertex};
@@ -121,15 +121,14 @@ use crate::gpu::light_view::LightView;
 use crate::gpu::raster::{bin, draw, no_tile_culling, Fragment};
 use crate::gpu::setup::{setup_all_barycentric, CullMode};
 use crate::gpu::transform::ClipVertex;
+use crate::options::{option_names, option_table, OptionTable};
 use crate::plan::BufferPlan;
 use crate::scene::LightShape;
 use glam::DVec3;
 use serde::Serialize;
 use std::time::Instant;
 
-/// The largest `map_size` (the RGBA f32 target of 4096² texels takes 256 MB).
-pub const MAX_MAP_SIZE: u32 = 4096;
-/// The default number of corner-fan triangles per full circle (`fan_segments`).
+/// The default number of corner-fan triangles per full circle (`fan-segments`).
 pub const DEFAULT_FAN_SEGMENTS: u32 = 32;
 /// Relative margin of the sphere the volumes reach beyond the farthest mesh vertex, and of the
 /// distance range beyond that sphere.
@@ -179,41 +178,46 @@ pub struct DBufferSettings {
     pub distances: Distances,
 }
 
+option_names!(Eq3 {
+    Corrected = "corrected",
+    Printed = "printed",
+});
+
+option_names!(Distances {
+    Interpolated = "interpolated",
+    Exact = "exact",
+});
+
+option_table! {
+    /// `[options.dbuffer]` (module doc): the D-buffer's shadow-map keys, as `penumbra-map`'s,
+    /// and the method's own.
+    pub struct DBufferOptions["dbuffer"] {
+        ..maps: ShadowMapKeys,
+        /// storage of the four distance channels
+        storage: ColorFormat [&[ColorFormat::F32, ColorFormat::F16]] = ColorFormat::F32;
+        /// V(t): 3t² − 2t³ (CGI 2004 eq. 4) or √t (§6.2, for occluders smaller than the light)
+        falloff: Falloff [&[Falloff::Smoothstep, Falloff::Sqrt]] = Falloff::Smoothstep;
+        /// eq. 3's denominator: (|cx| − |cx_s|), t = ½ at the light center's shadow line, or as printed
+        eq3: Eq3 = Eq3::Corrected;
+        /// corner-fan triangles per full circle of the volumes
+        fan_segments: u32 [4..=1024] = DEFAULT_FAN_SEGMENTS;
+        /// the D-buffer's distances: the vertex distances interpolated (the paper's), or per fragment
+        distances: Distances = Distances::Interpolated;
+    }
+}
+
 /// Read and check `[options.dbuffer]` (module doc) for `frame`.
 pub fn read_settings(frame: &Frame) -> Result<DBufferSettings, InputError> {
-    let scene = frame.scene;
-    let mut r = OptionReader::new(scene, "dbuffer");
-    let map_size = r.map_size(scene, MAX_MAP_SIZE)?;
-    let depth = r.depth_format("depth", frame.gpu.depth)?;
-    let storage = match r.choice("storage", &["f32", "f16"], "f32")? {
-        "f16" => ColorFormat::F16,
-        _ => ColorFormat::F32,
-    };
-    // The shadow maps' defaults (`penumbra-map`'s).
-    let offset = r.polygon_offset(
-        super::penumbra_map::DEFAULT_BIAS_UNITS,
-        super::penumbra_map::DEFAULT_SLOPE_BIAS,
-    )?;
-    let falloff = Falloff::read(&mut r, &["smoothstep", "sqrt"])?;
-    let eq3 = match r.choice("eq3", &["corrected", "printed"], "corrected")? {
-        "printed" => Eq3::Printed,
-        _ => Eq3::Corrected,
-    };
-    let fan_segments = r.uint("fan_segments", DEFAULT_FAN_SEGMENTS as u64, 4..=1024)? as u32;
-    let distances = match r.choice("distances", &["interpolated", "exact"], "interpolated")? {
-        "exact" => Distances::Exact,
-        _ => Distances::Interpolated,
-    };
-    r.finish()?;
+    let o = DBufferOptions::read(frame.scene)?;
     Ok(DBufferSettings {
-        map_size,
-        depth,
-        storage,
-        offset,
-        falloff,
-        eq3,
-        fan_segments,
-        distances,
+        map_size: o.maps.map_edge(frame.scene),
+        depth: o.maps.depth_format(frame),
+        storage: o.storage,
+        offset: o.maps.offset(),
+        falloff: o.falloff,
+        eq3: o.eq3,
+        fan_segments: o.fan_segments,
+        distances: o.distances,
     })
 }
 

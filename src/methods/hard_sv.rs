@@ -15,7 +15,6 @@
 //!
 //! A pixel is lit (visibility 1) when its stencil count is 0; background pixels are lit.
 
-use super::options::OptionReader;
 use super::output::{MethodOutput, PassStats, RawImage8, Visibility};
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, BACKGROUND};
@@ -26,7 +25,8 @@ use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::raster::{bin, draw, no_tile_culling};
 use crate::gpu::setup::CullMode;
 use crate::gpu::stencil::{StencilFace, StencilOp, StencilState};
-use crate::plan::{eye_in_shadow, BufferPlan, MethodPlan};
+use crate::options::{option_names, option_table, OptionTable, OptionType};
+use crate::plan::{BufferPlan, CountMode, MethodPlan};
 use glam::Vec3;
 use std::time::Instant;
 
@@ -68,41 +68,46 @@ pub struct StencilShadowSettings {
     pub submission: Submission,
 }
 
-/// `hard-sv` options: `mode = auto|zpass|zfail`, `stencil = wrap|saturate`,
-/// `submission = two-sided|two-pass`. With `auto`, z-fail is chosen when the eye (or any point
-/// of the near plane) is in the light center's shadow.
-pub fn read_settings(
-    r: &mut OptionReader,
-    frame: &Frame,
-    lights: &[Vec3],
-) -> Result<(StencilShadowSettings, &'static str), InputError> {
-    let mode = r.choice("mode", &["auto", "zpass", "zfail"], "auto")?;
-    let overflow = match r.choice("stencil", &["wrap", "saturate"], "wrap")? {
-        "wrap" => StencilOverflow::Wrap,
-        _ => StencilOverflow::Saturate,
-    };
-    let submission = match r.choice("submission", &["two-sided", "two-pass"], "two-sided")? {
-        "two-sided" => Submission::TwoSided,
-        _ => Submission::TwoPass,
-    };
-    Ok((
-        StencilShadowSettings {
-            test: shadow_test(mode, frame, lights),
-            overflow,
-            submission,
-        },
-        mode,
-    ))
+option_names!(StencilOverflow {
+    Wrap = "wrap",
+    Saturate = "saturate",
+});
+
+option_names!(Submission {
+    TwoSided = "two-sided",
+    TwoPass = "two-pass",
+});
+
+option_table! {
+    /// `[options.hard-sv]` (module doc); `nsample` has these keys too.
+    pub struct HardSvOptions["hard-sv"] {
+        /// count z-pass or z-fail; auto: z-fail when the near plane is in the light's shadow
+        mode: CountMode = CountMode::Auto;
+        /// stencil overflow: INCR_WRAP/DECR_WRAP or saturating INCR/DECR
+        stencil: StencilOverflow = StencilOverflow::Wrap;
+        /// one two-sided stencil pass, or the incrementing facing first, then the other
+        submission: Submission = Submission::TwoSided;
+    }
 }
 
-/// The counting direction a `mode = auto|zpass|zfail` option asks for: `auto` picks z-fail
-/// when the eye (or any point of the near plane) is in the shadow of one of `lights`.
-pub fn shadow_test(mode: &str, frame: &Frame, lights: &[Vec3]) -> ShadowTest {
-    match mode {
-        "zpass" => ShadowTest::ZPass,
-        "zfail" => ShadowTest::ZFail,
-        _ if eye_in_shadow(frame.scene, frame.proj.near, lights) => ShadowTest::ZFail,
-        _ => ShadowTest::ZPass,
+impl HardSvOptions {
+    /// The stencil settings these options ask for on `frame`: with `mode = auto`, z-fail when
+    /// the eye (or any point of the near plane) is in the shadow of one of `lights`.
+    pub fn stencil_settings(&self, frame: &Frame, lights: &[Vec3]) -> StencilShadowSettings {
+        StencilShadowSettings {
+            test: shadow_test(self.mode, frame, lights),
+            overflow: self.stencil,
+            submission: self.submission,
+        }
+    }
+}
+
+/// The counting direction `mode` asks for on `frame` ([`CountMode::zfail`] with `lights`).
+pub fn shadow_test(mode: CountMode, frame: &Frame, lights: &[Vec3]) -> ShadowTest {
+    if mode.zfail(frame.scene, frame.proj.near, lights) {
+        ShadowTest::ZFail
+    } else {
+        ShadowTest::ZPass
     }
 }
 
@@ -186,19 +191,12 @@ pub fn stencil_row_major(frame: &Frame, tiles: &[StencilTile]) -> Vec<u8> {
     frame.tiling.to_row_major(&flat)
 }
 
-/// Read and check `[options.hard-sv]` (settings and the `mode` as written).
-pub fn options(frame: &Frame) -> Result<(StencilShadowSettings, &'static str), InputError> {
-    let mut r = OptionReader::new(frame.scene, "hard-sv");
-    let parsed = read_settings(&mut r, frame, &[frame.scene.light().center])?;
-    r.finish()?;
-    Ok(parsed)
-}
-
 /// Run `hard-sv` on a rendered frame.
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let start = Instant::now();
     let center = frame.scene.light().center;
-    let (settings, mode) = options(frame)?;
+    let options = HardSvOptions::read(frame.scene)?;
+    let settings = options.stencil_settings(frame, &[center]);
     let pass_start = Instant::now();
     let (tiles, counters) = stencil_shadow(frame, center, &settings);
     let name = match settings.test {
@@ -228,7 +226,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         method: "hard-sv".into(),
         passes: vec![frame.pass.name.clone(), name.into()],
         buffers: vec![BufferPlan::depth(&frame.gpu), BufferPlan::stencil8()],
-        settings: serde_json::json!({ "mode": mode, "resolved": settings, "gpu": frame.gpu }),
+        settings: serde_json::json!({ "mode": options.mode.written(), "resolved": settings, "gpu": frame.gpu }),
     };
     let passes = vec![frame.pass.clone(), pass];
     Ok(MethodOutput {

@@ -19,7 +19,6 @@ pub mod dbuffer;
 pub mod hard_sv;
 pub mod light_average;
 pub mod nsample;
-pub mod options;
 pub mod output;
 pub mod penumbra_map;
 pub mod pw2002;
@@ -30,11 +29,14 @@ pub mod ssv_optimized;
 pub mod wedge_blending;
 
 use crate::error::InputError;
-use crate::frame::Frame;
+use crate::frame::{Frame, GpuOptions};
+use crate::gpu::color::ColorFormat;
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::DepthFormat;
 use crate::gpu::light_view::{LightView, MAX_LIGHT_VIEW_HALF_ANGLE_DEG};
+use crate::gpu::texture::Filter;
 use crate::gpu::tiling::Tiling;
+use crate::options::{option_names, option_table, KeyDoc, OptionTable, OptionType};
 use crate::plan::{BufferPlan, MethodPlan};
 use crate::scene::{LightShape, Scene};
 use output::{MethodOutput, MethodStats, PassStats, Visibility};
@@ -154,14 +156,73 @@ pub fn selected(scene: &Scene) -> Result<Vec<String>, InputError> {
     }
 }
 
-/// Check that every `[options.X]` table names a known method (or `gpu`).
+/// An option table as the registry holds it: its name, its keys documented, and its check
+/// (the table read from a scene, [`OptionTable::read`]).
+type Table = (
+    &'static str,
+    fn() -> Vec<KeyDoc>,
+    fn(&Scene) -> Result<(), InputError>,
+);
+
+/// The registry entry of table `O`.
+fn table<O: OptionTable>() -> Table {
+    (O::NAME, O::keys, |scene| O::read(scene).map(drop))
+}
+
+/// Every option table: `gpu`, then the methods in [`ALL`] order.
+fn tables() -> [Table; 11] {
+    [
+        table::<GpuOptions>(),
+        table::<RaycastOptions>(),
+        table::<nsample::NsampleOptions>(),
+        table::<hard_sv::HardSvOptions>(),
+        table::<pw2002::Pw2002Options>(),
+        table::<pw_restructured::PwRestructuredOptions>(),
+        table::<ssv_optimized::SsvOptimizedOptions>(),
+        table::<ssv::SsvOptions>(),
+        table::<wedge_blending::WedgeBlendingOptions>(),
+        table::<penumbra_map::PenumbraMapOptions>(),
+        table::<dbuffer::DBufferOptions>(),
+    ]
+}
+
+/// Every option table's name and keys, documented: `gpu`, then the methods in [`ALL`] order
+/// (what `penumbra list --options` prints, [`crate::options::listing`]).
+pub fn option_docs() -> Vec<(&'static str, Vec<KeyDoc>)> {
+    tables()
+        .iter()
+        .map(|(name, keys, _)| (*name, keys()))
+        .collect()
+}
+
+/// Check every `[options.X]` table of `scene` before anything is rendered: X must be `gpu` or a
+/// method, every key and value must read ([`OptionTable::read`]) — also for a method this run
+/// does not render —, and a method whose table sets a key must be able to render the scene's
+/// lights (else its options could never act). The checks that need the rendered frame follow
+/// in [`check_options`].
 pub fn check_option_tables(scene: &Scene) -> Result<(), InputError> {
-    for k in scene.options.keys() {
-        if k != "gpu" && !ALL.contains(&k.as_str()) {
-            return Err(InputError::at(
-                &scene.source,
-                format!("options.{k}"),
-                format!("unknown method {k:?}; known: gpu, {}", ALL.join(", ")),
+    let tables = tables();
+    for (name, written) in &scene.options {
+        let first_key = written.keys().next();
+        let Some((_, _, read)) = tables.iter().find(|t| t.0 == name) else {
+            let known: Vec<&str> = tables.iter().map(|t| t.0).collect();
+            let message = format!("unknown method {name:?}; known: {}", known.join(", "));
+            return Err(match first_key {
+                Some(key) if scene.cli_options.contains_key(&(name.clone(), key.clone())) => {
+                    scene.option_error(name, key, message)
+                }
+                _ => InputError::at(&scene.source, format!("options.{name}"), message),
+            });
+        };
+        read(scene)?;
+        if name == GpuOptions::NAME {
+            continue;
+        }
+        if let (Some(why), Some(key)) = (unsupported_light(name, scene), first_key) {
+            return Err(scene.option_error(
+                name,
+                key,
+                format!("{why}, so options for it cannot act on this scene"),
             ));
         }
     }
@@ -221,24 +282,28 @@ impl Falloff {
             Falloff::Sqrt => x.sqrt(),
         }
     }
-
-    /// Read option `falloff` of `r` among `allowed` (option names `smoothstep`, `linear`,
-    /// `sqrt`), smoothstep by default.
-    pub fn read(
-        r: &mut options::OptionReader,
-        allowed: &[&'static str],
-    ) -> Result<Self, InputError> {
-        Ok(match r.choice("falloff", allowed, "smoothstep")? {
-            "linear" => Falloff::Linear,
-            "sqrt" => Falloff::Sqrt,
-            _ => Falloff::Smoothstep,
-        })
-    }
 }
 
+option_names!(Falloff {
+    Smoothstep = "smoothstep",
+    Linear = "linear",
+    Sqrt = "sqrt",
+});
+
+option_names!(ColorFormat {
+    Unorm8 = "unorm8",
+    F16 = "f16",
+    F32 = "f32",
+});
+
+option_names!(Filter {
+    Nearest = "nearest",
+    Bilinear = "bilinear",
+});
+
 /// The light view of `frame`'s (only) light for `method`: a `map_size`² target of format
-/// `depth` fitted around the scene ([`LightView::fit`]). Errors name `options.METHOD.map_size`
-/// for a size the tiling rejects, and the light, the farthest vertex and its angle when one
+/// `depth` fitted around the scene ([`LightView::fit`]). Errors name the option `map-size`
+/// ([`Scene::option_error`]) for a size the tiling rejects, and the light, the farthest vertex and its angle when one
 /// frustum cannot cover the scene (`who` names the maps in the message, e.g. "penumbra maps").
 pub fn fit_light_view(
     frame: &Frame,
@@ -249,7 +314,7 @@ pub fn fit_light_view(
 ) -> Result<LightView, InputError> {
     let scene = frame.scene;
     let tiling = Tiling::new(map_size, map_size, frame.tiling.tile)
-        .map_err(|e| InputError::at(&scene.source, format!("options.{method}.map_size"), e))?;
+        .map_err(|e| scene.option_error(method, "map-size", e))?;
     LightView::fit(scene, scene.light().center, tiling, depth).map_err(|u| {
         let m = &scene.meshes[u.mesh];
         InputError::at(
@@ -364,7 +429,7 @@ fn run_raycast(frame: &Frame) -> Result<MethodOutput, InputError> {
     let (settings, receiver) = raycast_options(scene)?;
     let pass_start = Instant::now();
     let primary;
-    let receivers = if receiver == "primary-ray" {
+    let receivers = if receiver == ReceiverPoint::PrimaryRay {
         primary = frame.primary_ray_receivers();
         &primary[..]
     } else {
@@ -385,7 +450,7 @@ fn run_raycast(frame: &Frame) -> Result<MethodOutput, InputError> {
             "samples": settings.samples,
             "seed": settings.seed,
             "pattern": "jittered",
-            "receiver": receiver,
+            "receiver": receiver.written(),
             "sphere": match settings.sphere_disk {
                 raycast::SphereDisk::FacingReceiver => "the disk facing each receiver".to_string(),
                 raycast::SphereDisk::Facing(p) => format!("one disk facing ({}, {}, {})", p.x, p.y, p.z),
@@ -395,7 +460,7 @@ fn run_raycast(frame: &Frame) -> Result<MethodOutput, InputError> {
     let passes = vec![frame.pass.clone(), pass];
     let mut stats = method_stats("raycast", frame, start, &plan, passes);
     let snapped = frame.snapped_receivers();
-    if snapped > 0 && receiver == "depth-buffer" {
+    if snapped > 0 && receiver == ReceiverPoint::DepthBuffer {
         stats.warnings.push(format!(
             "{snapped} pixels: the depth buffer cannot hold the surface there (a near plane too \
              close for the depth format?); their receivers, for every method, are the exact \
@@ -433,7 +498,7 @@ pub fn reference_noise_floor(
     let next_seed = |f: &Frame| -> Result<Visibility, InputError> {
         let (mut settings, receiver) = raycast_options(f.scene)?;
         settings.seed = settings.seed.wrapping_add(1);
-        let all = if receiver == "primary-ray" {
+        let all = if receiver == ReceiverPoint::PrimaryRay {
             f.primary_ray_receivers()
         } else {
             f.receivers().to_vec()
@@ -476,49 +541,65 @@ pub fn reference_noise_floor(
     Ok(crate::metrics::compare(&merged, reference))
 }
 
+option_names! {
+    /// How `raycast` sees a sphere light (`[options.raycast] sphere`).
+    pub enum SphereAs {
+        /// The disk through the center facing each receiver (the papers' definition).
+        FacingReceiver = "facing-receiver",
+        /// `nsample`'s one disk, facing the center of the mesh bounds.
+        FixedDisk = "fixed-disk",
+    }
+}
+
+option_names! {
+    /// Which point of a pixel `raycast` computes the visibility of (`[options.raycast] receiver`).
+    pub enum ReceiverPoint {
+        /// The pixel center un-projected at its stored depth, the point the rasterized methods see.
+        DepthBuffer = "depth-buffer",
+        /// The exact hit of the ray through the pixel center with the visible triangle's plane.
+        PrimaryRay = "primary-ray",
+    }
+}
+
+option_table! {
+    /// `[options.raycast]`: the reference's samples and definitions.
+    pub struct RaycastOptions["raycast"] {
+        /// light samples per pixel, jittered in √n×√n strata (a perfect square)
+        samples: u32 [1..=65536] = raycast::DEFAULT_SAMPLES;
+        /// seed of the jitter
+        seed: u64 [0..=u64::MAX >> 1] = 0;
+        /// the pixel's point: the depth buffer's (what the rasterized methods see) or the pixel ray's exact hit
+        receiver: ReceiverPoint = ReceiverPoint::DepthBuffer;
+        /// a sphere light as the disk facing each receiver (the papers'), or as nsample's one disk facing the center of the mesh bounds
+        sphere: SphereAs = SphereAs::FacingReceiver;
+    }
+}
+
 /// Read and check `[options.raycast]`: the settings and the receiver choice.
-fn raycast_options(scene: &Scene) -> Result<(raycast::RaycastSettings, &'static str), InputError> {
-    let mut r = options::OptionReader::new(scene, "raycast");
-    let sphere_disk = match r.choice(
-        "sphere",
-        &["facing-receiver", "fixed-disk"],
-        "facing-receiver",
-    )? {
-        "fixed-disk" => raycast::SphereDisk::Facing(nsample::sphere_disk_target(scene)),
-        _ => raycast::SphereDisk::FacingReceiver,
-    };
+fn raycast_options(scene: &Scene) -> Result<(raycast::RaycastSettings, ReceiverPoint), InputError> {
+    let o = RaycastOptions::read(scene)?;
     let settings = raycast::RaycastSettings {
-        samples: r.uint("samples", raycast::DEFAULT_SAMPLES as u64, 1..=65536)? as u32,
-        seed: r.uint("seed", 0, 0..=u64::MAX >> 1)?,
-        sphere_disk,
+        samples: o.samples,
+        seed: o.seed,
+        sphere_disk: match o.sphere {
+            SphereAs::FixedDisk => raycast::SphereDisk::Facing(nsample::sphere_disk_target(scene)),
+            SphereAs::FacingReceiver => raycast::SphereDisk::FacingReceiver,
+        },
     };
     settings
         .validate()
-        .map_err(|e| InputError::at(&scene.source, "options.raycast.samples", e))?;
-    let receiver = r.choice("receiver", &["depth-buffer", "primary-ray"], "depth-buffer")?;
-    r.finish()?;
-    Ok((settings, receiver))
+        .map_err(|e| scene.option_error(RaycastOptions::NAME, "samples", e))?;
+    Ok((settings, o.receiver))
 }
 
-/// Parse and check `method`'s options without running it, so that a bad option is reported
-/// even for a method this run does not render. Options of a method that cannot render the
-/// scene's lights are an error (they could never act); a method that runs once per light is
-/// checked for each light.
+/// Check `method`'s options against the rendered `frame` without running it (what needs the
+/// frame: a sample count the light's shape cannot take, an option that cannot act with the
+/// others, …), so that a bad option is reported even for a method this run does not render.
+/// A method that runs once per light is checked for each light. A method that cannot render
+/// the scene's lights is skipped: [`check_option_tables`] refused any key of its table.
 pub fn check_options(method: &str, frame: &Frame) -> Result<(), InputError> {
-    if let Some(why) = unsupported_light(method, frame.scene) {
-        let key = frame
-            .scene
-            .options
-            .get(method)
-            .and_then(|t| t.keys().next());
-        return match key {
-            None => Ok(()),
-            Some(key) => Err(InputError::at(
-                &frame.scene.source,
-                format!("options.{method}.{key}"),
-                format!("{why}, so options for it cannot act on this scene"),
-            )),
-        };
+    if unsupported_light(method, frame.scene).is_some() {
+        return Ok(());
     }
     if frame.scene.is_multi_light() && !RENDERS_SEVERAL_LIGHTS.contains(&method) {
         for k in 0..frame.scene.lights.len() {
@@ -533,7 +614,7 @@ pub fn check_options(method: &str, frame: &Frame) -> Result<(), InputError> {
 /// [`check_options`] for a frame with one light (or a method in [`RENDERS_SEVERAL_LIGHTS`]).
 fn check_options_one_light(method: &str, frame: &Frame) -> Result<(), InputError> {
     match method {
-        "hard-sv" => hard_sv::options(frame).map(drop),
+        "hard-sv" => hard_sv::HardSvOptions::read(frame.scene).map(drop),
         "nsample" => nsample::options(frame).map(drop),
         "raycast" => raycast_options(frame.scene).map(drop),
         "pw2002" => pw2002::options(frame).map(drop),

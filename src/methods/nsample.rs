@@ -13,21 +13,21 @@
 //! for `hard-sv`; `mode = auto` chooses z-fail when the near plane is in the shadow of the
 //! light center or of the shape's extreme points ([`crate::plan::representative_light_points`]).
 
-use super::hard_sv::{read_settings, stencil_shadow, ShadowTest, StencilShadowSettings};
-use super::options::OptionReader;
+use super::hard_sv::{stencil_shadow, HardSvOptions, ShadowTest, StencilShadowSettings};
 use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
 use crate::frame::{Frame, BACKGROUND};
 use crate::gpu::counters::Counters;
 use crate::light::sampling::{stratified, LightSample, Pattern};
-use crate::plan::{representative_light_points, BufferPlan, MethodPlan};
+use crate::options::{option_table, OptionTable, OptionType};
+use crate::plan::{representative_light_points, BufferPlan, CountMode, MethodPlan};
 use crate::scene::{LightShape, Scene};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::time::Instant;
 
 /// Default sample count (Paper III §5.1).
-pub const DEFAULT_SAMPLES: u64 = 1024;
+pub const DEFAULT_SAMPLES: u32 = 1024;
 
 /// The point a sphere light's sampling disk faces: the center of the mesh bounds.
 pub fn sphere_disk_target(scene: &Scene) -> Vec3 {
@@ -42,24 +42,33 @@ pub fn sphere_disk_target(scene: &Scene) -> Vec3 {
     (lo + hi) * 0.5
 }
 
+option_table! {
+    /// `[options.nsample]` (module doc): those of `hard-sv` and the sample count.
+    pub struct NsampleOptions["nsample"] {
+        ..shadow: HardSvOptions,
+        /// light samples: the centers of √n×√n strata (a perfect square)
+        n: u32 [1..=4096] = DEFAULT_SAMPLES;
+    }
+}
+
 /// Read and check `[options.nsample]`: the light samples, the stencil settings and the
 /// `mode` as written.
 pub fn options(
     frame: &Frame,
-) -> Result<(Vec<LightSample>, StencilShadowSettings, &'static str), InputError> {
+) -> Result<(Vec<LightSample>, StencilShadowSettings, CountMode), InputError> {
     let scene = frame.scene;
-    let mut r = OptionReader::new(scene, "nsample");
-    let n = r.uint("n", DEFAULT_SAMPLES, 1..=4096)?;
-    let (settings, mode) = read_settings(&mut r, frame, &representative_light_points(scene))?;
-    r.finish()?;
+    let o = NsampleOptions::read(scene)?;
+    let settings = o
+        .shadow
+        .stencil_settings(frame, &representative_light_points(scene));
     let samples = stratified(
         scene.light(),
-        n as u32,
+        o.n,
         Pattern::Centered,
         sphere_disk_target(frame.scene),
     )
-    .map_err(|e| InputError::at(&scene.source, "options.nsample.n", e))?;
-    Ok((samples, settings, mode))
+    .map_err(|e| scene.option_error(NsampleOptions::NAME, "n", e))?;
+    Ok((samples, settings, o.shadow.mode))
 }
 
 /// Run `nsample` on a rendered frame.
@@ -139,7 +148,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
                 bytes_per_sample: 24,
             },
         ],
-        settings: serde_json::json!({ "n": samples.len(), "pattern": "centered", "mode": mode, "resolved": settings, "colored": colored, "gpu": frame.gpu }),
+        settings: serde_json::json!({ "n": samples.len(), "pattern": "centered", "mode": mode.written(), "resolved": settings, "colored": colored, "gpu": frame.gpu }),
     };
     let passes = vec![frame.pass.clone(), pass];
     Ok(MethodOutput {

@@ -7,10 +7,10 @@
 //!
 //! 1. **Shadow map** (§3 "the first pass renders a standard shadow map from the viewpoint of a
 //!    point light source at the approximate center of the light"): the scene from the light
-//!    center into a `map_size`² depth target (`depth`, default the frame's format, D24), back
+//!    center into a `map-size`² depth target (`depth`, default the frame's format, D24), back
 //!    faces culled. The depth bias is a polygon offset ([`PolygonOffset`],
-//!    `glPolygonOffset(slope_bias, bias)`): `bias` in units of the format's resolvable
-//!    difference (one D24 or D16 step, default 4) and `slope_bias`, the slope-scaled factor
+//!    `glPolygonOffset(slope-bias, bias)`): `bias` in units of the format's resolvable
+//!    difference (one D24 or D16 step, default 4) and `slope-bias`, the slope-scaled factor
 //!    (default 1). The paper's "larger bias" (§5) compensates for shadows of simplified models
 //!    cast onto full models; here both are the same mesh, and what the method needs is the
 //!    slope-scaled part: the fitted light view is not perpendicular to any floor, so a
@@ -21,7 +21,7 @@
 //!    units instead: 0.389 / 0.535 / 0.341 / 0.540), 0.278 / 0.262 / 0.181 / 0.299 with
 //!    factor 0.5, 0.173 / 0.138 / 0.149 / 0.185 with 1 (default), 0.174 / 0.155 / 0.168 /
 //!    0.185 with 2 (light leaks grow); 0, 4 or 64 units change nothing visible at D24.
-//!    `bias_stage` chooses where the offset applies: `render` (default) offsets the shadow
+//!    `bias-stage` chooses where the offset applies: `render` (default) offsets the shadow
 //!    map as it is drawn, so pass 2 reads the offset depths too — near an occluder's own
 //!    silhouette, where its surface is seen edge-on and the slope term is large, the offset
 //!    pushes the surface behind the silhouette, a cone's fragments pass line (4) there and
@@ -34,7 +34,7 @@
 //!    lookup 49/45, 268/322, 140/815, 166/888 (RMSE 0.173, 0.141, 0.173, 0.217).
 //! 2. **Penumbra map** (§3): the silhouette from the light center (possible silhouette edges
 //!    and their loops), a cone per silhouette vertex and an outer sheet per silhouette edge
-//!    ([`crate::geometry::penumbra_cones`]; `cone_segments` triangles per cone), drawn into a
+//!    ([`crate::geometry::penumbra_cones`]; `cone-segments` triangles per cone), drawn into a
 //!    map with a colour channel (`storage = unorm8|f16|f32`, [`ColorFormat`]; unorm8 as a
 //!    p-buffer of 2003 held it) cleared to white and a depth channel (the light view's format)
 //!    cleared to 1.0, both facings, in the order of
@@ -90,7 +90,6 @@
 //! depth along the cone, not across the penumbra (halfway across a sheet from a silhouette at
 //! view depth 2 to a receiver at 3, I = 0.4 and I′ = 0.35; `raycast` there is about 0.8).
 
-use super::options::OptionReader;
 use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
 use crate::frame::Frame;
@@ -103,19 +102,21 @@ use crate::gpu::light_view::LightView;
 use crate::gpu::raster::{bin, draw, no_tile_culling, Fragment};
 use crate::gpu::setup::{setup_all_barycentric, CullMode};
 use crate::gpu::texture::Filter;
+use crate::options::{option_names, option_table, OptionTable};
 use crate::plan::BufferPlan;
-use crate::scene::LightShape;
+use crate::scene::{LightShape, Scene};
 use serde::Serialize;
 use std::time::Instant;
 
 /// The default polygon-offset units of the shadow map (`bias`): resolvable-difference steps.
 pub const DEFAULT_BIAS_UNITS: f64 = 4.0;
-/// The default slope-scaled polygon-offset factor of the shadow map (`slope_bias`).
+/// The default slope-scaled polygon-offset factor of the shadow map (`slope-bias`).
 pub const DEFAULT_SLOPE_BIAS: f64 = 1.0;
-/// The largest `map_size`: the three map buffers (shadow map, penumbra colour and depth) of
-/// 4096² texels take 200 MB as stored; the paper's maps are 1024².
+/// The largest `map-size` of `penumbra-map` and `dbuffer` ([`ShadowMapKeys`]): the three map
+/// buffers of `penumbra-map` (shadow map, penumbra colour and depth) of 4096² texels take
+/// 200 MB as stored, the RGBA f32 D-buffer 256 MB; the papers' maps are 1024².
 pub const MAX_MAP_SIZE: u32 = 4096;
-/// The default number of triangles per cone (`cone_segments`).
+/// The default number of triangles per cone (`cone-segments`).
 pub const DEFAULT_CONE_SEGMENTS: u32 = 16;
 
 /// How the penumbra intensity falls off across the penumbra (§3): `I′ = 3I² − 2I³`
@@ -142,7 +143,7 @@ pub struct PenumbraMapSettings {
     pub map_size: u32,
     /// Depth format of the shadow map and of the penumbra map's depth channel.
     pub depth: DepthFormat,
-    /// The shadow-map bias: `bias` (units) and `slope_bias` (factor).
+    /// The shadow-map bias: `bias` (units) and `slope-bias` (factor).
     pub offset: PolygonOffset,
     /// Where the bias is applied.
     pub bias_stage: BiasStage,
@@ -156,35 +157,78 @@ pub struct PenumbraMapSettings {
     pub filter: Filter,
 }
 
+option_names!(BiasStage {
+    Render = "render",
+    Lookup = "lookup",
+});
+
+option_table! {
+    /// The keys of a shadow map rendered from the light: `penumbra-map`'s, and `dbuffer`'s
+    /// D-buffer (its nearest-surface channel is a distance shadow map).
+    pub struct ShadowMapKeys {
+        /// edge of the maps rendered from the light, in texels
+        map_size: Option<u32> [8..=MAX_MAP_SIZE] = None,
+            scene format!("the image's larger side, at most {MAX_MAP_SIZE}");
+        /// depth format of the maps rendered from the light
+        depth: Option<DepthFormat> = None, scene "the frame's, [options.gpu] depth";
+        /// polygon-offset units of the shadow-map depth, in resolvable steps of its depth format
+        bias: f64 [0.0..=16_777_215.0] = DEFAULT_BIAS_UNITS;
+        /// slope-scaled polygon-offset factor of the shadow-map depth (glPolygonOffset's factor)
+        slope_bias: f64 [0.0..=1000.0] = DEFAULT_SLOPE_BIAS;
+    }
+}
+
+impl ShadowMapKeys {
+    /// The edge of the maps: `map-size`, by default the image's larger side (at most
+    /// [`MAX_MAP_SIZE`]).
+    pub fn map_edge(&self, scene: &Scene) -> u32 {
+        self.map_size
+            .unwrap_or(scene.width.max(scene.height).min(MAX_MAP_SIZE))
+    }
+
+    /// The depth format of the maps: `depth`, by default the frame's.
+    pub fn depth_format(&self, frame: &Frame) -> DepthFormat {
+        self.depth.unwrap_or(frame.gpu.depth)
+    }
+
+    /// The shadow map's polygon offset, `glPolygonOffset(slope-bias, bias)`.
+    pub fn offset(&self) -> PolygonOffset {
+        PolygonOffset {
+            factor: self.slope_bias,
+            units: self.bias,
+        }
+    }
+}
+
+option_table! {
+    /// `[options.penumbra-map]` (module doc).
+    pub struct PenumbraMapOptions["penumbra-map"] {
+        ..maps: ShadowMapKeys,
+        /// where the bias applies: drawing the shadow map, or the screen pass's shadow test
+        bias_stage: BiasStage = BiasStage::Render;
+        /// triangles per cone at a silhouette vertex
+        cone_segments: u32 [3..=1024] = DEFAULT_CONE_SEGMENTS;
+        /// I′ = 3I² − 2I³ (Wyman & Hansen §3, the Bernstein interpolant) or I′ = I
+        falloff: Falloff [&[Falloff::Smoothstep, Falloff::Linear]] = Falloff::Smoothstep;
+        /// storage of the penumbra map's colour channel
+        storage: ColorFormat = ColorFormat::Unorm8;
+        /// filter of the penumbra-map lookup in the screen pass
+        filter: Filter = Filter::Nearest;
+    }
+}
+
 /// Read and check `[options.penumbra-map]` (module doc) for `frame`.
 pub fn read_settings(frame: &Frame) -> Result<PenumbraMapSettings, InputError> {
-    let scene = frame.scene;
-    let mut r = OptionReader::new(scene, "penumbra-map");
-    let map_size = r.map_size(scene, MAX_MAP_SIZE)?;
-    let depth = r.depth_format("depth", frame.gpu.depth)?;
-    let offset = r.polygon_offset(DEFAULT_BIAS_UNITS, DEFAULT_SLOPE_BIAS)?;
-    let bias_stage = match r.choice("bias_stage", &["render", "lookup"], "render")? {
-        "lookup" => BiasStage::Lookup,
-        _ => BiasStage::Render,
-    };
-    let cone_segments = r.uint("cone_segments", DEFAULT_CONE_SEGMENTS as u64, 3..=1024)? as u32;
-    let falloff = Falloff::read(&mut r, &["smoothstep", "linear"])?;
-    let storage = r.choice("storage", &ColorFormat::OPTION_NAMES, "unorm8")?;
-    let storage = ColorFormat::from_option(storage).unwrap_or(ColorFormat::Unorm8);
-    let filter = match r.choice("filter", &["nearest", "bilinear"], "nearest")? {
-        "bilinear" => Filter::Bilinear,
-        _ => Filter::Nearest,
-    };
-    r.finish()?;
+    let o = PenumbraMapOptions::read(frame.scene)?;
     Ok(PenumbraMapSettings {
-        map_size,
-        depth,
-        offset,
-        bias_stage,
-        cone_segments,
-        falloff,
-        storage,
-        filter,
+        map_size: o.maps.map_edge(frame.scene),
+        depth: o.maps.depth_format(frame),
+        offset: o.maps.offset(),
+        bias_stage: o.bias_stage,
+        cone_segments: o.cone_segments,
+        falloff: o.falloff,
+        storage: o.storage,
+        filter: o.filter,
     })
 }
 

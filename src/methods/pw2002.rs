@@ -19,18 +19,18 @@
 //! `pw-restructured` add literally the same integers. Background pixels (stored depth 1.0) have
 //! no point; their p is never inside a wedge. Visibility = clamp(LI, 0, 255)/255.
 //!
-//! Options (`[options.pw2002]`): `side_planes = compute|cancel` ([`SidePlanes`]: the §4
+//! Options ([`Pw2002Options`]): `side-planes = compute|cancel` ([`SidePlanes`]: the §4
 //! pseudocode, default, or the §5 shortcut — 255 on front planes, 0 on back and side planes;
-//! pw2002 only), and, shared with `pw-restructured` by [`read_wedge_settings`], `li = 16|12|8` (bits),
+//! pw2002 only), and, shared with `pw-restructured` ([`WedgeKeys`]), `li = 16|12|8` (bits),
 //! `overflow = wrap|saturate`, `falloff = linear|smoothstep`
-//! (s' = 3s² − 2s³, §4.2), `corner_wedges = on|off` (Fig. 7), `parallel_rule = on|off` (§8),
+//! (s' = 3s² − 2s³, §4.2), `corner-wedges = on|off` (Fig. 7), `parallel-rule = on|off` (§8),
 //! `lights = shared|separate` ([`MultiLight`]: several lights in one LI buffer with amounts
 //! scaled by 255/n, Paper I §7, default; or one LI buffer per light, averaged).
 //! The eye is assumed to be outside every shadow (Paper I §8); `pw-restructured` handles the
 //! other case.
 
-use super::options::OptionReader;
 use super::output::{MethodOutput, PassStats, Visibility};
+use super::Falloff;
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, BACKGROUND};
 use crate::geometry::penumbra_wedge::{
@@ -42,6 +42,7 @@ use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::li_buffer::{li_clamped, li_visibility, LiFormat, LiOverflow, LiTile};
 use crate::gpu::raster::{bin, draw, no_tile_culling};
 use crate::gpu::setup::CullMode;
+use crate::options::{option_names, option_table, OptionTable, Switch};
 use crate::plan::{eye_in_shadow, representative_light_points, BufferPlan, MethodPlan};
 use crate::scene::{LightShape, Scene};
 use std::time::Instant;
@@ -91,42 +92,72 @@ pub struct WedgeSettings {
     pub wedge: WedgeOptions,
 }
 
-/// Read the options shared by both penumbra-wedge methods from `r`.
-pub fn read_wedge_settings(
-    r: &mut OptionReader,
-    frame: &Frame,
-) -> Result<WedgeSettings, InputError> {
-    let li = match r.choice("li", &["16", "12", "8"], "16")? {
-        "12" => LiFormat::Li12,
-        "8" => LiFormat::Li8,
-        _ => LiFormat::Li16,
-    };
-    let overflow = match r.choice("overflow", &["wrap", "saturate"], "wrap")? {
-        "saturate" => LiOverflow::Saturate,
-        _ => LiOverflow::Wrap,
-    };
-    let smooth = r.choice("falloff", &["linear", "smoothstep"], "linear")? == "smoothstep";
-    let corner = r.choice("corner_wedges", &["on", "off"], "on")? == "on";
-    let parallel = r.choice("parallel_rule", &["on", "off"], "on")? == "on";
-    let multi_light = match r.choice("lights", &["shared", "separate"], "shared")? {
-        "separate" => MultiLight::PerLight,
-        _ => MultiLight::SharedLi,
-    };
-    let scene = frame.scene;
-    let lights = sphere_lights(scene)?;
-    Ok(WedgeSettings {
-        li,
-        overflow,
-        smooth,
-        side_planes: SidePlanes::Compute,
-        lights: lights.len() as u32,
-        multi_light,
-        wedge: WedgeOptions {
-            extra_corner_wedges: corner,
-            parallel_rule: parallel,
-            ..lights[0]
-        },
-    })
+option_names!(LiFormat {
+    Li16 = "16",
+    Li12 = "12",
+    Li8 = "8",
+});
+
+option_names!(LiOverflow {
+    Wrap = "wrap",
+    Saturate = "saturate",
+});
+
+option_names!(SidePlanes {
+    Compute = "compute",
+    Cancel = "cancel",
+});
+
+option_names!(MultiLight {
+    SharedLi = "shared",
+    PerLight = "separate",
+});
+
+option_table! {
+    /// The keys both penumbra-wedge methods read (module doc).
+    pub struct WedgeKeys {
+        /// LI buffer: signed 16 or 12 bits, or an unsigned 8-bit stencil buffer
+        li: LiFormat = LiFormat::Li16;
+        /// LI values past the format's range: wrap around or saturate
+        overflow: LiOverflow = LiOverflow::Wrap;
+        /// light intensity across a wedge: s, or s' = 3s² − 2s³ (Paper I §4.2)
+        falloff: Falloff [&[Falloff::Linear, Falloff::Smoothstep]] = Falloff::Linear;
+        /// the extra wedges at silhouette corners (Paper I Fig. 7)
+        corner_wedges: Switch = Switch::On;
+        /// the rule for silhouette edges parallel to the light direction (Paper I §8)
+        parallel_rule: Switch = Switch::On;
+        /// several lights: one LI buffer with amounts scaled by 255/n (Paper I §7), or one per light, averaged
+        lights: MultiLight = MultiLight::SharedLi;
+    }
+}
+
+impl WedgeKeys {
+    /// The wedge settings these keys ask for on `frame` (every light must be a sphere).
+    pub fn settings(&self, frame: &Frame) -> Result<WedgeSettings, InputError> {
+        let lights = sphere_lights(frame.scene)?;
+        Ok(WedgeSettings {
+            li: self.li,
+            overflow: self.overflow,
+            smooth: self.falloff == Falloff::Smoothstep,
+            side_planes: SidePlanes::Compute,
+            lights: lights.len() as u32,
+            multi_light: self.lights,
+            wedge: WedgeOptions {
+                extra_corner_wedges: self.corner_wedges.is_on(),
+                parallel_rule: self.parallel_rule.is_on(),
+                ..lights[0]
+            },
+        })
+    }
+}
+
+option_table! {
+    /// `[options.pw2002]` (module doc).
+    pub struct Pw2002Options["pw2002"] {
+        ..wedges: WedgeKeys,
+        /// values at a wedge's entry and exit points: computed (Paper I §4) or 255/0 with side planes cancelling (§5)
+        side_planes: SidePlanes = SidePlanes::Compute;
+    }
 }
 
 /// Center, radius and far distance of every light of `scene` (all must be spheres), as wedge
@@ -275,14 +306,11 @@ pub fn render_li(
 
 /// Read and check `[options.pw2002]`.
 pub fn options(frame: &Frame) -> Result<WedgeSettings, InputError> {
-    let mut r = OptionReader::new(frame.scene, "pw2002");
-    let mut s = read_wedge_settings(&mut r, frame)?;
-    s.side_planes = match r.choice("side_planes", &["compute", "cancel"], "compute")? {
-        "cancel" => SidePlanes::Cancel,
-        _ => SidePlanes::Compute,
-    };
-    r.finish()?;
-    Ok(s)
+    let o = Pw2002Options::read(frame.scene)?;
+    Ok(WedgeSettings {
+        side_planes: o.side_planes,
+        ..o.wedges.settings(frame)?
+    })
 }
 
 /// Run `pw2002` on a rendered frame.

@@ -26,7 +26,7 @@
 //!   `cube-of-spheres-sphere`, 256², light radius 0.5 over spheres of radius 0.18): this method
 //!   is lighter than `raycast` by more than 0.25 at 224 pixels. 173 lie on the spheres next to
 //!   their silhouette seen from the light center, with the same LI in this method and in
-//!   `pw2002` (both `side_planes` forms): 138 light-facing facets at LI 255 (`raycast` < 0.75)
+//!   `pw2002` (both `side-planes` forms): 138 light-facing facets at LI 255 (`raycast` < 0.75)
 //!   and 35 facets just past the silhouette at LI 64–251 (`raycast` 0–0.63). The wedges know
 //!   only that one silhouette, not the sphere's own curvature (the single-silhouette
 //!   approximation, Paper III §5.3).
@@ -38,7 +38,7 @@
 //!   crossing that loop's umbra surface. The wedge's penumbra is then added without the
 //!   umbra's −255. Paper II §1 names the case ("artifacts may appear when the light source is
 //!   so large that there is no umbra region at all"). 33 of the 51 have exactly the LI of
-//!   `pw2002` with `side_planes = cancel` (Paper I §5); the other 18 are 255 or 510 lighter
+//!   `pw2002` with `side-planes = cancel` (Paper I §5); the other 18 are 255 or 510 lighter
 //!   than it because the outer-volume quad of a degenerate wedge is a bow-tie whose far half
 //!   is wound the other way. The quad is kept: against `pw2002`/`cancel` it changes 529
 //!   pixels, always by whole multiples of 255 (383 closer to `raycast`, 52 farther), and it
@@ -60,15 +60,13 @@
 //! * z-pass or z-fail: `mode = auto` picks z-fail when [`crate::plan::eye_in_shadow`] finds the
 //!   near plane in the shadow of a point of the light.
 //!
-//! Options: those of `pw2002` except `side_planes` (an error here: the restructured
+//! Options ([`PwRestructuredOptions`]): those of `pw2002` except `side-planes` (an error here: the restructured
 //! algorithm never visits side planes, it is the `cancel` form by construction) plus `passes = single|three`, `culling = zmin-zmax|zmax|off`,
 //! `mode = auto|zpass|zfail`.
 
-use super::options::OptionReader;
 use super::output::{MethodOutput, PassStats};
 use super::pw2002::{
-    frame_wedges, li_buffer_plan, li_row_major, read_wedge_settings, resolve, MultiLight,
-    WedgeSettings,
+    frame_wedges, li_buffer_plan, li_row_major, resolve, MultiLight, WedgeKeys, WedgeSettings,
 };
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame};
@@ -82,7 +80,8 @@ use crate::gpu::li_buffer::LiTile;
 use crate::gpu::raster::{bin, draw, Fragment};
 use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::stencil::{StencilFace, StencilOp, StencilState};
-use crate::plan::{eye_in_shadow, representative_light_points, BufferPlan, MethodPlan};
+use crate::options::{option_names, option_table, OptionTable, OptionType};
+use crate::plan::{representative_light_points, BufferPlan, CountMode, MethodPlan};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
@@ -128,41 +127,47 @@ pub struct RestructuredSettings {
     pub culling: Culling,
 }
 
-/// Read the options of `pw-restructured`.
-pub fn read_settings(frame: &Frame) -> Result<(RestructuredSettings, &'static str), InputError> {
-    let mut r = OptionReader::new(frame.scene, "pw-restructured");
-    let wedge = read_wedge_settings(&mut r, frame)?;
-    let passes = match r.choice("passes", &["single", "three"], "single")? {
-        "three" => Passes::Three,
-        _ => Passes::Single,
-    };
-    let culling = match r.choice("culling", &["zmin-zmax", "zmax", "off"], "zmin-zmax")? {
-        "zmax" => Culling::Zmax,
-        "off" => Culling::Off,
-        _ => Culling::ZminZmax,
-    };
-    let mode = r.choice("mode", &["auto", "zpass", "zfail"], "auto")?;
-    r.finish()?;
-    let test = match mode {
-        "zpass" => WedgeTest::ZPass,
-        "zfail" => WedgeTest::ZFail,
-        _ => {
-            let pts = representative_light_points(frame.scene);
-            if eye_in_shadow(frame.scene, frame.proj.near, &pts) {
-                WedgeTest::ZFail
-            } else {
-                WedgeTest::ZPass
-            }
-        }
+option_names!(Passes {
+    Single = "single",
+    Three = "three",
+});
+
+option_names!(Culling {
+    ZminZmax = "zmin-zmax",
+    Zmax = "zmax",
+    Off = "off",
+});
+
+option_table! {
+    /// `[options.pw-restructured]` (module doc).
+    pub struct PwRestructuredOptions["pw-restructured"] {
+        ..wedges: WedgeKeys,
+        /// umbra and penumbra in one pass (Paper II §6.2), or stencil, stencil, penumbra (§6.1)
+        passes: Passes = Passes::Single;
+        /// tile occlusion culling (Paper II §4): zmin and zmax with the box test, zmax only, or none
+        culling: Culling = Culling::ZminZmax;
+        /// count z-pass or z-fail (Paper II §5); auto: z-fail when the near plane is in the light's shadow
+        mode: CountMode = CountMode::Auto;
+    }
+}
+
+/// Read the options of `pw-restructured`, and the `mode` as written.
+pub fn read_settings(frame: &Frame) -> Result<(RestructuredSettings, CountMode), InputError> {
+    let o = PwRestructuredOptions::read(frame.scene)?;
+    let pts = representative_light_points(frame.scene);
+    let test = if o.mode.zfail(frame.scene, frame.proj.near, &pts) {
+        WedgeTest::ZFail
+    } else {
+        WedgeTest::ZPass
     };
     Ok((
         RestructuredSettings {
-            wedge,
+            wedge: o.wedges.settings(frame)?,
             test,
-            passes,
-            culling,
+            passes: o.passes,
+            culling: o.culling,
         },
-        mode,
+        o.mode,
     ))
 }
 
@@ -538,7 +543,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         passes: names,
         buffers,
         settings: serde_json::json!({
-            "mode": mode,
+            "mode": mode.written(),
             "resolved": s,
             "wedges": set.wedges.len(),
             "open_wedges": set.open_wedges,

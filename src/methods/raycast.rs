@@ -957,6 +957,7 @@ mod tests {
             meshes,
             methods: None,
             options: Default::default(),
+            cli_options: Default::default(),
             ambient: 0.1,
         }
     }

@@ -49,7 +49,6 @@
 
 use super::hard_sv::{shadow_test, stencil_row_major, stencil_shadow, ShadowTest, StencilOverflow};
 use super::hard_sv::{StencilShadowSettings, Submission};
-use super::options::OptionReader;
 use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, Receiver, FULL_SCREEN};
@@ -70,7 +69,8 @@ use crate::light::coverage::{
 use crate::light::coverage_texture::{
     coverage_texture, CoverageFilter, CoverageTexture, CoverageTextureKey, DEFAULT_N, MAX_N, MIN_N,
 };
-use crate::plan::{BufferPlan, MethodPlan};
+use crate::options::{option_names, option_table, OptionTable, OptionType};
+use crate::plan::{BufferPlan, CountMode, MethodPlan};
 use crate::scene::LightShape;
 use glam::DVec3;
 use std::sync::Arc;
@@ -101,54 +101,85 @@ pub struct SsvSettings {
     pub test: ShadowTest,
 }
 
-/// Read the `ssv` options (module doc) for `frame`.
-pub fn read_settings(frame: &Frame) -> Result<(SsvSettings, &'static str), InputError> {
+option_names! {
+    /// How `ssv` computes coverage (`[options.ssv] coverage`; module doc, "Coverage").
+    pub enum CoverageKind {
+        /// Exact clipping (§3.2.2).
+        Exact = "exact",
+        /// The 4D coverage texture (§3.3).
+        Texture = "texture",
+    }
+}
+
+option_names!(CoverageFilter {
+    Nearest = "nearest",
+    Bilinear = "bilinear",
+    Quadrilinear = "quadrilinear",
+});
+
+option_names! {
+    /// The V-buffer `ssv` renders into (`[options.ssv] vbuffer`; module doc, "V-buffer").
+    pub enum VBufferKind {
+        /// f32 (RGB f32 for a textured light).
+        F32 = "f32",
+        /// f16.
+        F16 = "f16",
+        /// The 8-bit stencil and R/G channels of §4.2.
+        Bit8 = "8bit",
+    }
+}
+
+option_table! {
+    /// `[options.ssv]` (module doc).
+    pub struct SsvOptions["ssv"] {
+        /// count pass 1 z-pass or z-fail; auto: z-fail when the near plane is in the light center's shadow
+        mode: CountMode = CountMode::Auto;
+        /// coverage of an edge: exact clipping (Paper III §3.2.2) or the 4D coverage texture (§3.3; rectangle lights)
+        coverage: Option<CoverageKind> = None, scene "texture for a textured light, else exact";
+        /// texel positions per light side of the coverage texture (coverage = texture only)
+        texture_n: u32 [MIN_N..=MAX_N] = DEFAULT_N;
+        /// lookup filter of the coverage texture (coverage = texture only)
+        filter: CoverageFilter = CoverageFilter::Nearest;
+        /// V-buffer format: f32, f16, or the 8-bit stencil and channels of Paper III §4.2 (textured lights: f32)
+        vbuffer: VBufferKind = VBufferKind::F32;
+    }
+}
+
+/// Read the `ssv` options (module doc) for `frame`, and the `mode` as written.
+pub fn read_settings(frame: &Frame) -> Result<(SsvSettings, CountMode), InputError> {
     let scene = frame.scene;
     let textured = matches!(scene.light().shape, LightShape::TexturedRect { .. });
-    let mut r = OptionReader::new(scene, "ssv");
-    let texture_keys: Vec<&str> = ["texture-n", "filter"]
-        .into_iter()
-        .filter(|k| r.has(k))
-        .collect();
-    let mode = r.choice("mode", &["auto", "zpass", "zfail"], "auto")?;
-    let coverage = r.choice(
-        "coverage",
-        &["exact", "texture"],
-        if textured { "texture" } else { "exact" },
-    )?;
-    let n = r.uint("texture-n", DEFAULT_N as u64, MIN_N as u64..=MAX_N as u64)? as u32;
-    let filter = match r.choice(
-        "filter",
-        &["nearest", "bilinear", "quadrilinear"],
-        "nearest",
-    )? {
-        "nearest" => CoverageFilter::Nearest,
-        "bilinear" => CoverageFilter::Bilinear,
-        _ => CoverageFilter::Quadrilinear,
+    let o = SsvOptions::read(scene)?;
+    let coverage = o.coverage.unwrap_or(if textured {
+        CoverageKind::Texture
+    } else {
+        CoverageKind::Exact
+    });
+    let vbuffer = match o.vbuffer {
+        VBufferKind::F32 if textured => VBufferFormat::RgbF32,
+        VBufferKind::F32 => VBufferFormat::F32,
+        VBufferKind::F16 => VBufferFormat::F16,
+        VBufferKind::Bit8 => VBufferFormat::Split8,
     };
-    let vbuffer = match r.choice("vbuffer", &["f32", "f16", "8bit"], "f32")? {
-        "f32" if textured => VBufferFormat::RgbF32,
-        "f32" => VBufferFormat::F32,
-        "f16" => VBufferFormat::F16,
-        _ => VBufferFormat::Split8,
-    };
-    r.finish()?;
-    let bad =
-        |key: &str, msg: &str| InputError::at(&scene.source, format!("options.ssv.{key}"), msg);
-    if textured && coverage == "exact" {
+    let bad = |key: &str, msg: &str| scene.option_error(SsvOptions::NAME, key, msg);
+    if textured && coverage == CoverageKind::Exact {
         return Err(bad(
             "coverage",
             "textured lights need coverage = \"texture\" (the RGB coverage texture, Paper III §3.3)",
         ));
     }
-    if matches!(scene.light().shape, LightShape::Sphere { .. }) && coverage == "texture" {
+    if matches!(scene.light().shape, LightShape::Sphere { .. }) && coverage == CoverageKind::Texture
+    {
         return Err(bad(
             "coverage",
             "sphere lights need coverage = \"exact\" (Paper III §5.3: no coverage texture for \
              spheres; the 4D texture of §3.3 is defined over a rectangle)",
         ));
     }
-    if let (Some(key), "exact") = (texture_keys.first(), coverage) {
+    let texture_key = ["texture-n", "filter"]
+        .into_iter()
+        .find(|k| SsvOptions::is_written(scene, k));
+    if let (Some(key), CoverageKind::Exact) = (texture_key, coverage) {
         return Err(bad(
             key,
             "only used with coverage = \"texture\"; coverage is \"exact\" (the default for \
@@ -161,18 +192,20 @@ pub fn read_settings(frame: &Frame) -> Result<(SsvSettings, &'static str), Input
             "textured lights need the RGB f32 V-buffer (vbuffer = \"f32\"); f16 and 8bit are grey",
         ));
     }
-    let test = shadow_test(mode, frame, &[scene.light().center]);
     let coverage = match coverage {
-        "exact" => CoverageMode::Exact,
-        _ => CoverageMode::Texture { n, filter },
+        CoverageKind::Exact => CoverageMode::Exact,
+        CoverageKind::Texture => CoverageMode::Texture {
+            n: o.texture_n,
+            filter: o.filter,
+        },
     };
     Ok((
         SsvSettings {
             coverage,
             vbuffer,
-            test,
+            test: shadow_test(o.mode, frame, &[scene.light().center]),
         },
-        mode,
+        o.mode,
     ))
 }
 
@@ -471,7 +504,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         passes: passes.iter().map(|p| p.name.clone()).collect(),
         buffers,
         settings: serde_json::json!({
-            "mode": mode,
+            "mode": mode.written(),
             "resolved": settings,
             "wedges": r.wedges.0,
             "wedges_full_screen": r.wedges.1,

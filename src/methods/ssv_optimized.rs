@@ -34,22 +34,22 @@
 //!
 //! Wedges (`wedge`, §4.1, [`LightModel::wedge_halfspaces`]): `tight` (default) is the convex
 //! hull of the two end pyramids — over the rectangle's corners, or for a sphere over the
-//! `sphere_sides`-gons (3…64, default 8) circumscribing its silhouette disks seen from the end
+//! `sphere-sides`-gons (3…64, default 8) circumscribing its silhouette disks seen from the end
 //! points, cut by Paper III's planes ([`tight_wedge`], "Spheres"); `bounding-sphere` is the
 //! paper's baseline, Paper III's wedge of the light's bounding sphere (the sphere through a
 //! rectangle's corners; a sphere light itself). On `cube-of-spheres-sphere` at 256² the tight
 //! wedges shade 134,160 fragments where Paper III's (`ssv`) shade 157,526; on `cube-of-spheres`
 //! 157,733 where `ssv` shades 235,902 and `bounding-sphere` 311,655.
 //!
-//! Options: `coverage = tables|exact`, `filter = bilinear|nearest` (area table), `split =
-//! stencil|plane`, `wedge = tight|bounding-sphere`, `sphere_sides` (sphere lights with
-//! `wedge = tight` only), `overlap = off|loops`, `light_split = 1…4`, `reserved_bits = 1…7`
-//! (default 5), `mode = auto|zpass|zfail`.
+//! Options ([`SsvOptimizedOptions`]): `coverage = tables|exact`, `filter = bilinear|nearest`
+//! (area table), `split = stencil|plane`, `wedge = tight|bounding-sphere`, `sphere-sides`
+//! (sphere lights with `wedge = tight` only), `overlap = off|loops`, `light-split = 1…4`,
+//! `reserved-bits = 1…7` (default 5), `mode = auto|zpass|zfail`.
 //!
 //! Improvements (§5): `overlap = "loops"` renders every silhouette loop
 //! ([`crate::geometry::loops::silhouette_loops`]) into its own V-buffer and combines the loops'
 //! coverages `c = max(c_A, c_B) + ½·min(c_A, c_B)` (eq. 1), folded over the loops in order;
-//! `light_split = k` splits a rectangular light into k×k equal pieces, each with its own
+//! `light-split = k` splits a rectangular light into k×k equal pieces, each with its own
 //! silhouettes, and averages their visibilities (§5.2).
 //!
 //! Choices where the paper is silent or ambiguous:
@@ -70,7 +70,6 @@
 //! - The overlap approximation renders each loop's quads z-pass (per-loop caps do not exist);
 //!   it is refused when the eye is in shadow. Light splitting is for rectangular lights only.
 
-use super::options::OptionReader;
 use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, BACKGROUND};
@@ -91,7 +90,8 @@ use crate::gpu::stencil::{StencilFace, StencilFunc, StencilOp, StencilState};
 use crate::gpu::transform::ClipVertex;
 use crate::light::coverage::{self, RectLight};
 use crate::light::lookup_tables::{AreaShape, AreaTable, Atan2CubeMap, SplitTable, TableFilter};
-use crate::plan::{eye_in_shadow, BufferPlan, MethodPlan};
+use crate::options::{option_names, option_table, OptionTable};
+use crate::plan::{BufferPlan, CountMode, MethodPlan};
 use crate::scene::LightShape;
 use glam::{DVec2, DVec3, Vec3};
 use std::time::Instant;
@@ -190,7 +190,7 @@ impl LightModel {
     /// - `tight`, rectangle: Paper IV §4.1, the hull of the end pyramids over the four corners
     ///   ([`tight_wedge::wedge_halfspaces`]);
     /// - `tight`, sphere: Paper IV §4.1 for a sphere, the hull of the end pyramids over the
-    ///   `sphere_sides`-gons circumscribing the silhouette disks seen from the end points,
+    ///   `sphere_sides`-gons (option `sphere-sides`) circumscribing the silhouette disks seen from the end points,
     ///   intersected with Paper III's wedge of the sphere
     ///   ([`tight_wedge::sphere_wedge_halfspaces`]);
     /// - not `tight` (`wedge = bounding-sphere`): Paper III's wedge of the light's bounding
@@ -286,35 +286,76 @@ pub fn sector_minus_triangle(a: DVec2, b: DVec2, shape: AreaShape, mode: Coverag
     }
 }
 
-/// Read the `ssv-optimized` options (module doc).
-pub fn read_settings(r: &mut OptionReader, frame: &Frame) -> Result<Settings, InputError> {
-    let coverage = r.choice("coverage", &["tables", "exact"], "tables")?;
-    let filter = match r.choice("filter", &["bilinear", "nearest"], "bilinear")? {
-        "nearest" => TableFilter::Nearest,
-        _ => TableFilter::Bilinear,
+option_names! {
+    /// How the shaders compute coverage (`[options.ssv-optimized] coverage`).
+    pub enum CoverageKind {
+        /// The paper's lookup tables.
+        Tables = "tables",
+        /// Exact arithmetic.
+        Exact = "exact",
+    }
+}
+
+option_names!(HalfSplit {
+    Stencil = "stencil",
+    Plane = "plane",
+});
+
+option_names! {
+    /// The overlap approximation (`[options.ssv-optimized] overlap`, §5.1).
+    pub enum Overlap {
+        /// One V-buffer for all silhouettes.
+        Off = "off",
+        /// One V-buffer per silhouette loop, combined by eq. 1.
+        Loops = "loops",
+    }
+}
+
+option_names! {
+    /// The wedges (`[options.ssv-optimized] wedge`, §4.1).
+    pub enum WedgeShape {
+        /// The hull of the end pyramids.
+        Tight = "tight",
+        /// Paper III's wedge of the light's bounding sphere.
+        BoundingSphere = "bounding-sphere",
+    }
+}
+
+option_table! {
+    /// `[options.ssv-optimized]` (module doc).
+    pub struct SsvOptimizedOptions["ssv-optimized"] {
+        /// coverage in the shaders: the paper's lookup tables (Paper IV §4.2) or exact arithmetic
+        coverage: CoverageKind = CoverageKind::Tables;
+        /// filter of the area table (coverage = tables)
+        filter: TableFilter = TableFilter::Bilinear;
+        /// wedge halves: rendered apart with stencil and depth tests (Paper IV §4.4), or split by the hard-quad plane in the shader
+        split: HalfSplit = HalfSplit::Stencil;
+        /// the overlap approximation: one V-buffer per silhouette loop, combined by eq. 1 (Paper IV §5.1)
+        overlap: Overlap = Overlap::Off;
+        /// wedges: the tight hull of the end pyramids (Paper IV §4.1), or Paper III's wedge of the light's bounding sphere
+        wedge: WedgeShape = WedgeShape::Tight;
+        /// sides of the polygons around a sphere light's silhouette disks (sphere lights with wedge = tight only)
+        sphere_sides: u32 [3..=64] = DEFAULT_SPHERE_SIDES as u32;
+        /// a rectangle light split into k×k pieces, each with its own silhouettes (Paper IV §5.2)
+        light_split: u32 [1..=4] = 1;
+        /// carry bits per channel of the split V-buffer (Paper IV §4.3)
+        reserved_bits: u32 [1..=7] = 5;
+        /// count pass 1 z-pass or z-fail; auto: z-fail when the near plane is in the shadow of a light center
+        mode: CountMode = CountMode::Auto;
+    }
+}
+
+/// Read and check `[options.ssv-optimized]` (module doc).
+pub fn options(frame: &Frame) -> Result<Settings, InputError> {
+    let scene = frame.scene;
+    let o = SsvOptimizedOptions::read(scene)?;
+    let bad = |key: &str, msg: &str| scene.option_error(SsvOptimizedOptions::NAME, key, msg);
+    let coverage = match o.coverage {
+        CoverageKind::Exact => CoverageMode::Exact,
+        CoverageKind::Tables => CoverageMode::Tables(o.filter),
     };
-    let coverage = match coverage {
-        "exact" => CoverageMode::Exact,
-        _ => CoverageMode::Tables(filter),
-    };
-    let split = match r.choice("split", &["stencil", "plane"], "stencil")? {
-        "plane" => HalfSplit::Plane,
-        _ => HalfSplit::Stencil,
-    };
-    let overlap = r.choice("overlap", &["off", "loops"], "off")? == "loops";
-    let tight_wedges = r.choice("wedge", &["tight", "bounding-sphere"], "tight")? == "tight";
-    let sphere_sides_set = r.has("sphere_sides");
-    let sphere_sides = r.uint("sphere_sides", DEFAULT_SPHERE_SIDES as u64, 3..=64)? as usize;
-    let light_split = r.uint("light_split", 1, 1..=4)? as u32;
-    let reserved = r.uint("reserved_bits", 5, 1..=7)? as u32;
-    let format = SplitFormat::new(reserved).map_err(|e| {
-        InputError::at(
-            &frame.scene.source,
-            "options.ssv-optimized.reserved_bits",
-            e,
-        )
-    })?;
-    let mode = r.choice("mode", &["auto", "zpass", "zfail"], "auto")?;
+    let tight_wedges = o.wedge == WedgeShape::Tight;
+    let format = SplitFormat::new(o.reserved_bits).map_err(|e| bad("reserved-bits", &e))?;
     let model = LightModel::from_shape(frame.scene.light().center, &frame.scene.light().shape)
         .ok_or_else(|| {
             InputError::at(
@@ -323,43 +364,39 @@ pub fn read_settings(r: &mut OptionReader, frame: &Frame) -> Result<Settings, In
                 "ssv-optimized supports rect and sphere lights",
             )
         })?;
-    if sphere_sides_set && !(tight_wedges && matches!(model, LightModel::Sphere { .. })) {
-        return Err(InputError::at(
-            &frame.scene.source,
-            "options.ssv-optimized.sphere_sides",
-            "sphere_sides shapes the tight wedges of a sphere light only (wedge = tight)",
+    if SsvOptimizedOptions::is_written(scene, "sphere-sides")
+        && !(tight_wedges && matches!(model, LightModel::Sphere { .. }))
+    {
+        return Err(bad(
+            "sphere-sides",
+            "sphere-sides shapes the tight wedges of a sphere light only (wedge = tight)",
         ));
     }
-    let pieces = model.pieces(light_split).ok_or_else(|| {
-        InputError::at(
-            &frame.scene.source,
-            "options.ssv-optimized.light_split",
+    let pieces = model.pieces(o.light_split).ok_or_else(|| {
+        bad(
+            "light-split",
             "light splitting (Paper IV §5.2) is for rectangular lights",
         )
     })?;
     let centers: Vec<Vec3> = pieces.iter().map(|p| p.center().as_vec3()).collect();
-    let zfail = match mode {
-        "zpass" => false,
-        "zfail" => true,
-        _ => eye_in_shadow(frame.scene, frame.proj.near, &centers),
-    };
+    let zfail = o.mode.zfail(scene, frame.proj.near, &centers);
+    let overlap = o.overlap == Overlap::Loops;
     if overlap && zfail {
-        return Err(InputError::at(
-            &frame.scene.source,
-            "options.ssv-optimized.overlap",
+        return Err(bad(
+            "overlap",
             "the overlap approximation renders each silhouette loop z-pass; the eye is in shadow \
              (or mode = zfail)",
         ));
     }
     Ok(Settings {
         coverage,
-        split,
+        split: o.split,
         overlap,
-        light_split,
+        light_split: o.light_split,
         format,
         zfail,
         tight_wedges,
-        sphere_sides,
+        sphere_sides: o.sphere_sides as usize,
     })
 }
 
@@ -706,23 +743,15 @@ pub fn overlap_combine(a: f32, b: f32) -> f32 {
     a.max(b) + 0.5 * a.min(b)
 }
 
-/// Read and check `[options.ssv-optimized]`.
-pub fn options(frame: &Frame) -> Result<Settings, InputError> {
-    let mut r = OptionReader::new(frame.scene, "ssv-optimized");
-    let s = read_settings(&mut r, frame)?;
-    r.finish()?;
-    Ok(s)
-}
-
 /// Run `ssv-optimized` on a rendered frame.
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let start = Instant::now();
     let s = options(frame)?;
     let model = LightModel::from_shape(frame.scene.light().center, &frame.scene.light().shape)
-        .expect("read_settings checked the shape");
+        .expect("options checked the shape");
     let pieces = model
         .pieces(s.light_split)
-        .expect("read_settings checked the split");
+        .expect("options checked the split");
     let pass_start = Instant::now();
     let receivers = receiver_tiles(frame);
     let mut sum = vec![0.0f32; frame.pixel_count()];

@@ -140,6 +140,7 @@ fn scene(camera: Camera, light: Light, meshes: Vec<Mesh>) -> Scene {
         meshes,
         methods: None,
         options: RawOptions::new(),
+        cli_options: Default::default(),
         ambient: 0.15,
     }
 }

@@ -375,6 +375,7 @@ fn build(def: SceneDef, source: &str, base_dir: &Path) -> Result<Scene, InputErr
         meshes,
         methods: def.methods,
         options,
+        cli_options: Default::default(),
         ambient: def.ambient.unwrap_or(DEFAULT_AMBIENT) as f32,
     })
 }

@@ -19,6 +19,7 @@ pub mod obj;
 pub mod procedural;
 pub mod validate;
 
+use crate::error::InputError;
 use glam::{DVec3, Vec3};
 use std::collections::BTreeMap;
 
@@ -123,8 +124,8 @@ pub struct Mesh {
 }
 
 /// Raw per-method options as written in `[options.METHOD]` or with `--opt METHOD.KEY=VALUE`.
-/// Values are kept as strings/numbers/bools; each method validates its own keys
-/// ([`crate::methods::options::OptionReader`]).
+/// Values are kept as strings/numbers/bools; each method reads its own table into its typed
+/// options ([`crate::options::OptionTable::read`]).
 pub type RawOptions = BTreeMap<String, BTreeMap<String, OptionValue>>;
 
 /// One option value as written by the user.
@@ -154,14 +155,25 @@ impl OptionValue {
             OptionValue::Str(v.to_string())
         }
     }
+
+    /// The value's text, which is what an option reads ([`crate::options`]), so that a scene
+    /// file and `--opt` agree: a string as written, a number or bool as the command line
+    /// writes it; a float keeps its point (`4.0`), so an integer key refuses it.
+    pub fn text(&self) -> String {
+        match self {
+            OptionValue::Str(s) => s.clone(),
+            other => other.to_string(),
+        }
+    }
 }
 
 impl std::fmt::Display for OptionValue {
+    /// As a message shows it: a string quoted, a float with its point (`4.0`).
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             OptionValue::Bool(b) => write!(f, "{b}"),
             OptionValue::Int(i) => write!(f, "{i}"),
-            OptionValue::Float(x) => write!(f, "{x}"),
+            OptionValue::Float(x) => write!(f, "{x:?}"),
             OptionValue::Str(s) => write!(f, "{s:?}"),
         }
     }
@@ -186,6 +198,9 @@ pub struct Scene {
     pub methods: Option<Vec<String>>,
     /// Per-method options, not yet validated against each method's keys.
     pub options: RawOptions,
+    /// The `--opt METHOD.KEY=VALUE` argument that set each option `(METHOD, KEY)` from the
+    /// command line ([`Scene::set_cli_option`]), so that an error about it names the argument.
+    pub cli_options: BTreeMap<(String, String), String>,
     /// Ambient term of the shaded image, in [0, 1].
     pub ambient: f32,
 }
@@ -207,6 +222,34 @@ impl Scene {
             (None, Some(h)) => (scaled(w0, h0, h), h),
             (None, None) => (w0, h0),
         };
+    }
+
+    /// Sets an option from a command-line argument `METHOD.KEY=VALUE` (`--opt`), over the
+    /// scene file's value; the value is read as [`OptionValue::parse_cli`] reads it.
+    pub fn set_cli_option(&mut self, arg: &str) -> Result<(), InputError> {
+        let bad = || InputError::new(format!("--opt {arg}"), "expected METHOD.KEY=VALUE");
+        let (lhs, value) = arg.split_once('=').ok_or_else(bad)?;
+        let (method, key) = lhs.split_once('.').ok_or_else(bad)?;
+        if method.is_empty() || key.is_empty() {
+            return Err(bad());
+        }
+        self.options
+            .entry(method.to_string())
+            .or_default()
+            .insert(key.to_string(), OptionValue::parse_cli(value));
+        self.cli_options
+            .insert((method.to_string(), key.to_string()), arg.to_string());
+        Ok(())
+    }
+
+    /// An error about option `key` of table `method`, naming where it was written: the
+    /// `--opt` argument that set it, else `options.METHOD.KEY` of the scene file (also for a
+    /// default the method cannot use).
+    pub fn option_error(&self, method: &str, key: &str, message: impl Into<String>) -> InputError {
+        match self.cli_options.get(&(method.to_string(), key.to_string())) {
+            Some(arg) => InputError::new(format!("--opt {arg}"), message),
+            None => InputError::at(&self.source, format!("options.{method}.{key}"), message),
+        }
     }
 
     /// The light of a single-light scene. Methods that render one light at a time only ever

@@ -649,6 +649,7 @@ mod tests {
             ],
             methods: None,
             options: Default::default(),
+            cli_options: Default::default(),
             ambient: 0.15,
         }
     }

@@ -94,7 +94,6 @@ pub mod blend;
 pub mod vbuffer;
 
 use super::hard_sv::{shadow_test, volume_stencil_state, ShadowTest, StencilOverflow};
-use super::options::OptionReader;
 use super::output::{MethodOutput, PassStats, RawImage8, Visibility};
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, FULL_SCREEN};
@@ -114,7 +113,8 @@ use crate::gpu::tiling::Tiling;
 use crate::gpu::transform::{ClipVertex, WindowPlane};
 use crate::light::coverage::{quad_side, RectLight};
 use crate::light::radial_parts::{edge_in_parts, PART_COUNT};
-use crate::plan::{BufferPlan, MethodPlan};
+use crate::options::{option_names, option_table, OptionTable, OptionType, Switch};
+use crate::plan::{BufferPlan, CountMode, MethodPlan};
 use crate::scene::LightShape;
 use blend::{blend_part, BlendCase, InnerAdjust, PartState, Rules};
 use glam::DVec3;
@@ -159,47 +159,71 @@ pub struct Settings {
     pub test: ShadowTest,
 }
 
-/// Read and check `[options.wedge-blending]`: `packing = 8bit|f32`,
-/// `target = raw|flush-denormals|canonical-nans`, `centroid = off|on`,
-/// `adjust = checked|always|never`,
-/// `order = forward|reverse`, `silhouettes = loops|meshes`, `mode = auto|zpass|zfail`.
-pub fn options(frame: &Frame) -> Result<(Settings, &'static str), InputError> {
+option_names!(Packing {
+    Bit8 = "8bit",
+    F32 = "f32",
+});
+
+option_names!(FloatTarget {
+    Raw = "raw",
+    FlushDenormals = "flush-denormals",
+    CanonicalNans = "canonical-nans",
+});
+
+option_names!(InnerAdjust {
+    Checked = "checked",
+    Always = "always",
+    Never = "never",
+});
+
+option_names!(Grouping {
+    Loops = "loops",
+    Meshes = "meshes",
+});
+
+option_names! {
+    /// The order the silhouettes are blended in (`[options.wedge-blending] order`).
+    pub enum Order {
+        /// Meshes in scene order, loops in the order they are found (module doc).
+        Forward = "forward",
+        /// The opposite.
+        Reverse = "reverse",
+    }
+}
+
+option_table! {
+    /// `[options.wedge-blending]` (module doc).
+    pub struct WedgeBlendingOptions["wedge-blending"] {
+        /// vBuffer storage: PK4UB-packed 8-bit values in two RGBA32F targets (Forest et al. §4.3), or f32
+        packing: Packing = Packing::Bit8;
+        /// how the RGBA32F targets store packed patterns (packing = 8bit only)
+        target: FloatTarget = FloatTarget::Raw;
+        /// the center of gravity per radial part (Forest et al. §6)
+        centroid: Switch = Switch::Off;
+        /// when the inner rectangle adjustment of Forest et al. Fig. 10 applies
+        adjust: InnerAdjust = InnerAdjust::Checked;
+        /// the order the silhouettes are blended in (the result depends on it)
+        order: Order = Order::Forward;
+        /// one silhouette vBuffer per silhouette loop, or per mesh
+        silhouettes: Grouping = Grouping::Loops;
+        /// count the shadow volumes z-pass or z-fail; auto: z-fail when the near plane is in the light center's shadow
+        mode: CountMode = CountMode::Auto;
+    }
+}
+
+/// Read and check `[options.wedge-blending]` ([`WedgeBlendingOptions`]), and the `mode` as
+/// written.
+pub fn options(frame: &Frame) -> Result<(Settings, CountMode), InputError> {
     let scene = frame.scene;
-    let mut r = OptionReader::new(scene, "wedge-blending");
-    let packing = match r.choice("packing", &["8bit", "f32"], "8bit")? {
-        "f32" => Packing::F32,
-        _ => Packing::Bit8,
-    };
-    let target_name = r.choice(
-        "target",
-        &["raw", "flush-denormals", "canonical-nans"],
-        "raw",
-    )?;
-    let target = match target_name {
-        "flush-denormals" => FloatTarget::FlushDenormals,
-        "canonical-nans" => FloatTarget::CanonicalNans,
-        _ => FloatTarget::Raw,
-    };
-    let centroid = r.choice("centroid", &["off", "on"], "off")? == "on";
-    let adjust = match r.choice("adjust", &["checked", "always", "never"], "checked")? {
-        "always" => InnerAdjust::Always,
-        "never" => InnerAdjust::Never,
-        _ => InnerAdjust::Checked,
-    };
-    let reverse = r.choice("order", &["forward", "reverse"], "forward")? == "reverse";
-    let grouping = match r.choice("silhouettes", &["loops", "meshes"], "loops")? {
-        "meshes" => Grouping::Meshes,
-        _ => Grouping::Loops,
-    };
-    let mode = r.choice("mode", &["auto", "zpass", "zfail"], "auto")?;
-    r.finish()?;
-    if packing == Packing::F32 && target != FloatTarget::Raw {
-        return Err(InputError::at(
-            &scene.source,
-            "options.wedge-blending.target",
+    let o = WedgeBlendingOptions::read(scene)?;
+    if o.packing == Packing::F32 && o.target != FloatTarget::Raw {
+        return Err(scene.option_error(
+            WedgeBlendingOptions::NAME,
+            "target",
             format!(
-                "target = \"{target_name}\" describes how RGBA32F targets store packed 8-bit \
-                 values; it needs packing = \"8bit\""
+                "target = \"{}\" describes how RGBA32F targets store packed 8-bit values; it \
+                 needs packing = \"8bit\"",
+                o.target.written()
             ),
         ));
     }
@@ -210,18 +234,17 @@ pub fn options(frame: &Frame) -> Result<(Settings, &'static str), InputError> {
             "wedge-blending supports rect lights (Forest et al. 2006 §4.2)",
         ));
     }
-    let test = shadow_test(mode, frame, &[scene.light().center]);
     Ok((
         Settings {
-            packing,
-            target,
-            centroid,
-            adjust,
-            reverse,
-            grouping,
-            test,
+            packing: o.packing,
+            target: o.target,
+            centroid: o.centroid.is_on(),
+            adjust: o.adjust,
+            reverse: o.order == Order::Reverse,
+            grouping: o.silhouettes,
+            test: shadow_test(o.mode, frame, &[scene.light().center]),
         },
-        mode,
+        o.mode,
     ))
 }
 
@@ -943,7 +966,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         passes: passes.iter().map(|p| p.name.clone()).collect(),
         buffers,
         settings: serde_json::json!({
-            "mode": mode,
+            "mode": mode.written(),
             "resolved": s,
             "gpu": frame.gpu,
             "buffer_bytes": footprint,
