@@ -27,6 +27,11 @@ struct Cli {
     /// Worker threads, 1 to 1024 (default: all cores). Results are bit-identical for any count.
     #[arg(long, global = true)]
     threads: Option<usize>,
+    /// Also write every buffer each method resolved its visibility from, as raw values, a
+    /// viewable PNG and an overflow/clamp map (render, report and the default run; see
+    /// docs/buffer-dumps.md).
+    #[arg(long, global = true)]
+    dump_buffers: bool,
 }
 
 #[derive(Subcommand, Debug)]
@@ -194,10 +199,11 @@ fn prepare(arg: &str, a: &SceneOverrides) -> Result<Scene, Box<dyn std::error::E
     Ok(scene)
 }
 
-/// Renders `scene` with a progress bar on a terminal (one step per method).
-fn render_scene(scene: &Scene) -> Result<Vec<MethodRun>, InputError> {
+/// Renders `scene` with a progress bar on a terminal (one step per method), with every
+/// buffer dump when `dump_buffers`.
+fn render_scene(scene: &Scene, dump_buffers: bool) -> Result<Vec<MethodRun>, InputError> {
     let progress = Progress::new(penumbra::render::render_order(scene)?.len(), &scene.source);
-    let runs = penumbra::render::render_scene_with(scene, |m| progress.start(m));
+    let runs = penumbra::render::render_scene_dumping(scene, dump_buffers, |m| progress.start(m));
     progress.finish();
     runs
 }
@@ -209,13 +215,15 @@ struct Rendered {
     files: Vec<Vec<String>>,
 }
 
-/// Writes `scene`'s runs into `out/METHOD/` and prints its table and the outputs written.
+/// Writes `scene`'s runs into `out/METHOD/` (every buffer dump's files with `dump_buffers`)
+/// and prints its table and the outputs written.
 fn write_and_print(
     out: &Path,
     scene: Scene,
     runs: Vec<MethodRun>,
+    dump_buffers: bool,
 ) -> Result<Rendered, Box<dyn std::error::Error>> {
-    let files = penumbra::render::write_runs(out, &scene, &runs)?;
+    let files = penumbra::render::write_runs(out, &scene, &runs, dump_buffers)?;
     print!("{}", penumbra::render::table(&scene, &runs));
     let error_png = if runs
         .iter()
@@ -229,13 +237,19 @@ fn write_and_print(
         "outputs: {}/METHOD/{{image.png, visibility.png, visibility.exr, visibility.pfm, {error_png}stats.json}}",
         out.display()
     );
+    if dump_buffers {
+        println!(
+            "buffer dumps: {}/METHOD/NAME.{{bin or png, json, view.png, events.bin, events.png}} (docs/buffer-dumps.md)",
+            out.display()
+        );
+    }
     Ok(Rendered { scene, runs, files })
 }
 
-fn render(a: &RenderArgs) -> Result<Rendered, Box<dyn std::error::Error>> {
+fn render(a: &RenderArgs, dump_buffers: bool) -> Result<Rendered, Box<dyn std::error::Error>> {
     let scene = prepare(&a.scene, &a.overrides)?;
-    let runs = render_scene(&scene)?;
-    write_and_print(&a.out, scene, runs)
+    let runs = render_scene(&scene, dump_buffers)?;
+    write_and_print(&a.out, scene, runs, dump_buffers)
 }
 
 /// Writes the report page for `rendered` scenes, whose method folders are `dirs` (relative to
@@ -263,7 +277,7 @@ fn write_report(
 /// `report`: every scene is loaded and checked, then rendered, before anything is written, so
 /// a bad scene or option leaves no output. Each scene's methods go to `out/SCENE/METHOD/`
 /// (SCENE: the name's file stem, made unique), then the page to `out/index.html`.
-fn report(a: &ReportArgs) -> Result<(), Box<dyn std::error::Error>> {
+fn report(a: &ReportArgs, dump_buffers: bool) -> Result<(), Box<dyn std::error::Error>> {
     let scenes = a
         .scenes
         .iter()
@@ -271,7 +285,7 @@ fn report(a: &ReportArgs) -> Result<(), Box<dyn std::error::Error>> {
         .collect::<Result<Vec<_>, _>>()?;
     let runs = scenes
         .iter()
-        .map(render_scene)
+        .map(|s| render_scene(s, dump_buffers))
         .collect::<Result<Vec<_>, _>>()?;
     let mut dirs: Vec<PathBuf> = Vec::new();
     let mut rendered = Vec::new();
@@ -284,7 +298,12 @@ fn report(a: &ReportArgs) -> Result<(), Box<dyn std::error::Error>> {
             })
             .find(|d| !dirs.contains(d))
             .expect("some suffix is free");
-        rendered.push(write_and_print(&a.out.join(&dir), scene, runs)?);
+        rendered.push(write_and_print(
+            &a.out.join(&dir),
+            scene,
+            runs,
+            dump_buffers,
+        )?);
         dirs.push(dir);
     }
     write_report(&a.out, &rendered, &dirs)
@@ -423,6 +442,19 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
             .build_global()
             .map_err(|e| bad(format!("cannot start {n} worker threads: {e}")))?;
     }
+    let dumps = cli.dump_buffers;
+    if dumps
+        && matches!(
+            cli.cmd,
+            Some(Cmd::List | Cmd::Experiment(_) | Cmd::Golden { .. })
+        )
+    {
+        return Err(InputError::new(
+            "--dump-buffers",
+            "only render, report and the default run (no command) write buffer dumps",
+        )
+        .into());
+    }
     match cli.cmd {
         // The default scene, then its companions so that the methods its rectangular light
         // cannot run appear in a table too: the sphere-light twin (penumbra wedges,
@@ -431,11 +463,14 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
         // reference.
         None => {
             let out = PathBuf::from(penumbra::render::DEFAULT_OUT);
-            let mut rendered = vec![render(&RenderArgs {
-                scene: builtin::DEFAULT.into(),
-                overrides: SceneOverrides::default(),
-                out: out.clone(),
-            })?];
+            let mut rendered = vec![render(
+                &RenderArgs {
+                    scene: builtin::DEFAULT.into(),
+                    overrides: SceneOverrides::default(),
+                    out: out.clone(),
+                },
+                dumps,
+            )?];
             let mut dirs = vec![PathBuf::new()];
             for name in builtin::DEFAULT_COMPANIONS {
                 let scene = builtin::load(name).ok_or("missing built-in companion scene")?;
@@ -444,21 +479,24 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
                     .filter(|m| **m != "nsample" && penumbra::methods::supports_scene(m, &scene))
                     .map(|m| m.to_string())
                     .collect();
-                rendered.push(render(&RenderArgs {
-                    scene: name.to_string(),
-                    overrides: SceneOverrides {
-                        methods: Some(methods),
-                        ..SceneOverrides::default()
+                rendered.push(render(
+                    &RenderArgs {
+                        scene: name.to_string(),
+                        overrides: SceneOverrides {
+                            methods: Some(methods),
+                            ..SceneOverrides::default()
+                        },
+                        out: out.join(name),
                     },
-                    out: out.join(name),
-                })?);
+                    dumps,
+                )?);
                 dirs.push(PathBuf::from(name));
             }
             write_report(&out, &rendered, &dirs)
         }
         Some(Cmd::Experiment(e)) => experiment(e),
-        Some(Cmd::Render(a)) => render(&a).map(|_| ()),
-        Some(Cmd::Report(a)) => report(&a),
+        Some(Cmd::Render(a)) => render(&a, dumps).map(|_| ()),
+        Some(Cmd::Report(a)) => report(&a, dumps),
         Some(Cmd::List) => {
             println!("# built-in scenes");
             for n in builtin::names() {

@@ -232,7 +232,7 @@ fn without_a_reference_the_page_says_so_and_links_only_what_was_written() {
     let mut scene = sized(builtin::load("single-quad").unwrap(), 32);
     scene.methods = Some(vec!["hard-sv".into()]);
     let runs = penumbra::render::render_scene(&scene).unwrap();
-    let files = penumbra::render::write_runs(&dir.join("q"), &scene, &runs).unwrap();
+    let files = penumbra::render::write_runs(&dir.join("q"), &scene, &runs, false).unwrap();
     assert!(!files[0].iter().any(|f| f == "error.png"));
     let page = penumbra::report::write(
         &dir,

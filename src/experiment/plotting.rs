@@ -9,8 +9,9 @@ use std::sync::OnceLock;
 /// The embedded font (DejaVu Sans 2.37).
 const FONT: &[u8] = include_bytes!("font/DejaVuSans.ttf");
 
-/// Registers [`FONT`] as plotters' `sans-serif` once per process.
-fn register_font() -> Result<(), String> {
+/// Registers the embedded font as plotters' `sans-serif` once per process (also for the
+/// legends of buffer dumps, [`crate::output::dump`]).
+pub fn register_font() -> Result<(), String> {
     static DONE: OnceLock<Result<(), String>> = OnceLock::new();
     DONE.get_or_init(|| {
         plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
