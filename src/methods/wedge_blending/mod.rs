@@ -944,8 +944,8 @@ fn blending_dumps<S: VBufferStorage>(
         tile_pixels(tiling, t, |i, g| {
             last[g] = tile.last[i];
             sums[g] = tile.stencil_sum[i];
-            for k in 0..2 {
-                events[k][g] = tile.final_events[k][i];
+            for (e, record) in events.iter_mut().zip(&tile.final_events) {
+                e[g] = record[i];
             }
         });
     }
