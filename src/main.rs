@@ -175,8 +175,13 @@ fn apply_overrides(scene: &mut Scene, a: &SceneOverrides) -> Result<(), InputErr
 }
 
 /// The scene argument `arg` with the overrides applied, validated, and checked against the
-/// memory limit; prints the f32-rounding warning if it applies. Nothing is rendered yet.
-fn prepare(arg: &str, a: &SceneOverrides) -> Result<Scene, Box<dyn std::error::Error>> {
+/// memory limit (with its buffer dumps when `dump_buffers`); prints the f32-rounding warning
+/// if it applies. Nothing is rendered yet.
+fn prepare(
+    arg: &str,
+    a: &SceneOverrides,
+    dump_buffers: bool,
+) -> Result<Scene, Box<dyn std::error::Error>> {
     let mut scene = file::resolve(arg)?;
     apply_overrides(&mut scene, a)?;
     let (limit, origin) = match &a.max_memory {
@@ -192,7 +197,8 @@ fn prepare(arg: &str, a: &SceneOverrides) -> Result<Scene, Box<dyn std::error::E
             "the default, half of the machine's memory; set it with --max-memory",
         ),
     };
-    memory::check_fits(&scene, &penumbra::methods::selected(&scene)?, limit, origin)?;
+    let methods = penumbra::methods::selected(&scene)?;
+    memory::check_fits(&scene, (&methods, dump_buffers), limit, origin)?;
     if let Some(w) = validate::f32_rounding_warning(&scene) {
         eprintln!("penumbra: {w}");
     }
@@ -247,7 +253,7 @@ fn write_and_print(
 }
 
 fn render(a: &RenderArgs, dump_buffers: bool) -> Result<Rendered, Box<dyn std::error::Error>> {
-    let scene = prepare(&a.scene, &a.overrides)?;
+    let scene = prepare(&a.scene, &a.overrides, dump_buffers)?;
     let runs = render_scene(&scene, dump_buffers)?;
     write_and_print(&a.out, scene, runs, dump_buffers)
 }
@@ -281,7 +287,7 @@ fn report(a: &ReportArgs, dump_buffers: bool) -> Result<(), Box<dyn std::error::
     let scenes = a
         .scenes
         .iter()
-        .map(|arg| prepare(arg, &a.overrides))
+        .map(|arg| prepare(arg, &a.overrides, dump_buffers))
         .collect::<Result<Vec<_>, _>>()?;
     let runs = scenes
         .iter()
@@ -388,7 +394,7 @@ fn experiment(cmd: ExperimentCmd) -> Result<(), Box<dyn std::error::Error>> {
                 for m in penumbra::methods::ALL {
                     memory::check_fits(
                         &scene,
-                        &[m.to_string()],
+                        (&[m.to_string()], false),
                         memory::default_limit(),
                         "half of the machine's memory",
                     )?;
