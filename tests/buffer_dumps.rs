@@ -76,10 +76,6 @@ fn assert_resolves(label: &str, s: &Scene, vis: &[f32], resolve: impl Fn(usize) 
     }
 }
 
-fn sum(v: &[u32]) -> u64 {
-    v.iter().map(|&n| u64::from(n)).sum()
-}
-
 /// The total overflow events of every kind in a dump's event map.
 fn events(d: &BufferDump) -> u64 {
     d.events
@@ -104,21 +100,9 @@ fn u8s(d: &BufferDump) -> &[u8] {
 
 #[test]
 fn asking_for_dumps_changes_no_visibility_bit_and_no_counter() {
-    let every = [
-        "raycast",
-        "nsample",
-        "hard-sv",
-        "pw2002",
-        "pw-restructured",
-        "ssv-optimized",
-        "ssv",
-        "wedge-blending",
-        "penumbra-map",
-        "dbuffer",
-    ];
     for name in ["cube-of-spheres", "cube-of-spheres-sphere", "disk-block"] {
         let mut s = scene(name, 40, &[], &["nsample.n=16", "raycast.samples=64"]);
-        let methods: Vec<String> = every
+        let methods: Vec<String> = penumbra::methods::ALL
             .iter()
             .filter(|m| penumbra::methods::supports_scene(m, &s))
             .map(|m| m.to_string())

@@ -171,7 +171,7 @@ impl PartialEq for DumpValues {
 }
 
 /// What one element of a dump is (`docs/buffer-dumps.md` lists the formats): its storage,
-/// its channels, and how its viewable image shows it ([`ElementFormat::panels`]).
+/// its channels, and how its viewable image shows it ([`BufferDump::panels`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ElementFormat {
     /// An 8-bit stencil value (`gpu::stencil`), u8.

@@ -61,7 +61,7 @@
 //!   near plane in the shadow of a point of the light.
 //!
 //! Buffer dump (`--dump-buffers`): `li`, as `pw2002`'s
-//! ([`li_dump`](super::pw2002::li_dump)).
+//! ([`super::pw2002::li_dump`]).
 //!
 //! Options: those of `pw2002` except `side_planes` (an error here: the restructured
 //! algorithm never visits side planes, it is the `cancel` form by construction) plus `passes = single|three`, `culling = zmin-zmax|zmax|off`,
