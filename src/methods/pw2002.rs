@@ -203,7 +203,7 @@ pub fn resolve(frame: &Frame, li: &[i32]) -> (Visibility, Vec<bool>) {
 }
 
 /// The dump of the LI buffer `li` (row-major, from `tiles`) in the format of `s`, with its
-/// overflow events per pixel and the pixels the resolve `clamped` (`method` names the paper).
+/// overflow events per pixel and the pixels the resolve `clamped` (`paper` cites the sections).
 pub fn li_dump(
     frame: &Frame,
     s: &WedgeSettings,
