@@ -131,6 +131,10 @@ pub struct Frame<'s> {
     prim_rows: OnceLock<Vec<u32>>,
     /// Row-major depth-buffer receivers, computed on first use ([`Frame::receivers`]).
     depth_receivers: OnceLock<(Vec<Option<Receiver>>, usize)>,
+    /// Whether methods hand back every buffer they resolved, with its event map
+    /// ([`crate::methods::dump`], `--dump-buffers`); false after [`Frame::render`], set with
+    /// [`Frame::dumping`].
+    pub dump_buffers: bool,
 }
 
 impl<'s> Frame<'s> {
@@ -222,7 +226,14 @@ impl<'s> Frame<'s> {
             pass,
             prim_rows: OnceLock::new(),
             depth_receivers: OnceLock::new(),
+            dump_buffers: false,
         })
+    }
+
+    /// This frame with [`Frame::dump_buffers`] set to `on`.
+    pub fn dumping(mut self, on: bool) -> Self {
+        self.dump_buffers = on;
+        self
     }
 
     /// The meshes that cast shadows with their adjacency ([`Frame::casters`]), in scene order:
@@ -261,6 +272,7 @@ impl<'s> Frame<'s> {
             pass: self.pass.clone(),
             prim_rows: self.prim_rows.clone(),
             depth_receivers: self.depth_receivers.clone(),
+            dump_buffers: self.dump_buffers,
         }
     }
 

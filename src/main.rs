@@ -27,6 +27,11 @@ struct Cli {
     /// Worker threads, 1 to 1024 (default: all cores). Results are bit-identical for any count.
     #[arg(long, global = true)]
     threads: Option<usize>,
+    /// Also write every buffer each method resolved its visibility from, as raw values, a
+    /// viewable PNG and an overflow/clamp map (render, report and the default run; see
+    /// docs/buffer-dumps.md).
+    #[arg(long, global = true)]
+    dump_buffers: bool,
 }
 
 #[derive(Subcommand, Debug)]
@@ -167,8 +172,13 @@ fn apply_overrides(scene: &mut Scene, a: &SceneOverrides) -> Result<(), InputErr
 }
 
 /// The scene argument `arg` with the overrides applied, validated, and checked against the
-/// memory limit; prints the f32-rounding warning if it applies. Nothing is rendered yet.
-fn prepare(arg: &str, a: &SceneOverrides) -> Result<Scene, Box<dyn std::error::Error>> {
+/// memory limit (with its buffer dumps when `dump_buffers`); prints the f32-rounding warning
+/// if it applies. Nothing is rendered yet.
+fn prepare(
+    arg: &str,
+    a: &SceneOverrides,
+    dump_buffers: bool,
+) -> Result<Scene, Box<dyn std::error::Error>> {
     let mut scene = file::resolve(arg)?;
     apply_overrides(&mut scene, a)?;
     let (limit, origin) = match &a.max_memory {
@@ -184,17 +194,19 @@ fn prepare(arg: &str, a: &SceneOverrides) -> Result<Scene, Box<dyn std::error::E
             "the default, half of the machine's memory; set it with --max-memory",
         ),
     };
-    memory::check_fits(&scene, &penumbra::methods::selected(&scene)?, limit, origin)?;
+    let methods = penumbra::methods::selected(&scene)?;
+    memory::check_fits(&scene, (&methods, dump_buffers), limit, origin)?;
     if let Some(w) = validate::f32_rounding_warning(&scene) {
         eprintln!("penumbra: {w}");
     }
     Ok(scene)
 }
 
-/// Renders `scene` with a progress bar on a terminal (one step per method).
-fn render_scene(scene: &Scene) -> Result<Vec<MethodRun>, InputError> {
+/// Renders `scene` with a progress bar on a terminal (one step per method), with every
+/// buffer dump when `dump_buffers`.
+fn render_scene(scene: &Scene, dump_buffers: bool) -> Result<Vec<MethodRun>, InputError> {
     let progress = Progress::new(penumbra::render::render_order(scene)?.len(), &scene.source);
-    let runs = penumbra::render::render_scene_with(scene, |m| progress.start(m));
+    let runs = penumbra::render::render_scene_dumping(scene, dump_buffers, |m| progress.start(m));
     progress.finish();
     runs
 }
@@ -206,13 +218,15 @@ struct Rendered {
     files: Vec<Vec<String>>,
 }
 
-/// Writes `scene`'s runs into `out/METHOD/` (`out` = the scene's folder) and prints its table and the outputs written.
+/// Writes `scene`'s runs into `out/METHOD/` (`out` = the scene's folder; every buffer dump's
+/// files with `dump_buffers`) and prints its table and the outputs written.
 fn write_and_print(
     out: &Path,
     scene: Scene,
     runs: Vec<MethodRun>,
+    dump_buffers: bool,
 ) -> Result<Rendered, Box<dyn std::error::Error>> {
-    let files = penumbra::render::write_runs(out, &scene, &runs)?;
+    let files = penumbra::render::write_runs(out, &scene, &runs, dump_buffers)?;
     print!("{}", penumbra::render::table(&scene, &runs));
     let error_png = if runs
         .iter()
@@ -226,16 +240,22 @@ fn write_and_print(
         "outputs: {}/METHOD/{{image.png, visibility.png, visibility.exr, visibility.pfm, {error_png}stats.json}}",
         out.display()
     );
+    if dump_buffers {
+        println!(
+            "buffer dumps: {}/METHOD/NAME.{{bin or png, json, view.png, events.bin, events.png}} (docs/buffer-dumps.md)",
+            out.display()
+        );
+    }
     Ok(Rendered { scene, runs, files })
 }
 
-fn render(a: &RenderArgs) -> Result<Rendered, Box<dyn std::error::Error>> {
-    let scene = prepare(&a.scene, &a.overrides)?;
+fn render(a: &RenderArgs, dump_buffers: bool) -> Result<Rendered, Box<dyn std::error::Error>> {
+    let scene = prepare(&a.scene, &a.overrides, dump_buffers)?;
     let out = a.out.clone().unwrap_or_else(|| {
         Path::new(penumbra::render::DEFAULT_OUT).join(scene_dir_name(&scene.source))
     });
-    let runs = render_scene(&scene)?;
-    write_and_print(&out, scene, runs)
+    let runs = render_scene(&scene, dump_buffers)?;
+    write_and_print(&out, scene, runs, dump_buffers)
 }
 
 /// Writes the report page for `rendered` scenes, whose method folders are `dirs` (relative to
@@ -263,15 +283,15 @@ fn write_report(
 /// `report`: every scene is loaded and checked, then rendered, before anything is written, so
 /// a bad scene or option leaves no output. Each scene's methods go to `out/SCENE/METHOD/`
 /// (SCENE: the name's file stem, made unique), then the page to `out/index.html`.
-fn report(a: &ReportArgs) -> Result<(), Box<dyn std::error::Error>> {
+fn report(a: &ReportArgs, dump_buffers: bool) -> Result<(), Box<dyn std::error::Error>> {
     let scenes = a
         .scenes
         .iter()
-        .map(|arg| prepare(arg, &a.overrides))
+        .map(|arg| prepare(arg, &a.overrides, dump_buffers))
         .collect::<Result<Vec<_>, _>>()?;
     let runs = scenes
         .iter()
-        .map(render_scene)
+        .map(|s| render_scene(s, dump_buffers))
         .collect::<Result<Vec<_>, _>>()?;
     let mut dirs: Vec<PathBuf> = Vec::new();
     let mut rendered = Vec::new();
@@ -284,7 +304,12 @@ fn report(a: &ReportArgs) -> Result<(), Box<dyn std::error::Error>> {
             })
             .find(|d| !dirs.contains(d))
             .expect("some suffix is free");
-        rendered.push(write_and_print(&a.out.join(&dir), scene, runs)?);
+        rendered.push(write_and_print(
+            &a.out.join(&dir),
+            scene,
+            runs,
+            dump_buffers,
+        )?);
         dirs.push(dir);
     }
     write_report(&a.out, &rendered, &dirs)
@@ -376,7 +401,7 @@ fn experiment(cmd: ExperimentCmd) -> Result<(), Box<dyn std::error::Error>> {
                 for m in penumbra::methods::ALL {
                     memory::check_fits(
                         &scene,
-                        &[m.to_string()],
+                        (&[m.to_string()], false),
                         memory::default_limit(),
                         "half of the machine's memory",
                     )?;
@@ -430,6 +455,19 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
             .build_global()
             .map_err(|e| bad(format!("cannot start {n} worker threads: {e}")))?;
     }
+    let dumps = cli.dump_buffers;
+    if dumps
+        && matches!(
+            cli.cmd,
+            Some(Cmd::List { .. } | Cmd::Experiment(_) | Cmd::Golden { .. })
+        )
+    {
+        return Err(InputError::new(
+            "--dump-buffers",
+            "only render, report and the default run (no command) write buffer dumps",
+        )
+        .into());
+    }
     match cli.cmd {
         // The default scene, then its companions so that the methods its rectangular light
         // cannot run appear in a table too: the sphere-light twin (penumbra wedges,
@@ -438,11 +476,14 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
         // reference.
         None => {
             let out = PathBuf::from(penumbra::render::DEFAULT_OUT);
-            let mut rendered = vec![render(&RenderArgs {
-                scene: builtin::DEFAULT.into(),
-                overrides: SceneOverrides::default(),
-                out: Some(out.join(builtin::DEFAULT)),
-            })?];
+            let mut rendered = vec![render(
+                &RenderArgs {
+                    scene: builtin::DEFAULT.into(),
+                    overrides: SceneOverrides::default(),
+                    out: Some(out.join(builtin::DEFAULT)),
+                },
+                dumps,
+            )?];
             let mut dirs = vec![PathBuf::from(builtin::DEFAULT)];
             for name in builtin::DEFAULT_COMPANIONS {
                 let scene = builtin::load(name).ok_or("missing built-in companion scene")?;
@@ -451,21 +492,24 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
                     .filter(|m| **m != "nsample" && penumbra::methods::supports_scene(m, &scene))
                     .map(|m| m.to_string())
                     .collect();
-                rendered.push(render(&RenderArgs {
-                    scene: name.to_string(),
-                    overrides: SceneOverrides {
-                        methods: Some(methods),
-                        ..SceneOverrides::default()
+                rendered.push(render(
+                    &RenderArgs {
+                        scene: name.to_string(),
+                        overrides: SceneOverrides {
+                            methods: Some(methods),
+                            ..SceneOverrides::default()
+                        },
+                        out: Some(out.join(name)),
                     },
-                    out: Some(out.join(name)),
-                })?);
+                    dumps,
+                )?);
                 dirs.push(PathBuf::from(name));
             }
             write_report(&out, &rendered, &dirs)
         }
         Some(Cmd::Experiment(e)) => experiment(e),
-        Some(Cmd::Render(a)) => render(&a).map(|_| ()),
-        Some(Cmd::Report(a)) => report(&a),
+        Some(Cmd::Render(a)) => render(&a, dumps).map(|_| ()),
+        Some(Cmd::Report(a)) => report(&a, dumps),
         Some(Cmd::List { options: true }) => {
             print!(
                 "{}",

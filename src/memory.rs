@@ -24,6 +24,13 @@ pub const KEPT_BYTES_PER_PIXEL: u64 = 32;
 /// visibility (up to RGB f32) and raw images, kept until they are averaged.
 pub const PER_LIGHT_BYTES_PER_PIXEL: u64 = 16;
 
+/// What a finished method's buffer dumps keep per pixel until the outputs are written, with
+/// `--dump-buffers` (`methods::dump`): measured at 512² and 1024² on `cube-of-spheres` with
+/// `hard-sv`, `ssv`, `ssv-optimized` and `wedge-blending`, 129 bytes per pixel for the four
+/// (raw values, event records, clamp flags), rounded up per method. Light-view maps count at
+/// their default size, the image's larger side squared.
+pub const DUMP_BYTES_PER_PIXEL: u64 = 48;
+
 /// A method's peak memory per pixel while it runs (module doc: measured, rounded up).
 pub fn method_bytes_per_pixel(method: &str) -> u64 {
     match method {
@@ -35,6 +42,18 @@ pub fn method_bytes_per_pixel(method: &str) -> u64 {
         // needs about a third), and any other name (names are checked before) as the largest.
         _ => 384,
     }
+}
+
+/// Estimated bytes to render `scene` with `methods` and, with `dump_buffers`, keep their
+/// buffer dumps ([`DUMP_BYTES_PER_PIXEL`] each).
+pub fn estimate_dumping(scene: &Scene, methods: &[String], dump_buffers: bool) -> u64 {
+    let side = u64::from(scene.width.max(scene.height));
+    let dumps = if dump_buffers {
+        DUMP_BYTES_PER_PIXEL * side * side * methods.len() as u64
+    } else {
+        0
+    };
+    estimate(scene, methods) + dumps
 }
 
 /// Estimated bytes to render `scene` with `methods` (module doc).
@@ -117,19 +136,20 @@ pub fn fmt_bytes(bytes: u64) -> String {
     }
 }
 
-/// Refuses a render of `scene` with `methods` whose [`estimate`] exceeds `limit` (no check
-/// when `limit` is `None`), naming the image size, the estimate and the limit; `limit_origin`
-/// says where the limit came from (`--max-memory` or the default).
+/// Refuses a render of `scene` with `methods` (and their buffer dumps with `dump_buffers`)
+/// whose [`estimate_dumping`] exceeds `limit` (no check when `limit` is `None`), naming the
+/// image size, the estimate and the limit; `limit_origin` says where the limit came from
+/// (`--max-memory` or the default).
 pub fn check_fits(
     scene: &Scene,
-    methods: &[String],
+    (methods, dump_buffers): (&[String], bool),
     limit: Option<u64>,
     limit_origin: &str,
 ) -> Result<(), InputError> {
     let Some(limit) = limit else {
         return Ok(());
     };
-    let need = estimate(scene, methods);
+    let need = estimate_dumping(scene, methods, dump_buffers);
     if need <= limit {
         return Ok(());
     }
@@ -172,7 +192,7 @@ mod tests {
         assert_eq!(estimate(&s, &one), FIXED_BYTES + (1 << 20) * (72 + 32));
         let two = vec!["hard-sv".to_string(), "ssv".to_string()];
         assert_eq!(estimate(&s, &two), FIXED_BYTES + (1 << 20) * (160 + 64));
-        let e = check_fits(&s, &one, Some(100 << 20), "--max-memory")
+        let e = check_fits(&s, (&one, false), Some(100 << 20), "--max-memory")
             .unwrap_err()
             .to_string();
         assert_eq!(
@@ -180,8 +200,14 @@ mod tests {
             "single-quad: width×height: 1024×1024 with hard-sv needs an estimated 168.0 MiB, \
              more than the memory limit of 100.0 MiB (--max-memory)"
         );
-        check_fits(&s, &one, Some(200 << 20), "--max-memory").unwrap();
-        check_fits(&s, &one, None, "default").unwrap();
+        check_fits(&s, (&one, false), Some(200 << 20), "--max-memory").unwrap();
+        check_fits(&s, (&one, false), None, "default").unwrap();
+        // Dumps add their bytes per pixel per method.
+        assert_eq!(
+            estimate_dumping(&s, &two, true),
+            estimate(&s, &two) + (1 << 20) * 2 * DUMP_BYTES_PER_PIXEL
+        );
+        assert!(check_fits(&s, (&one, true), Some(200 << 20), "--max-memory").is_err());
     }
 
     #[test]

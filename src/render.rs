@@ -98,12 +98,22 @@ pub fn render_order(scene: &Scene) -> Result<Vec<String>, InputError> {
 /// progress bar).
 pub fn render_scene_with(
     scene: &Scene,
+    starting: impl FnMut(&str),
+) -> Result<Vec<MethodRun>, InputError> {
+    render_scene_dumping(scene, false, starting)
+}
+
+/// [`render_scene_with`]; with `dump_buffers` every method also hands back every buffer it
+/// resolved, with its event map (`--dump-buffers`, [`crate::methods::dump`]).
+pub fn render_scene_dumping(
+    scene: &Scene,
+    dump_buffers: bool,
     mut starting: impl FnMut(&str),
 ) -> Result<Vec<MethodRun>, InputError> {
     methods::check_option_tables(scene)?;
     let order = render_order(scene)?;
     let gpu = gpu_settings(scene)?;
-    let frame = Frame::render(scene, gpu)?;
+    let frame = Frame::render(scene, gpu)?.dumping(dump_buffers);
     // Every option table is checked before anything runs, also for methods not rendered now.
     for method in scene.options.keys().filter(|k| k.as_str() != "gpu") {
         methods::check_options(method, &frame)?;
@@ -137,12 +147,15 @@ pub fn render_scene_with(
 /// Write every run's files under `dir/METHOD/`, all or nothing: the method folders appear
 /// only once every method's files were written ([`crate::output::write_method_dirs`]). When
 /// the reference ran, every other method also gets `error.png` and its error (whole image and
-/// penumbra only) in `stats.json` ([`Comparison`]). Returns the names of the files written
-/// into each method's folder, in the order of `runs`.
+/// penumbra only) in `stats.json` ([`Comparison`]). Every buffer dump's raw file is written;
+/// with `dump_buffers` also its sidecar, viewable image and event map
+/// ([`crate::output::dump`]). Returns the names of the files written into each method's
+/// folder, in the order of `runs`.
 pub fn write_runs(
     dir: &Path,
     scene: &Scene,
     runs: &[MethodRun],
+    dump_buffers: bool,
 ) -> std::io::Result<Vec<Vec<String>>> {
     let names: Vec<&str> = runs.iter().map(|r| r.method.as_str()).collect();
     let reference = runs.iter().find(|r| r.method == methods::REFERENCE);
@@ -164,6 +177,7 @@ pub fn write_runs(
             (scene.width, scene.height),
             &scene.source,
             &comparison,
+            dump_buffers,
         )
     })
 }

@@ -524,19 +524,23 @@ fn small_render_writes_every_documented_output() {
         String::from_utf8_lossy(&output.stderr)
     );
     let dir = out.join("hard-sv");
-    for f in [
+    let mut documented = [
         "image.png",
         "visibility.png",
         "visibility.exr",
         "visibility.pfm",
         "stats.json",
         "stencil.png",
-    ] {
+    ];
+    for f in documented {
         let len = std::fs::metadata(dir.join(f))
             .unwrap_or_else(|e| panic!("{f}: {e}"))
             .len();
         assert!(len > 0, "{f} is empty");
     }
+    // Nothing else: buffer dumps beyond the stencil only with --dump-buffers.
+    documented.sort();
+    assert_eq!(entries(&dir), documented);
     let stats: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.join("stats.json")).unwrap()).unwrap();
     assert_eq!(stats["scene"], "single-quad");
@@ -657,6 +661,39 @@ fn long_paths_are_shortened() {
     assert_bad_input("long path", &run, "scene.toml", &["characters, shortened]"]);
     assert!(run.0.stderr.len() < 4000, "{} bytes", run.0.stderr.len());
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// `--dump-buffers` acts on render, report and the default run; elsewhere it is refused as
+/// bad input, and with a bad option it writes nothing, like any bad input.
+#[test]
+fn dump_buffers_where_it_cannot_act_and_with_bad_input() {
+    for args in [
+        &["list", "--dump-buffers"][..],
+        &["golden", "--dump-buffers"],
+        &[
+            "experiment",
+            "tile-size",
+            "cube-of-spheres-sphere",
+            "--dump-buffers",
+        ],
+    ] {
+        let o = penumbra(args);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{args:?}: {stderr}");
+        assert!(stderr.contains("--dump-buffers"), "{args:?}: {stderr}");
+        assert!(o.stdout.is_empty(), "{args:?}");
+    }
+    let bad = render(
+        "dump-bad",
+        &["single-quad", "--dump-buffers", "--opt", "ssv.vbuffer=f64"],
+    );
+    assert_bad_input(
+        "--dump-buffers with a bad option",
+        &bad,
+        "single-quad",
+        &["vbuffer"],
+    );
 }
 
 #[test]

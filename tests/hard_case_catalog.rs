@@ -373,7 +373,7 @@ fn every_hard_scene_renders_with_every_method_within_its_bound() {
             let one = render(&scene, m, 1);
             let two = render(&scene, m, 2);
             if one.visibility != two.visibility
-                || one.raw_images != two.raw_images
+                || one.dumps != two.dumps
                 || one.stats.totals != two.stats.totals
             {
                 failures.push(format!("{name} {m}: differs between 1 and 2 threads"));

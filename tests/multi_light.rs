@@ -73,7 +73,7 @@ fn one_light_methods_give_the_mean_of_single_light_renders_bit_for_bit() {
     // hard-sv exposes one stencil per light.
     let raw: Vec<&str> = both[2]
         .output
-        .raw_images
+        .dumps
         .iter()
         .map(|r| r.name.as_str())
         .collect();

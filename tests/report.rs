@@ -2,8 +2,9 @@
 //! XML (roxmltree, a strict parser: the page is written as XHTML), every link and image refers
 //! to a file that exists, every method table has one row per method that ran, a scene file
 //! name with markup characters is shown escaped, the accuracy–time and tile-size results next
-//! to the page are shown, and a bad scene writes nothing. Small frames (32²), three methods,
-//! `raycast.samples=16`.
+//! to the page are shown, a bad scene writes nothing, and with `--dump-buffers` every buffer
+//! dump is linked (its viewable image, raw values, sidecar and event map, all existing files).
+//! Small frames (32²), three methods, `raycast.samples=16`.
 
 use penumbra::experiment::accuracy_time::{self, Configuration, Shard};
 use penumbra::experiment::{sized, tile_size};
@@ -232,7 +233,7 @@ fn without_a_reference_the_page_says_so_and_links_only_what_was_written() {
     let mut scene = sized(builtin::load("single-quad").unwrap(), 32);
     scene.methods = Some(vec!["hard-sv".into()]);
     let runs = penumbra::render::render_scene(&scene).unwrap();
-    let files = penumbra::render::write_runs(&dir.join("q"), &scene, &runs).unwrap();
+    let files = penumbra::render::write_runs(&dir.join("q"), &scene, &runs, false).unwrap();
     assert!(!files[0].iter().any(|f| f == "error.png"));
     let page = penumbra::report::write(
         &dir,
@@ -259,6 +260,65 @@ fn without_a_reference_the_page_says_so_and_links_only_what_was_written() {
 }
 
 #[test]
+fn with_dump_buffers_every_dump_is_linked_with_its_files() {
+    let dir = fresh_dir("dumps");
+    let o = penumbra(&[
+        "report",
+        "single-quad",
+        "--dump-buffers",
+        "--methods",
+        "raycast,hard-sv,ssv,wedge-blending",
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--opt",
+        "raycast.samples=16",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(dir.join("index.html")).unwrap();
+    let doc = parse_and_check_links(&dir, &text);
+    let buffers: Vec<(String, &str)> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("a") && has_class(n, "buffer"))
+        .map(|n| (text_of(n), n.attribute("href").unwrap()))
+        .collect();
+    // Every dump of every method, linking to its viewable image.
+    for (method, name) in [
+        ("hard-sv", "stencil"),
+        ("ssv", "vbuffer"),
+        ("wedge-blending", "penumbrae"),
+        ("wedge-blending", "final-occlusion"),
+        ("wedge-blending", "stencil-sum"),
+    ] {
+        let href = format!("single-quad/{method}/{name}.view.png");
+        assert!(
+            buffers.iter().any(|(t, h)| t == name && *h == href),
+            "{method} {name}: {buffers:?}"
+        );
+    }
+    assert!(!buffers.iter().any(|(_, h)| h.contains("/raycast/")));
+    // Beside each: its raw values, its sidecar and (where it has one) its event map.
+    let hrefs: Vec<&str> = doc
+        .descendants()
+        .filter_map(|n| n.attribute("href"))
+        .collect();
+    for f in [
+        "hard-sv/stencil.png",
+        "hard-sv/stencil.json",
+        "hard-sv/stencil.events.png",
+        "ssv/vbuffer.bin",
+        "ssv/vbuffer.events.png",
+        "wedge-blending/final-rects.bin",
+    ] {
+        assert!(hrefs.contains(&format!("single-quad/{f}").as_str()), "{f}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn a_bad_scene_exits_2_and_writes_nothing() {
     let dir = fresh_dir("bad");
     let out = dir.join("out");
@@ -280,4 +340,15 @@ fn a_bad_scene_exits_2_and_writes_nothing() {
         assert_eq!(stderr.lines().count(), 1, "{stderr}");
         assert!(!out.exists(), "{second}: {} was written", out.display());
     }
+    // With buffer dumps asked for, the same: the bad scene is found before anything renders.
+    let o = penumbra(&[
+        "report",
+        "single-quad",
+        bad.to_str().unwrap(),
+        "--dump-buffers",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(!out.exists());
 }

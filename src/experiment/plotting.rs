@@ -10,8 +10,9 @@ use std::sync::OnceLock;
 const FONT: &[u8] = include_bytes!("font/DejaVuSans.ttf");
 
 /// Registers [`FONT`] as plotters' `sans-serif` once per process. Every plot of this crate
-/// calls it; a program that draws with plotters through another crate (the benchmarks'
-/// criterion HTML reports) calls it first, since no system font is looked up.
+/// calls it (also the legends of buffer dumps, [`crate::output::dump`]); a program that draws
+/// with plotters through another crate (the benchmarks' criterion HTML reports) calls it
+/// first, since no system font is looked up.
 pub fn register_font() -> Result<(), String> {
     static DONE: OnceLock<Result<(), String>> = OnceLock::new();
     DONE.get_or_init(|| {

@@ -5,7 +5,8 @@
 //!
 //! ```text
 //! golden/<scene>/<method>/visibility.pfm     the visibility buffer, exact f32 bits
-//! golden/<scene>/<method>/<raw>.png          each raw 8-bit buffer, e.g. hard-sv's stencil.png
+//! golden/<scene>/<method>/<raw>.png          each 8-bit buffer dump a method always hands
+//!                                            back, e.g. hard-sv's stencil.png
 //! golden/<scene>/<method>/counters.json      every integer counter of stats.json: totals,
 //!                                            per pass (name, runs, counters), clamped_pixels
 //! ```
@@ -31,11 +32,13 @@
 //!   compare, and the CLI's `golden --bless` calls [`bless`]. Goldens are never loosened
 //!   silently: there is no tolerance.
 
+use crate::methods::dump::{BufferDump, DumpValues};
 use crate::methods::output::{MethodOutput, Visibility};
 use crate::metrics::{diff_mask, diff_mask_u8};
+use crate::output::dump::raw_file_name;
 use crate::output::{
-    decode_gray8_png, encode_gray8_png, encode_pfm, encode_side_by_side_png, raw_image_file_name,
-    read_pfm, visibility_to_srgb8, write_files_all_or_nothing,
+    decode_gray8_png, encode_gray8_png, encode_pfm, encode_side_by_side_png, read_pfm,
+    visibility_to_srgb8, write_files_all_or_nothing,
 };
 use std::path::{Path, PathBuf};
 
@@ -104,8 +107,20 @@ fn check_component(what: &str, s: &str) -> Result<(), String> {
     Ok(())
 }
 
+/// The 8-bit values of a single-channel 8-bit dump (the only dumps a golden pins: those of a
+/// normal run), or why not.
+fn gray8_values(d: &BufferDump) -> Result<&[u8], String> {
+    match &d.values {
+        DumpValues::U8(v) if d.format.channels() == 1 => Ok(v),
+        _ => Err(format!(
+            "golden: buffer dump {:?} is not a single-channel 8-bit buffer",
+            d.name
+        )),
+    }
+}
+
 /// The golden files of one output, `(file name, bytes)`: [`VISIBILITY_FILE`], then one PNG
-/// per raw image in output order.
+/// per buffer dump in output order.
 fn golden_files(
     out: &MethodOutput,
     width: u32,
@@ -125,13 +140,13 @@ fn golden_files(
         ),
         (COUNTERS_FILE.to_string(), counters_json(out)),
     ];
-    for raw in &out.raw_images {
-        let name = raw_image_file_name(raw).map_err(|e| format!("golden: {e}"))?;
+    for d in &out.dumps {
+        let name = raw_file_name(d).map_err(|e| format!("golden: {e}"))?;
         if files.iter().any(|(f, _)| *f == name) {
             return Err(format!("golden: two outputs named {name}"));
         }
-        let png = encode_gray8_png(&raw.values, width, height)
-            .map_err(|e| format!("golden: raw image {:?}: {e}", raw.name))?;
+        let png = encode_gray8_png(gray8_values(d)?, d.width, d.height)
+            .map_err(|e| format!("golden: buffer dump {:?}: {e}", d.name))?;
         files.push((name, png));
     }
     Ok(files)
@@ -287,12 +302,18 @@ fn check_against(
         } else if name == COUNTERS_FILE {
             compare_counters(&expected, bytes)
         } else {
-            let raw = out
-                .raw_images
+            let d = out
+                .dumps
                 .iter()
-                .find(|r| format!("{}.png", r.name) == *name)
-                .expect("every golden file but the PFM comes from a raw image");
-            compare_raw(&expected, &raw.values, width, height)
+                .find(|d| format!("{}.png", d.name) == *name)
+                .expect("every golden file but the PFM and the counters comes from a dump");
+            match gray8_values(d) {
+                Ok(values) => compare_raw(&expected, values, d.width, d.height),
+                Err(e) => Err(Mismatch {
+                    summary: e,
+                    panels: None,
+                }),
+            }
         };
         match result {
             Ok(()) => {}
@@ -566,7 +587,8 @@ fn fmt_json(v: Option<&serde_json::Value>) -> String {
 mod tests {
     use super::*;
     use crate::gpu::counters::Counters;
-    use crate::methods::output::{MethodStats, RawImage8};
+    use crate::methods::dump::ElementFormat;
+    use crate::methods::output::MethodStats;
 
     /// A fresh `<tmp>/penumbra-golden-…/golden` root and its failures root.
     fn roots(tag: &str) -> (PathBuf, PathBuf, PathBuf) {
@@ -586,12 +608,16 @@ mod tests {
     fn output(vis: Vec<f32>, stencil: Option<Vec<u8>>) -> MethodOutput {
         MethodOutput {
             visibility: Visibility::Gray(vis),
-            raw_images: stencil
+            dumps: stencil
                 .map(|values| {
-                    vec![RawImage8 {
-                        name: "stencil".into(),
-                        values,
-                    }]
+                    let n = values.len() as u32;
+                    vec![BufferDump::new(
+                        "stencil",
+                        "test",
+                        if n == 6 { (3, 2) } else { (n, 1) },
+                        ElementFormat::Stencil8,
+                        DumpValues::U8(values),
+                    )]
                 })
                 .unwrap_or_default(),
             stats: MethodStats {
@@ -691,7 +717,10 @@ mod tests {
         let out = base_out();
         bless(&root, "scene", "hard-sv", &out).unwrap();
         let mut bad = out.clone();
-        bad.raw_images[0].values[2] = 255;
+        let DumpValues::U8(v) = &mut bad.dumps[0].values else {
+            unreachable!()
+        };
+        v[2] = 255;
         let err = run(&root, &fails, &bad).unwrap_err();
         assert!(err.contains("stencil.png"), "{err}");
         assert!(
@@ -743,7 +772,10 @@ mod tests {
         assert_eq!(first.len(), 3, "{first:?}");
         assert!(bless(&root, "scene", "hard-sv", &out).unwrap().is_empty());
         let mut one_pixel = out.clone();
-        one_pixel.raw_images[0].values[2] = 255;
+        let DumpValues::U8(v) = &mut one_pixel.dumps[0].values else {
+            unreachable!()
+        };
+        v[2] = 255;
         assert_eq!(
             bless(&root, "scene", "hard-sv", &one_pixel).unwrap(),
             vec![dir.join("stencil.png")]

@@ -106,11 +106,35 @@ impl DepthTile {
     }
 }
 
+/// A per-sample record of overflow events for a buffer dump (`methods::dump`): `len` zeros
+/// when `on`, else empty — a record that records nothing and costs nothing (a normal run).
+pub fn overflow_record(on: bool, len: usize) -> Vec<u32> {
+    if on {
+        vec![0; len]
+    } else {
+        Vec::new()
+    }
+}
+
+/// Count `n` overflow events at sample `i` of `record` when it is kept ([`overflow_record`]);
+/// called where the event happens, next to [`Counters::overflow_events`].
+#[inline]
+pub fn record_overflow(record: &mut [u32], i: usize, n: u32) {
+    if n > 0 {
+        if let Some(c) = record.get_mut(i) {
+            *c += n;
+        }
+    }
+}
+
 /// The 8-bit stencil samples of one tile.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct StencilTile {
     /// Stored values.
     pub values: Vec<u8>,
+    /// Overflow events (clamps and wraps) per sample, kept only for a buffer dump
+    /// ([`overflow_record`]; empty otherwise).
+    pub overflows: Vec<u32>,
 }
 
 impl StencilTile {
@@ -118,7 +142,14 @@ impl StencilTile {
     pub fn cleared(value: u8, len: usize) -> Self {
         Self {
             values: vec![value; len],
+            overflows: Vec::new(),
         }
+    }
+
+    /// This tile, recording its overflow events per sample when `on` ([`overflow_record`]).
+    pub fn recording(mut self, on: bool) -> Self {
+        self.overflows = overflow_record(on, self.values.len());
+        self
     }
 
     /// Apply the stencil state to fragment `f` of a triangle with the given facing, given the
@@ -140,6 +171,7 @@ impl StencilTile {
         if let Some((v, overflow)) = face.update(stored, stencil_pass, depth_pass) {
             c.stencil_write_bytes += 1;
             c.overflow_events += overflow as u64;
+            record_overflow(&mut self.overflows, f.local, overflow as u32);
             self.values[f.local] = v;
         }
     }

@@ -14,6 +14,7 @@
 //! in the same format and write only the channels a [`ColorMask`] enables (`glColorMask`), so
 //! one target can be filled by several draws that each own some of its channels.
 
+use super::buffers::{overflow_record, record_overflow};
 use super::counters::Counters;
 use half::f16;
 
@@ -73,6 +74,9 @@ pub struct ColorTile {
     pub format: ColorFormat,
     /// Stored values ([`ColorFormat::encode`]).
     pub values: Vec<u32>,
+    /// Overflow events per sample, kept only for a buffer dump ([`overflow_record`]; empty
+    /// otherwise).
+    pub overflows: Vec<u32>,
 }
 
 impl ColorTile {
@@ -81,7 +85,14 @@ impl ColorTile {
         Self {
             format,
             values: vec![format.encode(value).0; len],
+            overflows: Vec::new(),
         }
+    }
+
+    /// This tile, recording its overflow events per sample when `on` ([`overflow_record`]).
+    pub fn recording(mut self, on: bool) -> Self {
+        self.overflows = overflow_record(on, self.values.len());
+        self
     }
 
     /// Write `v` to sample `i` (counted; a saturated or overflowed conversion counts an
@@ -91,6 +102,7 @@ impl ColorTile {
         let (stored, overflow) = self.format.encode(v);
         c.color_write_bytes += self.format.bytes();
         c.overflow_events += overflow as u64;
+        record_overflow(&mut self.overflows, i, overflow as u32);
         self.values[i] = stored;
     }
 
@@ -113,6 +125,9 @@ pub struct RgbaTile {
     pub format: ColorFormat,
     /// Stored values per sample and channel ([`ColorFormat::encode`]).
     pub values: Vec<[u32; 4]>,
+    /// Overflow events per sample (all channels), kept only for a buffer dump
+    /// ([`overflow_record`]; empty otherwise).
+    pub overflows: Vec<u32>,
 }
 
 impl RgbaTile {
@@ -121,7 +136,14 @@ impl RgbaTile {
         Self {
             format,
             values: vec![value.map(|v| format.encode(v).0); len],
+            overflows: Vec::new(),
         }
+    }
+
+    /// This tile, recording its overflow events per sample when `on` ([`overflow_record`]).
+    pub fn recording(mut self, on: bool) -> Self {
+        self.overflows = overflow_record(on, self.values.len());
+        self
     }
 
     /// Write the channels of `v` that `mask` enables to sample `i` (each counted; a
@@ -133,6 +155,7 @@ impl RgbaTile {
                 let (stored, overflow) = self.format.encode(*value);
                 c.color_write_bytes += self.format.bytes();
                 c.overflow_events += overflow as u64;
+                record_overflow(&mut self.overflows, i, overflow as u32);
                 *slot = stored;
             }
         }

@@ -18,6 +18,7 @@
 //! Each add is a read-modify-write of one sample: its bytes (2 for `Li16`/`Li12`, 1 for `Li8`)
 //! are counted as colour/LI read and write traffic.
 
+use super::buffers::{overflow_record, record_overflow};
 use super::counters::Counters;
 
 /// Storage format of the LI buffer.
@@ -119,6 +120,9 @@ pub struct LiTile {
     pub overflow: LiOverflow,
     /// Stored values.
     pub values: Vec<i32>,
+    /// Overflow events per sample, kept only for a buffer dump ([`overflow_record`]; empty
+    /// otherwise).
+    pub overflows: Vec<u32>,
 }
 
 impl LiTile {
@@ -128,7 +132,14 @@ impl LiTile {
             format,
             overflow,
             values: vec![LI_CLEAR; len],
+            overflows: Vec::new(),
         }
+    }
+
+    /// This tile, recording its overflow events per sample when `on` ([`overflow_record`]).
+    pub fn recording(mut self, on: bool) -> Self {
+        self.overflows = overflow_record(on, self.values.len());
+        self
     }
 
     /// `addToLIBuffer(delta)` at sample `i` (Paper I §4 line 10): a counted read-modify-write;
@@ -140,6 +151,7 @@ impl LiTile {
         c.color_write_bytes += b;
         let (v, overflowed) = li_add(self.format, self.overflow, self.values[i], delta);
         c.overflow_events += overflowed as u64;
+        record_overflow(&mut self.overflows, i, overflowed as u32);
         self.values[i] = v;
     }
 }

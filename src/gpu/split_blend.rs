@@ -20,6 +20,7 @@
 //! The coverage-to-channels conversion is the 1024-entry split table of
 //! [`crate::light::lookup_tables::SplitTable`].
 
+use super::buffers::{overflow_record, record_overflow};
 use super::counters::Counters;
 
 /// The channel layout of a split value: how many upper bits of each 8-bit channel are reserved
@@ -95,6 +96,9 @@ pub struct SplitVTile {
     pub add: Vec<[u8; 4]>,
     /// Subtractive buffer.
     pub sub: Vec<[u8; 4]>,
+    /// Saturated channels per sample of the additive and the subtractive buffer, kept only for
+    /// a buffer dump ([`overflow_record`]; empty otherwise).
+    pub saturations: [Vec<u32>; 2],
 }
 
 /// Which of the two buffers a contribution goes to.
@@ -113,16 +117,24 @@ impl SplitVTile {
         Self {
             add: vec![add_clear; len],
             sub: vec![[0; 4]; len],
+            saturations: [Vec::new(), Vec::new()],
         }
+    }
+
+    /// This tile, recording its saturations per sample when `on` ([`overflow_record`]).
+    pub fn recording(mut self, on: bool) -> Self {
+        let len = self.add.len();
+        self.saturations = [overflow_record(on, len), overflow_record(on, len)];
+        self
     }
 
     /// Blend the split value `src` into sample `i` of `target`: read the destination (4 bytes),
     /// add with saturation, write (4 bytes). Every saturated channel counts one overflow event.
     #[inline]
     pub fn blend(&mut self, target: SplitTarget, i: usize, src: [u8; 4], c: &mut Counters) {
-        let buf = match target {
-            SplitTarget::Add => &mut self.add,
-            SplitTarget::Sub => &mut self.sub,
+        let (buf, record) = match target {
+            SplitTarget::Add => (&mut self.add, &mut self.saturations[0]),
+            SplitTarget::Sub => (&mut self.sub, &mut self.saturations[1]),
         };
         c.color_read_bytes += 4;
         c.color_write_bytes += 4;
@@ -131,6 +143,7 @@ impl SplitVTile {
             let (v, sat) = blend_add_u8(dst[k], src[k]);
             dst[k] = v;
             c.overflow_events += sat as u64;
+            record_overflow(record, i, sat as u32);
         }
     }
 

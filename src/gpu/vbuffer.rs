@@ -29,6 +29,7 @@
 //! (grey formats replicate their one channel); for [`VBuffer8Tile`] that is the penumbra sum
 //! only, which the method merges with its stencil umbra.
 
+use super::buffers::{overflow_record, record_overflow};
 use super::counters::Counters;
 use half::f16;
 
@@ -70,6 +71,14 @@ pub trait VBufferTile: Send {
     /// The accumulated value of pixel `i` per channel (module doc; not counted: the final
     /// read-back).
     fn resolve(&self, i: usize) -> [f32; 3];
+    /// Record overflow events per sample from now on, for a buffer dump
+    /// ([`overflow_record`]); formats that count none record nothing.
+    fn record_overflows(&mut self) {}
+    /// The overflow events per sample recorded since [`VBufferTile::record_overflows`]
+    /// (empty when nothing was recorded).
+    fn overflows(&self) -> &[u32] {
+        &[]
+    }
 }
 
 /// One f32 per pixel (module doc).
@@ -102,6 +111,8 @@ impl VBufferTile for VBufferF32Tile {
 pub struct VBufferF16Tile {
     /// Stored values.
     pub values: Vec<f16>,
+    /// Non-finite results per sample, kept only for a buffer dump ([`overflow_record`]).
+    pub overflows: Vec<u32>,
 }
 
 impl VBufferTile for VBufferF16Tile {
@@ -109,6 +120,7 @@ impl VBufferTile for VBufferF16Tile {
     fn cleared(len: usize) -> Self {
         Self {
             values: vec![f16::ONE; len],
+            overflows: Vec::new(),
         }
     }
     #[inline]
@@ -117,10 +129,17 @@ impl VBufferTile for VBufferF16Tile {
         c.color_write_bytes += 2;
         let v = f16::from_f32(self.values[i].to_f32() + delta[0]);
         c.overflow_events += !v.is_finite() as u64;
+        record_overflow(&mut self.overflows, i, !v.is_finite() as u32);
         self.values[i] = v;
     }
     fn resolve(&self, i: usize) -> [f32; 3] {
         [self.values[i].to_f32(); 3]
+    }
+    fn record_overflows(&mut self) {
+        self.overflows = overflow_record(true, self.values.len());
+    }
+    fn overflows(&self) -> &[u32] {
+        &self.overflows
     }
 }
 
@@ -161,6 +180,8 @@ pub struct VBuffer8Tile {
     pub add: Vec<u8>,
     /// The green channel: subtractive contributions, stored as positive values.
     pub sub: Vec<u8>,
+    /// Saturations per sample, kept only for a buffer dump ([`overflow_record`]).
+    pub overflows: Vec<u32>,
 }
 
 /// `round(|δ|·63)` as a 6-bit level (module doc).
@@ -174,6 +195,7 @@ impl VBufferTile for VBuffer8Tile {
         Self {
             add: vec![0; len],
             sub: vec![0; len],
+            overflows: Vec::new(),
         }
     }
     #[inline]
@@ -195,9 +217,16 @@ impl VBufferTile for VBuffer8Tile {
         };
         c.overflow_events += overflow as u64;
         *channel = sum;
+        record_overflow(&mut self.overflows, i, overflow as u32);
     }
     fn resolve(&self, i: usize) -> [f32; 3] {
         [(self.add[i] as f32 - self.sub[i] as f32) / VBUFFER8_FULL as f32; 3]
+    }
+    fn record_overflows(&mut self) {
+        self.overflows = overflow_record(true, self.add.len());
+    }
+    fn overflows(&self) -> &[u32] {
+        &self.overflows
     }
 }
 

@@ -102,12 +102,20 @@
 //!    The stencil buffer of §6.2 ("used to avoid overwriting umbra regions") is not needed: the
 //!    screen pass computes each pixel's V once, from the D-buffer, with nothing drawn over it.
 //!
+//! Buffer dumps (`--dump-buffers`, [`super::dump`]): `dbuffer`, the RGBA target at the map
+//! size as stored (R |cx_o|, G |cx_uv|, B |cx_pv|, A |cx_s|), with its non-finite writes; and
+//! `t`, per pixel eq. 3's t before the clamp (f64, NaN where the screen program computed none:
+//! umbra, lit, degenerate, background), with the pixels whose t the clamp changed — the
+//! method's `clamped_pixels`.
+//!
 //! Lights: disks only (the paper's "one circular light source"); every other shape is rejected
 //! by the registry. Several disk lights: one D-buffer each, averaged
 //! ([`super::light_average`]). The paper's failure cases — concave and overlapping occluders,
 //! no umbra (§4 case 2: V too low, √t better), acute silhouette corners — are measured and
 //! pinned in `tests/dbuffer.rs`; the findings are in `docs/dbuffer.md`.
 
+use super::dump::{color_values, row_major, BufferDump, DumpValues, ElementFormat};
+use super::dump::{EventKind, EventMap};
 use super::output::{MethodOutput, PassStats, Visibility};
 use super::penumbra_map::ShadowMapKeys;
 use crate::error::InputError;
@@ -281,6 +289,13 @@ pub struct Shade {
     pub degenerate: bool,
     /// The visibility (in [0, 1]: computed from t clamped to [0, 1]).
     pub v: f64,
+}
+
+impl Shade {
+    /// Whether the clamp of t to [0, 1] changed it (the method's clamped pixels).
+    pub fn clamped(&self) -> bool {
+        self.t.is_some_and(|t| !(0.0..=1.0).contains(&t))
+    }
 }
 
 /// The fragment program of the screen pass (module doc, pass 3): the receiver at distance `d`
@@ -613,7 +628,8 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
 
     // Pass 2: the D-buffer, three draws.
     let mut tiles = alloc_tiles(&view.tiling, |_, len| DTile {
-        color: RgbaTile::cleared(s.storage, [range, 0.0, 0.0, 0.0], len),
+        color: RgbaTile::cleared(s.storage, [range, 0.0, 0.0, 0.0], len)
+            .recording(frame.dump_buffers),
         depth: DepthTile::cleared(view.depth, len),
         stats: DBufferStats::default(),
     });
@@ -733,7 +749,7 @@ fn screen_pass(
                 Region::Lit => st.lit += 1,
             }
             st.degenerate_t += shade.degenerate as u64;
-            st.t_out_of_range += shade.t.is_some_and(|t| !(0.0..=1.0).contains(&t)) as u64;
+            st.t_out_of_range += shade.clamped() as u64;
             (shade.v as f32, Some(shade))
         });
     let (values, shades) = pixels.into_iter().unzip();
@@ -780,11 +796,61 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         }),
     );
     stats.clamped_pixels = r.screen.t_out_of_range;
+    let dumps = if frame.dump_buffers {
+        dbuffer_dumps(frame, &r, &s)
+    } else {
+        vec![]
+    };
     Ok(MethodOutput {
         visibility: r.visibility,
-        raw_images: vec![],
+        dumps,
         stats,
     })
+}
+
+/// The dumps of the D-buffer and of t (module doc).
+fn dbuffer_dumps(frame: &Frame, r: &DBufferRender, s: &DBufferSettings) -> Vec<BufferDump> {
+    let tiling = &r.view.tiling;
+    let texels = row_major(tiling, &r.dbuffer, |t| &t.values);
+    let dbuffer = BufferDump::new(
+        "dbuffer",
+        &format!(
+            "the D-buffer (CGI 2004 §2.2, §3) seen from the light center: per texel R = |cx_o| \
+             (nearest surface), G = |cx_uv| and B = |cx_pv| (farthest umbra- and penumbra-volume \
+             distance, 0 = none), A = |cx_s| (eq. 2), distances over [0, {}]",
+            r.range
+        ),
+        (r.view.size(), r.view.size()),
+        ElementFormat::Color(s.storage, 4),
+        color_values(s.storage, texels.into_iter().flatten()),
+    )
+    .with_channels(&["R |cx_o|", "G |cx_uv|", "B |cx_pv|", "A |cx_s|"])
+    .with_events(EventMap::new(
+        EventKind::NonFinite,
+        row_major(tiling, &r.dbuffer, |t| &t.overflows),
+        Vec::new(),
+    ));
+    let t: Vec<f64> = r
+        .shades
+        .iter()
+        .map(|sh| sh.and_then(|sh| sh.t).unwrap_or(f64::NAN))
+        .collect();
+    let clamped = r
+        .shades
+        .iter()
+        .map(|sh| sh.is_some_and(|sh| sh.clamped()))
+        .collect();
+    let t = BufferDump::new(
+        "t",
+        "per pixel, the penumbra parameter t of eq. 3 (CGI 2004 §4) before the clamp to [0, 1] \
+         that V = falloff(t) applies; NaN where the screen program computed none (umbra, lit, \
+         degenerate, background)",
+        (frame.scene.width, frame.scene.height),
+        ElementFormat::ScalarF64,
+        DumpValues::F64(t),
+    )
+    .with_events(EventMap::clamps(clamped));
+    vec![dbuffer, t]
 }
 
 #[cfg(test)]

@@ -14,8 +14,12 @@
 //!   counts from clamping at 0.
 //!
 //! A pixel is lit (visibility 1) when its stencil count is 0; background pixels are lit.
+//!
+//! Buffer dump ([`super::dump`]): `stencil`, the final counts (always, as `stencil.png`), with
+//! its wraps or clamps per pixel under `--dump-buffers`.
 
-use super::output::{MethodOutput, PassStats, RawImage8, Visibility};
+use super::dump::{row_major, BufferDump, DumpValues, ElementFormat, EventKind, EventMap};
+use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, BACKGROUND};
 use crate::geometry::shadow_volume::{shadow_volume_triangles, Capping};
@@ -135,7 +139,8 @@ pub fn volume_stencil_state(test: ShadowTest, overflow: StencilOverflow) -> Sten
 
 /// Render the hard shadow volumes of every mesh from light point `light` into a fresh 8-bit
 /// stencil buffer (tile-major) against the frame's depth buffer. Returns the stencil tiles and
-/// the counters (setup + rasterization).
+/// the counters (setup + rasterization). The tiles record their overflow events per sample
+/// when the frame asks for buffer dumps ([`Frame::dump_buffers`]).
 pub fn stencil_shadow(
     frame: &Frame,
     light: Vec3,
@@ -160,7 +165,9 @@ pub fn stencil_shadow(
         (Submission::TwoPass, ShadowTest::ZFail) => vec![CullMode::Front, CullMode::Back],
     };
     let tiling = &frame.tiling;
-    let mut stencil = alloc_tiles(tiling, |_, len| StencilTile::cleared(0, len));
+    let mut stencil = alloc_tiles(tiling, |_, len| {
+        StencilTile::cleared(0, len).recording(frame.dump_buffers)
+    });
     let mut counters = Counters::default();
     for cull in passes {
         let (tris, c) = setup_all(&prims, cull, tiling);
@@ -184,11 +191,40 @@ pub fn stencil_shadow(
 
 /// Row-major stencil values.
 pub fn stencil_row_major(frame: &Frame, tiles: &[StencilTile]) -> Vec<u8> {
-    let flat: Vec<u8> = tiles
-        .iter()
-        .flat_map(|t| t.values.iter().copied())
-        .collect();
-    frame.tiling.to_row_major(&flat)
+    row_major(&frame.tiling, tiles, |t| &t.values)
+}
+
+/// The kind of overflow event a stencil with `overflow` ops makes.
+pub fn stencil_event_kind(overflow: StencilOverflow) -> EventKind {
+    match overflow {
+        StencilOverflow::Wrap => EventKind::Wrap,
+        StencilOverflow::Saturate => EventKind::Saturate,
+    }
+}
+
+/// The dump of a hard-shadow stencil (`stencil` of `tiles`, row-major `values`) described by
+/// `about`, with its overflow events of `kind` when they were recorded.
+pub fn stencil_dump(
+    frame: &Frame,
+    name: &str,
+    about: &str,
+    tiles: &[StencilTile],
+    values: Vec<u8>,
+    kind: EventKind,
+) -> BufferDump {
+    let dump = BufferDump::new(
+        name,
+        about,
+        (frame.scene.width, frame.scene.height),
+        ElementFormat::Stencil8,
+        DumpValues::U8(values),
+    );
+    if frame.dump_buffers {
+        let overflows = row_major(&frame.tiling, tiles, |t| &t.overflows);
+        dump.with_events(EventMap::new(kind, overflows, Vec::new()))
+    } else {
+        dump
+    }
 }
 
 /// Run `hard-sv` on a rendered frame.
@@ -229,12 +265,18 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         settings: serde_json::json!({ "mode": options.mode.written(), "resolved": settings, "gpu": frame.gpu }),
     };
     let passes = vec![frame.pass.clone(), pass];
+    let dump = stencil_dump(
+        frame,
+        "stencil",
+        "the 8-bit stencil counts of the hard shadow volumes from the light center (Paper I §3; \
+         z-pass, or z-fail with caps, Paper II §5) as the resolve read them: lit where 0",
+        &tiles,
+        stencil,
+        stencil_event_kind(settings.overflow),
+    );
     Ok(MethodOutput {
         visibility: Visibility::Gray(vis),
-        raw_images: vec![RawImage8 {
-            name: "stencil".into(),
-            values: stencil,
-        }],
+        dumps: vec![dump],
         stats: super::method_stats("hard-sv", frame, start, &plan, passes),
     })
 }

@@ -7,10 +7,10 @@
 //! Arithmetic: per pixel and channel, the per-light values are summed in f32 in light order
 //! and the sum is divided by n once (fixed order: independent of threads). A gray and an RGB
 //! result average to RGB (gray replicated). Stats: the scene pass appears once; every pass of
-//! light k is named `light<k>/<pass>`; raw images are named `<name>-light<k>`; the plan lists
+//! light k is named `light<k>/<pass>`; buffer dumps are named `<name>-light<k>`; the plan lists
 //! the per-light plans (their buffers are allocated once per light, in turn).
 
-use super::output::{MethodOutput, RawImage8, Visibility};
+use super::output::{MethodOutput, Visibility};
 use crate::error::InputError;
 use crate::frame::Frame;
 use crate::plan::MethodPlan;
@@ -44,7 +44,7 @@ pub fn run(
         })
         .collect();
     let mut passes = vec![frame.pass.clone()];
-    let mut raw_images = Vec::new();
+    let mut dumps = Vec::new();
     let mut plans = Vec::new();
     for (k, out) in outputs.into_iter().enumerate() {
         passes.extend(
@@ -57,9 +57,10 @@ pub fn run(
                     p
                 }),
         );
-        raw_images.extend(out.raw_images.into_iter().map(|r| RawImage8 {
-            name: format!("{}-light{k}", r.name),
-            values: r.values,
+        dumps.extend(out.dumps.into_iter().map(|mut d| {
+            d.name = format!("{}-light{k}", d.name);
+            d.about = format!("light {k} alone: {}", d.about);
+            d
         }));
         plans.push(out.stats.plan);
     }
@@ -78,7 +79,7 @@ pub fn run(
     stats.warnings = warnings;
     Ok(MethodOutput {
         visibility,
-        raw_images,
+        dumps,
         stats,
     })
 }

@@ -16,6 +16,7 @@ macro_rules! field_sum {
 }
 
 pub mod dbuffer;
+pub mod dump;
 pub mod hard_sv;
 pub mod light_average;
 pub mod nsample;
@@ -469,7 +470,7 @@ fn run_raycast(frame: &Frame) -> Result<MethodOutput, InputError> {
     }
     Ok(MethodOutput {
         visibility,
-        raw_images: vec![],
+        dumps: vec![],
         stats,
     })
 }

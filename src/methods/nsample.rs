@@ -9,11 +9,19 @@
 //! Every stencil pass's memory traffic is counted, so the totals can be set against Paper III
 //! §5.2 (585 MB for 1024 samples vs 6 MB for the soft shadow volume pass).
 //!
+//! Buffer dump (`--dump-buffers`, [`super::dump`]): `accumulator`, per pixel (and channel for
+//! a textured light) the f64 sum of the weights of the samples that saw the light — what the
+//! visibility is rounded from (`clamp(sum, 0, 1)` to f32) — with the stencil's overflow
+//! events summed over the sample passes. The per-sample stencils are not kept.
+//!
 //! Options: `n` (a perfect square, 1…4096, default 1024), and `mode`, `stencil`, `submission` as
 //! for `hard-sv`; `mode = auto` chooses z-fail when the near plane is in the shadow of the
 //! light center or of the shape's extreme points ([`crate::plan::representative_light_points`]).
 
-use super::hard_sv::{stencil_shadow, HardSvOptions, ShadowTest, StencilShadowSettings};
+use super::dump::{row_major, BufferDump, DumpValues, ElementFormat, EventMap};
+use super::hard_sv::{
+    stencil_event_kind, stencil_shadow, HardSvOptions, ShadowTest, StencilShadowSettings,
+};
 use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
 use crate::frame::{Frame, BACKGROUND};
@@ -83,10 +91,22 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         .map(|_| vec![[0.0; 3]; tiling.tile_len()])
         .collect();
     let mut counters = Counters::default();
+    let mut overflows = vec![
+        0u32;
+        if frame.dump_buffers {
+            frame.pixel_count()
+        } else {
+            0
+        }
+    ];
     let pass_start = Instant::now();
     for s in &samples {
         let (stencil, c) = stencil_shadow(frame, s.position, &settings);
         counters += c;
+        if frame.dump_buffers {
+            let sample = row_major(tiling, &stencil, |t| &t.overflows);
+            overflows.iter_mut().zip(sample).for_each(|(a, b)| *a += b);
+        }
         let w = s.weight.map(f64::from);
         acc.par_iter_mut().zip(&stencil).for_each(|(a, st)| {
             for (px, v) in a.iter_mut().zip(&st.values) {
@@ -151,9 +171,29 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         settings: serde_json::json!({ "n": samples.len(), "pattern": "centered", "mode": mode.written(), "resolved": settings, "colored": colored, "gpu": frame.gpu }),
     };
     let passes = vec![frame.pass.clone(), pass];
+    let dumps = if frame.dump_buffers {
+        let channels = if colored { 3 } else { 1 };
+        let sums = rows.iter().flat_map(|p| p[..channels].to_vec()).collect();
+        vec![BufferDump::new(
+            "accumulator",
+            "per pixel the f64 sum, in sample order, of the weights of the light samples whose \
+             stencil count was 0 (Paper III §5.1); visibility = f32(clamp(sum, 0, 1)), \
+             background 1",
+            (scene.width, scene.height),
+            ElementFormat::SumF64(channels as u32),
+            DumpValues::F64(sums),
+        )
+        .with_events(EventMap::new(
+            stencil_event_kind(settings.overflow),
+            overflows,
+            Vec::new(),
+        ))]
+    } else {
+        vec![]
+    };
     Ok(MethodOutput {
         visibility,
-        raw_images: vec![],
+        dumps,
         stats: super::method_stats("nsample", frame, start, &plan, passes),
     })
 }

@@ -1,7 +1,8 @@
 //! What every method hands back: a visibility buffer in [0, 1] (`docs/architecture.md` "Methods":
-//! all methods are compared on the same footing), optional raw buffers for inspection, and the
-//! stats that go into `stats.json`.
+//! all methods are compared on the same footing), its buffers for inspection
+//! ([`super::dump`]), and the stats that go into `stats.json`.
 
+use super::dump::BufferDump;
 use crate::gpu::counters::Counters;
 use serde::Serialize;
 
@@ -43,16 +44,6 @@ impl Visibility {
             Visibility::Rgb(v) => (v[i][0] + v[i][1] + v[i][2]) / 3.0,
         }
     }
-}
-
-/// A raw 8-bit single-channel buffer a method exposes (e.g. `hard-sv`'s stencil counts),
-/// written as `DIR/METHOD/<name>.png`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct RawImage8 {
-    /// File stem, e.g. `stencil`.
-    pub name: String,
-    /// Row-major values, row 0 at the top.
-    pub values: Vec<u8>,
 }
 
 /// Time and counters of one pass.
@@ -111,8 +102,10 @@ pub struct MethodStats {
 pub struct MethodOutput {
     /// Visibility in [0, 1].
     pub visibility: Visibility,
-    /// Extra raw buffers (e.g. the stencil).
-    pub raw_images: Vec<RawImage8>,
+    /// The method's buffers as it resolved them ([`super::dump`]): those of its ordinary
+    /// outputs (e.g. `hard-sv`'s stencil) always, every other one only when the frame asks
+    /// for dumps ([`crate::frame::Frame::dump_buffers`]).
+    pub dumps: Vec<BufferDump>,
     /// Stats for `stats.json`.
     pub stats: MethodStats,
 }

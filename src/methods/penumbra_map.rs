@@ -75,6 +75,12 @@
 //!    with `filter` (`nearest`, default, as the paper, or `bilinear`), clamped to the edge.
 //!    Values outside [0, 1] before the final clamp are counted ([`ScreenStats`]).
 //!
+//! Buffer dumps (`--dump-buffers`, [`super::dump`]), at the map size: `shadow-map`, the depth
+//! target of pass 1 as stored, and `penumbra-map`, the colour channel of pass 2 with its
+//! overflow events (unorm8: clamped writes; f16/f32: non-finite results). The penumbra map's
+//! depth channel holds the same intensities as depths (the LESS test's copy) and is not
+//! dumped.
+//!
 //! Lights: spheres only (the paper's, §4); every other shape is rejected by the registry.
 //! Several lights: one shadow map and one penumbra map per light (§3, last paragraph), run once
 //! per light and averaged ([`super::light_average`]).
@@ -90,6 +96,9 @@
 //! depth along the cone, not across the penumbra (halfway across a sheet from a silhouette at
 //! view depth 2 to a receiver at 3, I = 0.4 and I′ = 0.35; `raycast` there is about 0.8).
 
+use super::dump::{
+    color_values, depth_values, row_major, BufferDump, ElementFormat, EventKind, EventMap,
+};
 use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
 use crate::frame::Frame;
@@ -348,7 +357,8 @@ pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRende
         &cone_light(&view, radius),
         s.cone_segments,
     );
-    let (color, program, c2) = render_penumbra_map(&view, &shadow_map, &geometry, s);
+    let (color, program, c2) =
+        render_penumbra_map(&view, &shadow_map, &geometry, s, frame.dump_buffers);
     let pass2 = PassStats::since("penumbra-map", t, c2);
 
     // Pass 3: the screen.
@@ -420,13 +430,14 @@ pub fn cone_light(view: &LightView, radius: f32) -> ConeLight {
 }
 
 /// Pass 2 (module doc): draw the cones and sheets of `geometry` over `shadow_map` (both in
-/// `view`) into a penumbra map; returns its colour tiles, the program's stats and the pass
-/// counters.
+/// `view`) into a penumbra map; returns its colour tiles (recording their overflow events per
+/// sample when `record`, for a buffer dump), the program's stats and the pass counters.
 pub fn render_penumbra_map(
     view: &LightView,
     shadow_map: &[DepthTile],
     geometry: &PenumbraGeometry,
     s: &PenumbraMapSettings,
+    record: bool,
 ) -> (Vec<ColorTile>, ProgramStats, Counters) {
     let prims: Vec<_> = geometry
         .triangles
@@ -436,7 +447,7 @@ pub fn render_penumbra_map(
     let (tris, mut counters) = setup_all_barycentric(&prims, CullMode::None, &view.tiling);
     let bins = bin(&view.tiling, &tris);
     let mut tiles = alloc_tiles(&view.tiling, |_, len| PenumbraTile {
-        color: ColorTile::cleared(s.storage, 1.0, len),
+        color: ColorTile::cleared(s.storage, 1.0, len).recording(record),
         depth: DepthTile::cleared(view.depth, len),
         stats: ProgramStats::default(),
     });
@@ -585,11 +596,56 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             "gpu": frame.gpu,
         }),
     );
+    let dumps = if frame.dump_buffers {
+        map_dumps(&r, &s)
+    } else {
+        vec![]
+    };
     Ok(MethodOutput {
         visibility: r.visibility,
-        raw_images: vec![],
+        dumps,
         stats,
     })
+}
+
+/// The dumps of the shadow map and the penumbra map (module doc).
+fn map_dumps(r: &PenumbraMapRender, s: &PenumbraMapSettings) -> Vec<BufferDump> {
+    let tiling = &r.view.tiling;
+    let size = (r.view.size(), r.view.size());
+    let shadow = BufferDump::new(
+        "shadow-map",
+        "the shadow map from the light center (Wyman & Hansen §3, pass 1): the nearest depth \
+         per texel of the fitted light view, as stored (polygon offset included with \
+         bias_stage = render); a receiver deeper than its texel is in the umbra",
+        size,
+        ElementFormat::Depth(r.view.depth),
+        depth_values(
+            r.view.depth,
+            row_major(tiling, &r.shadow_map, |t| &t.values).into_iter(),
+        ),
+    );
+    let kind = match s.storage {
+        ColorFormat::Unorm8 => EventKind::Saturate,
+        _ => EventKind::NonFinite,
+    };
+    let penumbra = BufferDump::new(
+        "penumbra-map",
+        "the penumbra map (Wyman & Hansen §3, pass 2): per texel the darkest intensity I′ of \
+         the cones and sheets over the shadow map's surface, 1 where none reached; the screen \
+         pass reads it where a receiver is not in the umbra",
+        size,
+        ElementFormat::Color(s.storage, 1),
+        color_values(
+            s.storage,
+            row_major(tiling, &r.penumbra_map, |t| &t.values).into_iter(),
+        ),
+    )
+    .with_events(EventMap::new(
+        kind,
+        row_major(tiling, &r.penumbra_map, |t| &t.overflows),
+        Vec::new(),
+    ));
+    vec![shadow, penumbra]
 }
 
 #[cfg(test)]

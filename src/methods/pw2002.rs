@@ -28,7 +28,11 @@
 //! scaled by 255/n, Paper I §7, default; or one LI buffer per light, averaged).
 //! The eye is assumed to be outside every shadow (Paper I §8); `pw-restructured` handles the
 //! other case.
+//!
+//! Buffer dump (`--dump-buffers`, [`super::dump`]): `li`, the LI buffer before the resolve, with
+//! its wraps or saturations per pixel and the pixels the resolve clamps ([`li_dump`]).
 
+use super::dump::{li_values, row_major, BufferDump, ElementFormat, EventKind, EventMap};
 use super::output::{MethodOutput, PassStats, Visibility};
 use super::Falloff;
 use crate::error::InputError;
@@ -205,31 +209,59 @@ pub fn frame_wedges(frame: &Frame, s: &WedgeSettings) -> Result<WedgeSet, InputE
 
 /// Row-major LI values of a tiled LI buffer.
 pub fn li_row_major(frame: &Frame, tiles: &[LiTile]) -> Vec<i32> {
-    let flat: Vec<i32> = tiles
-        .iter()
-        .flat_map(|t| t.values.iter().copied())
-        .collect();
-    frame.tiling.to_row_major(&flat)
+    row_major(&frame.tiling, tiles, |t| &t.values)
 }
 
-/// Resolve LI values to visibility (background pixels are lit), and count the receiver pixels
+/// Resolve LI values to visibility (background pixels are lit), and mark the receiver pixels
 /// whose LI value the resolve clamps (outside [0, 255]: overlapping shadows of Paper I §7's
 /// approximation, or an LI format's wrap).
-pub fn resolve(frame: &Frame, li: &[i32]) -> (Visibility, u64) {
+pub fn resolve(frame: &Frame, li: &[i32]) -> (Visibility, Vec<bool>) {
     let prims = frame.prim_ids();
-    let mut clamped = 0;
+    let mut clamped = vec![false; li.len()];
     let v = li
         .iter()
         .zip(prims)
-        .map(|(v, p)| {
+        .zip(&mut clamped)
+        .map(|((v, p), c)| {
             if *p == BACKGROUND {
                 return 1.0;
             }
-            clamped += li_clamped(*v) as u64;
+            *c = li_clamped(*v);
             li_visibility(*v)
         })
         .collect();
     (Visibility::Gray(v), clamped)
+}
+
+/// The dump of the LI buffer `li` (row-major, from `tiles`) in the format of `s`, with its
+/// overflow events per pixel and the pixels the resolve `clamped` (`paper` cites the sections).
+pub fn li_dump(
+    frame: &Frame,
+    s: &WedgeSettings,
+    tiles: &[LiTile],
+    li: &[i32],
+    clamped: Vec<bool>,
+    paper: &str,
+) -> BufferDump {
+    let kind = match s.overflow {
+        LiOverflow::Wrap => EventKind::Wrap,
+        LiOverflow::Saturate => EventKind::Saturate,
+    };
+    BufferDump::new(
+        "li",
+        &format!(
+            "the light-intensity (LI) buffer before the resolve ({paper}): cleared to 255, \
+             signed amounts added per wedge and umbra; visibility = clamp(LI, 0, 255)/255"
+        ),
+        (frame.scene.width, frame.scene.height),
+        ElementFormat::Li(s.li),
+        li_values(s.li, li),
+    )
+    .with_events(EventMap::new(
+        kind,
+        row_major(&frame.tiling, tiles, |t| &t.overflows),
+        clamped,
+    ))
 }
 
 /// The LI buffer of `pw2002` (tile-major) and its counters.
@@ -243,7 +275,9 @@ pub fn render_li(
     let tiling = &frame.tiling;
     let (rt, mut counters) = setup_all(&prims, CullMode::Back, tiling);
     let bins = bin(tiling, &rt);
-    let mut li = alloc_tiles(tiling, |_, len| LiTile::cleared(s.li, s.overflow, len));
+    let mut li = alloc_tiles(tiling, |_, len| {
+        LiTile::cleared(s.li, s.overflow, len).recording(frame.dump_buffers)
+    });
     let depth_state = DepthState {
         func: DepthFunc::Less,
         write: false,
@@ -351,7 +385,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         &plan,
         vec![frame.pass.clone(), pass],
     );
-    stats.clamped_pixels = clamped;
+    stats.clamped_pixels = clamped.iter().filter(|&&c| c).count() as u64;
     let lights = representative_light_points(frame.scene);
     if eye_in_shadow(frame.scene, frame.proj.near, &lights) {
         stats.warnings.push(
@@ -360,9 +394,14 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
                 .into(),
         );
     }
+    let dumps = if frame.dump_buffers {
+        vec![li_dump(frame, &s, &tiles, &li, clamped, "Paper I §4")]
+    } else {
+        vec![]
+    };
     Ok(MethodOutput {
         visibility,
-        raw_images: vec![],
+        dumps,
         stats,
     })
 }

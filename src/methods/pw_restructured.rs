@@ -60,13 +60,17 @@
 //! * z-pass or z-fail: `mode = auto` picks z-fail when [`crate::plan::eye_in_shadow`] finds the
 //!   near plane in the shadow of a point of the light.
 //!
+//! Buffer dump (`--dump-buffers`): `li`, as `pw2002`'s
+//! ([`super::pw2002::li_dump`]).
+//!
 //! Options ([`PwRestructuredOptions`]): those of `pw2002` except `side-planes` (an error here: the restructured
 //! algorithm never visits side planes, it is the `cancel` form by construction) plus `passes = single|three`, `culling = zmin-zmax|zmax|off`,
 //! `mode = auto|zpass|zfail`.
 
 use super::output::{MethodOutput, PassStats};
 use super::pw2002::{
-    frame_wedges, li_buffer_plan, li_row_major, resolve, MultiLight, WedgeKeys, WedgeSettings,
+    frame_wedges, li_buffer_plan, li_dump, li_row_major, resolve, MultiLight, WedgeKeys,
+    WedgeSettings,
 };
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame};
@@ -423,7 +427,7 @@ pub fn render_li(
     };
     let tiling = &frame.tiling;
     let mut tiles = alloc_tiles(tiling, |_, len| RTile {
-        li: LiTile::cleared(s.wedge.li, s.wedge.overflow, len),
+        li: LiTile::cleared(s.wedge.li, s.wedge.overflow, len).recording(frame.dump_buffers),
         memo: (0, false, false),
     });
     let mut stats = Vec::new();
@@ -554,10 +558,22 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     all.extend(passes);
     let (visibility, clamped) = resolve(frame, &li);
     let mut stats = super::method_stats("pw-restructured", frame, start, &plan, all);
-    stats.clamped_pixels = clamped;
+    stats.clamped_pixels = clamped.iter().filter(|&&c| c).count() as u64;
+    let dumps = if frame.dump_buffers {
+        vec![li_dump(
+            frame,
+            &s.wedge,
+            &tiles,
+            &li,
+            clamped,
+            "Paper II §3, §6",
+        )]
+    } else {
+        vec![]
+    };
     Ok(MethodOutput {
         visibility,
-        raw_images: vec![],
+        dumps,
         stats,
     })
 }

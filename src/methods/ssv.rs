@@ -46,7 +46,14 @@
 //!   (the 4D texture of §3.3 is indexed by the edge clipped to the rectangle).
 //! * Final visibility: the resolved V-buffer clamped to [0, 1] (overlapping occluders can
 //!   drive the Green's sum below 0, §5.3 "object overlap artifact"); background pixels are 1.
+//!
+//! Buffer dumps (`--dump-buffers`, [`super::dump`]): `vbuffer`, the V-buffer in its format
+//! before the resolve, with its overflow events (f16: non-finite results; 8-bit: saturated
+//! blends) and the pixels the resolve clamps; with the 8-bit V-buffer also `stencil`, the
+//! umbra counts of pass 1.
 
+use super::dump::{row_major, BufferDump, ElementFormat, EventKind, EventMap, VBufferDump};
+use super::hard_sv::stencil_dump;
 use super::hard_sv::{shadow_test, stencil_row_major, stencil_shadow, ShadowTest, StencilOverflow};
 use super::hard_sv::{StencilShadowSettings, Submission};
 use super::output::{MethodOutput, PassStats, Visibility};
@@ -263,6 +270,8 @@ pub struct SsvRender {
     pub wedges: (usize, usize),
     /// Wall time of pass 1 and of pass 2 (with the resolve), informational.
     pub seconds: [f64; 2],
+    /// The buffers before the resolve, when the frame asks for dumps (module doc).
+    pub dumps: Vec<BufferDump>,
 }
 
 /// Render `ssv` with `settings` on `frame` (the light must be a rectangle or a sphere, with
@@ -276,7 +285,7 @@ pub fn render(frame: &Frame, settings: &SsvSettings) -> SsvRender {
     }
 }
 
-fn render_with<V: VBufferTile>(frame: &Frame, settings: &SsvSettings) -> SsvRender {
+fn render_with<V: VBufferDump>(frame: &Frame, settings: &SsvSettings) -> SsvRender {
     let scene = frame.scene;
     let tiling = &frame.tiling;
     let light = WedgeLight::from_light(scene.light()).expect("ssv supports rects and spheres");
@@ -284,6 +293,10 @@ fn render_with<V: VBufferTile>(frame: &Frame, settings: &SsvSettings) -> SsvRend
     let mut vbuf: Vec<V> = (0..tiling.tile_count())
         .map(|_| V::cleared(tiling.tile_len()))
         .collect();
+    if frame.dump_buffers {
+        vbuf.iter_mut().for_each(V::record_overflows);
+    }
+    let mut dumps = Vec::new();
 
     // Pass 1: hard shadow quads, ±1 (float V-buffers) or the stencil (8-bit version).
     let t1 = Instant::now();
@@ -295,7 +308,19 @@ fn render_with<V: VBufferTile>(frame: &Frame, settings: &SsvSettings) -> SsvRend
             submission: Submission::TwoSided,
         };
         let (tiles, c) = stencil_shadow(frame, center, &s);
-        stencil = Some(stencil_row_major(frame, &tiles));
+        let values = stencil_row_major(frame, &tiles);
+        if frame.dump_buffers {
+            dumps.push(stencil_dump(
+                frame,
+                "stencil",
+                "pass 1 of the 8-bit V-buffer (Paper III §4.2): the stencil counts of the hard \
+                 shadow quads from the light center (wrap); the resolve adds 1 − count",
+                &tiles,
+                values.clone(),
+                EventKind::Wrap,
+            ));
+        }
+        stencil = Some(values);
         c
     } else {
         hard_quads_pass(frame, settings.test, &mut vbuf)
@@ -383,20 +408,43 @@ fn render_with<V: VBufferTile>(frame: &Frame, settings: &SsvSettings) -> SsvRend
         .flat_map(|t| (0..tiling.tile_len()).map(move |i| t.resolve(i)))
         .collect();
     let values = tiling.to_row_major(&flat);
-    let mut clamped_pixels = 0;
+    let mut clamped = vec![false; values.len()];
     let rgb: Vec<[f32; 3]> = values
         .iter()
+        .zip(&mut clamped)
         .enumerate()
-        .map(|(i, v)| {
+        .map(|(i, (v, c))| {
             if receivers[i].is_none() {
                 return [1.0; 3];
             }
             let umbra = stencil.as_ref().map_or(0.0, |s| 1.0 - s[i] as f32);
             let unclamped = v.map(|x| x + umbra);
-            clamped_pixels += unclamped.iter().any(|x| !(0.0..=1.0).contains(x)) as u64;
+            *c = unclamped.iter().any(|x| !(0.0..=1.0).contains(x));
             unclamped.map(|x| x.clamp(0.0, 1.0))
         })
         .collect();
+    let clamped_pixels = clamped.iter().filter(|&&c| c).count() as u64;
+    if frame.dump_buffers {
+        let overflows = || row_major(tiling, &vbuf, |t| t.overflows());
+        let events = match V::FORMAT {
+            VBufferFormat::F16 => EventMap::new(EventKind::NonFinite, overflows(), clamped),
+            VBufferFormat::Split8 => EventMap::new(EventKind::Saturate, overflows(), clamped),
+            _ => EventMap::clamps(clamped),
+        };
+        dumps.push(
+            BufferDump::new(
+                "vbuffer",
+                "the V-buffer before the resolve (Paper III §3.2, §4): cleared to 1, the hard \
+                 quads' ±1 (pass 1, float formats) and the wedges' signed coverages (pass 2) \
+                 added; visibility = clamp(V, 0, 1), for the 8-bit version (R − G)/63 + 1 − \
+                 stencil",
+                (scene.width, scene.height),
+                ElementFormat::VBuffer(V::FORMAT),
+                V::dump_values(tiling, &vbuf),
+            )
+            .with_events(events),
+        );
+    }
     let visibility = if V::FORMAT == VBufferFormat::RgbF32 {
         Visibility::Rgb(rgb)
     } else {
@@ -409,6 +457,7 @@ fn render_with<V: VBufferTile>(frame: &Frame, settings: &SsvSettings) -> SsvRend
         pass2,
         wedges: (edges.len(), full_screen),
         seconds: [pass1_seconds, t2.elapsed().as_secs_f64()],
+        dumps,
     }
 }
 
@@ -515,7 +564,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     stats.clamped_pixels = r.clamped_pixels;
     Ok(MethodOutput {
         visibility: r.visibility,
-        raw_images: vec![],
+        dumps: r.dumps,
         stats,
     })
 }

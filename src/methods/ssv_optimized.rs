@@ -69,7 +69,16 @@
 //!   paper's 16-bit float position texture.
 //! - The overlap approximation renders each loop's quads z-pass (per-loop caps do not exist);
 //!   it is refused when the eye is in shadow. Light splitting is for rectangular lights only.
+//!
+//! Buffer dumps (`--dump-buffers`, [`super::dump`]): `vbuffer-add` and `vbuffer-sub`, the two
+//! RGBA8 split buffers before the resolve (carry bits included), each with its saturated
+//! channels per pixel and the receiver pixels whose resolved value the clamp changed; one
+//! pair per rendered group, named `-loop<l>` with `overlap = loops` and `-piece<k>` with
+//! `light_split` > 1. The stencil only marks wedge halves and is not dumped.
 
+use super::dump::{
+    receiver_pixels, row_major, BufferDump, DumpValues, ElementFormat, EventKind, EventMap,
+};
 use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, BACKGROUND};
@@ -453,9 +462,13 @@ fn silhouettes(frame: &Frame, c: Vec3) -> Result<Vec<Vec<[DVec3; 2]>>, InputErro
     Ok(loops)
 }
 
+/// What one group rendered: the resolved, clamped visibility per pixel (row-major), the
+/// counters, per pixel whether the clamp changed the value, and its buffer dumps (when the
+/// frame asks for them).
+type GroupResult = (Vec<f32>, Counters, Vec<bool>, Vec<BufferDump>);
+
 /// Render one group (pass 1 quads + the wedges of `edges`) for light piece `light` into a
-/// fresh split V-buffer; returns the resolved, clamped visibility per pixel (row-major), the
-/// counters and per pixel whether the clamp changed the value.
+/// fresh split V-buffer ([`GroupResult`]).
 fn render_group(
     frame: &Frame,
     light: &LightModel,
@@ -463,13 +476,13 @@ fn render_group(
     edges: &[[DVec3; 2]],
     s: &Settings,
     receivers: &[Vec<Option<DVec3>>],
-) -> (Vec<f32>, Counters, Vec<bool>) {
+) -> GroupResult {
     let tiling = &frame.tiling;
     let format = s.format;
     let table = SplitTable::get(format);
     let full = format.split(format.full());
     let mut tiles = alloc_tiles(tiling, |_, len| OptTile {
-        v: SplitVTile::cleared(full, len),
+        v: SplitVTile::cleared(full, len).recording(frame.dump_buffers),
         stencil: StencilTile::cleared(0, len),
     });
     let (lo, hi) = wedge_clip_box(frame.scene);
@@ -649,9 +662,57 @@ fn render_group(
         .flat_map(|t| (0..t.v.add.len()).map(|i| t.v.resolve(format, i)))
         .collect();
     let values = tiling.to_row_major(&flat);
-    let clamped = values.iter().map(|v| !(0.0..=1.0).contains(v)).collect();
+    let clamped: Vec<bool> = values.iter().map(|v| !(0.0..=1.0).contains(v)).collect();
     let vis = values.iter().map(|v| v.clamp(0.0, 1.0) as f32).collect();
-    (vis, counters, clamped)
+    let dumps = if frame.dump_buffers {
+        split_dumps(frame, s, &tiles, &clamped)
+    } else {
+        Vec::new()
+    };
+    (vis, counters, clamped, dumps)
+}
+
+/// The dumps of a group's two split buffers (module doc): the raw RGBA8 pixels, the
+/// saturated channels, and the receiver pixels among `clamped`.
+fn split_dumps(
+    frame: &Frame,
+    s: &Settings,
+    tiles: &[OptTile],
+    clamped: &[bool],
+) -> Vec<BufferDump> {
+    let tiling = &frame.tiling;
+    let clamped: Vec<bool> = clamped
+        .iter()
+        .zip(receiver_pixels(frame))
+        .map(|(c, r)| *c && r)
+        .collect();
+    [
+        ("vbuffer-add", 0, "additive"),
+        ("vbuffer-sub", 1, "subtractive"),
+    ]
+    .into_iter()
+    .map(|(name, k, which)| {
+        let pixels = row_major(tiling, tiles, |t| if k == 0 { &t.v.add } else { &t.v.sub });
+        BufferDump::new(
+            name,
+            &format!(
+                "the {which} RGBA8 buffer of the split V-buffer (Paper IV §4.3): the value \
+                     over R, G, B, A, {} carry bits per channel, blended with saturation; \
+                     visibility = clamp((add − sub)/{}, 0, 1)",
+                s.format.reserved_bits,
+                s.format.full()
+            ),
+            (frame.scene.width, frame.scene.height),
+            ElementFormat::SplitRgba8(s.format),
+            DumpValues::U8(pixels.concat()),
+        )
+        .with_events(EventMap::new(
+            EventKind::Saturate,
+            row_major(tiling, tiles, |t| &t.v.saturations[k]),
+            clamped.clone(),
+        ))
+    })
+    .collect()
 }
 
 /// The plane-equation split (§4.4's first approach): the sign of the hard-quad plane equation
@@ -690,13 +751,13 @@ fn receiver_tiles(frame: &Frame) -> Vec<Vec<Option<DVec3>>> {
 }
 
 /// The visibility of one light piece (row-major, clamped) with the settings' overlap mode, the
-/// counters, and per pixel whether a clamp changed a value.
+/// counters, per pixel whether a clamp changed a value, and the buffer dumps of its groups.
 fn piece_visibility(
     frame: &Frame,
     light: &LightModel,
     s: &Settings,
     receivers: &[Vec<Option<DVec3>>],
-) -> Result<(Vec<f32>, Counters, Vec<bool>), InputError> {
+) -> Result<GroupResult, InputError> {
     let c = light.center().as_vec3();
     let loops = silhouettes(frame, c)?;
     if !s.overlap {
@@ -714,12 +775,18 @@ fn piece_visibility(
     let mut covered = vec![0.0f32; frame.pixel_count()];
     let mut clamped = vec![false; frame.pixel_count()];
     let mut counters = Counters::default();
-    for l in &loops {
+    let mut dumps = Vec::new();
+    for (k, l) in loops.iter().enumerate() {
         let quads: Vec<[ClipVertex; 3]> = l
             .iter()
             .flat_map(|e| silhouette_quad(&frame.proj, c, e[0].as_vec3(), e[1].as_vec3()))
             .collect();
-        let (v, cnt, cl) = render_group(frame, light, quads, l, s, receivers);
+        let (v, cnt, cl, group_dumps) = render_group(frame, light, quads, l, s, receivers);
+        dumps.extend(group_dumps.into_iter().map(|mut d| {
+            d.name = format!("{}-loop{k}", d.name);
+            d.about = format!("silhouette loop {k} alone (§5.1): {}", d.about);
+            d
+        }));
         counters += cnt;
         for (acc, v) in covered.iter_mut().zip(&v) {
             *acc = overlap_combine(*acc, 1.0 - v);
@@ -735,6 +802,7 @@ fn piece_visibility(
         covered.iter().map(|c| 1.0 - c.min(1.0)).collect(),
         counters,
         clamped,
+        dumps,
     ))
 }
 
@@ -757,8 +825,16 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let mut sum = vec![0.0f32; frame.pixel_count()];
     let mut clamped = vec![false; frame.pixel_count()];
     let mut counters = Counters::default();
-    for piece in &pieces {
-        let (v, c, cl) = piece_visibility(frame, piece, &s, &receivers)?;
+    let mut dumps = Vec::new();
+    for (k, piece) in pieces.iter().enumerate() {
+        let (v, c, cl, piece_dumps) = piece_visibility(frame, piece, &s, &receivers)?;
+        dumps.extend(piece_dumps.into_iter().map(|mut d| {
+            if pieces.len() > 1 {
+                d.name = format!("{}-piece{k}", d.name);
+                d.about = format!("light piece {k} alone (§5.2): {}", d.about);
+            }
+            d
+        }));
         counters += c;
         for (acc, v) in sum.iter_mut().zip(&v) {
             *acc += v;
@@ -813,7 +889,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         .count() as u64;
     Ok(MethodOutput {
         visibility: Visibility::Gray(vis),
-        raw_images: vec![],
+        dumps,
         stats,
     })
 }

@@ -9,7 +9,7 @@
 //! | `visibility.png` | 16-bit PNG, `round(v·65535)`: grayscale for [`Visibility::Gray`], RGB for [`Visibility::Rgb`] |
 //! | `visibility.exr` | OpenEXR, RGB f32 (gray replicated into the three channels) |
 //! | `visibility.pfm` | PFM with the exact f32 bits (`Pf` gray / `PF` RGB) — what goldens compare |
-//! | `<name>.png` | each [`RawImage8`] (e.g. `hard-sv`'s `stencil.png`), 8-bit grayscale, values as stored |
+//! | `<name>.png`, `<name>.bin`, … | each buffer dump ([`dump`]): in every run the raw file of the dumps a method always hands back (`hard-sv`'s `stencil.png`, `wedge-blending`'s `penumbrae.png`, 8-bit grayscale, values as stored); with `--dump-buffers` every dump with its sidecar, viewable image and event map |
 //! | `error.png` | when the reference ran: the signed error against it, on the fixed scale of [`error_colour`](crate::metrics::error_report::error_colour) (white 0, red too bright, blue too dark) |
 //! | `stats.json` | [`MethodStats`](crate::methods::output::MethodStats) as pretty-printed JSON, plus `"error"`: the [`ErrorReport`] against the reference (whole image and penumbra only), or null with `"error_note"` when no reference ran; the reference itself has `"reference_noise_floor"` |
 //!
@@ -21,7 +21,9 @@
 //!
 //! All images are row-major with row 0 at the top, like [`Visibility`].
 
-use crate::methods::output::{MethodOutput, RawImage8, Visibility};
+pub mod dump;
+
+use crate::methods::output::{MethodOutput, Visibility};
 use crate::metrics::error_report::ErrorReport;
 use crate::metrics::ErrorStats;
 use image::codecs::openexr::OpenExrEncoder;
@@ -488,8 +490,9 @@ pub fn write_method_dirs(
 }
 
 /// Encodes every output file of one method in memory: `(file name, bytes)` in a fixed order
-/// (see the module table). Nothing is written; errors (wrong buffer sizes, a raw image name
-/// that is not a plain file stem or collides with a standard output) come out here.
+/// (see the module table); each buffer dump's raw file, and with `dump_buffers` every file of
+/// every dump ([`dump::dump_files`]). Nothing is written; errors (wrong buffer sizes, a dump
+/// name that is not a plain file stem or collides with another output) come out here.
 /// `stats.json` names `scene` (the built-in name or the scene file) and this program's version;
 /// the options in force are its plan's `settings`.
 pub fn encode_method_outputs(
@@ -498,6 +501,7 @@ pub fn encode_method_outputs(
     (width, height): (u32, u32),
     scene: &str,
     comparison: &Comparison,
+    dump_buffers: bool,
 ) -> io::Result<Vec<(String, Vec<u8>)>> {
     check_len("shaded image", shaded.len(), width, height)?;
     check_len("visibility", out.visibility.len(), width, height)?;
@@ -520,22 +524,16 @@ pub fn encode_method_outputs(
             encode_pfm(&out.visibility, width, height),
         ),
     ];
-    for raw in &out.raw_images {
-        let name = raw_image_file_name(raw)?;
-        if files.iter().any(|(n, _)| *n == name) {
-            return Err(invalid(format!(
-                "raw image {:?} collides with another output file",
-                raw.name
-            )));
+    for d in &out.dumps {
+        for (name, bytes) in dump::dump_files(d, dump_buffers)? {
+            if files.iter().any(|(n, _)| *n == name) || name == "stats.json" {
+                return Err(invalid(format!(
+                    "buffer dump {:?}: {name} collides with another output file",
+                    d.name
+                )));
+            }
+            files.push((name, bytes));
         }
-        check_len(
-            &format!("raw image {:?}", raw.name),
-            raw.values.len(),
-            width,
-            height,
-        )?;
-        let png = encode_gray8_png(&raw.values, width, height)?;
-        files.push((name, png));
     }
     let encoding = |e: serde_json::Error| io::Error::other(format!("encoding stats.json: {e}"));
     let mut stats = serde_json::to_value(&out.stats).map_err(encoding)?;
@@ -588,27 +586,9 @@ pub enum Comparison<'a> {
     },
 }
 
-/// The file name of a raw image, `<name>.png`; the name must be a plain, non-hidden file stem
-/// (ASCII letters, digits, `-`, `_`, not starting with `-`).
-pub fn raw_image_file_name(raw: &RawImage8) -> io::Result<String> {
-    let ok = !raw.name.is_empty()
-        && !raw.name.starts_with('-')
-        && raw
-            .name
-            .bytes()
-            .all(|b| b.is_ascii_alphanumeric() || b == b'-' || b == b'_');
-    if !ok {
-        return Err(invalid(format!(
-            "raw image name {:?} is not a plain file stem",
-            raw.name
-        )));
-    }
-    Ok(format!("{}.png", raw.name))
-}
-
 /// Writes all outputs of one method to `dir/METHOD/` (see the module table): `image.png`
 /// from `shaded` (linear RGB, `width·height` pixels, row 0 at the top), `visibility.png`,
-/// `visibility.exr`, `visibility.pfm`, one `<name>.png` per raw image, and `stats.json`
+/// `visibility.exr`, `visibility.pfm`, the raw file of each buffer dump, and `stats.json`
 /// (without a reference: [`Comparison::NoReference`]).
 ///
 /// The folder appears only once every file was encoded and written ([`write_method_dirs`]).
@@ -626,6 +606,7 @@ pub fn write_method_outputs(
             (width, height),
             scene,
             &Comparison::NoReference,
+            false,
         )
     })
     .map(|_| ())
@@ -695,6 +676,7 @@ pub fn encode_side_by_side_png(w: u32, h: u32, panels: &[Vec<[u8; 3]>]) -> io::R
 mod tests {
     use super::*;
     use crate::gpu::counters::Counters;
+    use crate::methods::dump::{BufferDump, DumpValues, ElementFormat};
     use crate::methods::output::MethodStats;
 
     fn temp_dir(tag: &str) -> PathBuf {
@@ -711,10 +693,16 @@ mod tests {
 
     fn sample_output(vis: Visibility) -> MethodOutput {
         MethodOutput {
-            raw_images: vec![RawImage8 {
-                name: "stencil".into(),
-                values: (0..vis.len() as u32).map(|i| (i * 37) as u8).collect(),
-            }],
+            dumps: vec![BufferDump::new(
+                "stencil",
+                "test",
+                match vis.len() as u32 {
+                    n if n % 3 == 0 => (3, n / 3),
+                    n => (n, 1),
+                },
+                ElementFormat::Stencil8,
+                DumpValues::U8((0..vis.len() as u32).map(|i| (i * 37) as u8).collect()),
+            )],
             visibility: vis,
             stats: MethodStats {
                 method: "hard-sv".into(),
@@ -866,7 +854,7 @@ mod tests {
 
         let (w, h, st) = decode_gray8_png(&std::fs::read(m.join("stencil.png")).unwrap()).unwrap();
         assert_eq!((w, h), (3, 2));
-        assert_eq!(st, out.raw_images[0].values);
+        assert_eq!(DumpValues::U8(st), out.dumps[0].values);
 
         let json: serde_json::Value =
             serde_json::from_slice(&std::fs::read(m.join("stats.json")).unwrap()).unwrap();
@@ -881,7 +869,7 @@ mod tests {
         let dir = temp_dir("rgb");
         let vis = Visibility::Rgb(vec![[0.0, 0.5, 1.0], [1.0, 0.0, 0.25]]);
         let mut out = sample_output(vis.clone());
-        out.raw_images.clear();
+        out.dumps.clear();
         write_method_outputs(&dir, ("test", "ssv"), &out, &[[0.0; 3]; 2], (2, 1)).unwrap();
         let m = dir.join("ssv");
         let image::DynamicImage::ImageRgb16(v16) = image::open(m.join("visibility.png")).unwrap()
@@ -901,8 +889,8 @@ mod tests {
     fn bad_sizes_write_nothing() {
         let dir = temp_dir("bad");
         let mut out = sample_output(Visibility::Gray(vec![0.0; 6]));
-        // Raw image of the wrong size: encoding fails before any file exists.
-        out.raw_images[0].values.pop();
+        // A dump of the wrong size: encoding fails before any file exists.
+        out.dumps[0].values = DumpValues::U8(vec![0; 5]);
         let err = write_method_outputs(&dir, ("test", "hard-sv"), &out, &[[0.0; 3]; 6], (3, 2))
             .unwrap_err();
         assert!(err.to_string().contains("stencil"), "{err}");
@@ -915,11 +903,11 @@ mod tests {
             write_method_outputs(&dir, ("test", "../x"), &out, &[[0.0; 3]; 6], (3, 2)).is_err()
         );
         let mut out2 = out.clone();
-        out2.raw_images[0].name = "../evil".into();
+        out2.dumps[0].name = "../evil".into();
         assert!(
             write_method_outputs(&dir, ("test", "hard-sv"), &out2, &[[0.0; 3]; 6], (3, 2)).is_err()
         );
-        out2.raw_images[0].name = "visibility".into();
+        out2.dumps[0].name = "visibility".into();
         assert!(
             write_method_outputs(&dir, ("test", "hard-sv"), &out2, &[[0.0; 3]; 6], (3, 2)).is_err()
         );
@@ -936,6 +924,7 @@ mod tests {
                 (3, 2),
                 "test",
                 &Comparison::NoReference,
+                false,
             )
         };
         // A new output directory: not created at all.

@@ -1,12 +1,15 @@
 //! The image grid of a scene: the reference and every method's shaded image, captioned with
 //! the method, its paper, its time and its error, each linking to its error map; under each,
-//! links to every other file the method wrote, its raw buffers in bold. A checkbox swaps the
-//! shaded images for the error maps (CSS only).
+//! links to every other file the method wrote, then its buffer dumps in bold, each linking
+//! to its viewable image where it was written (`--dump-buffers`) or else its raw file, with
+//! its raw values and event map beside it. A checkbox swaps the shaded images for the error
+//! maps (CSS only).
 
 use super::html::Html;
 use super::SceneRuns;
 use crate::metrics::error_report::error_colour;
-use crate::output::{raw_image_file_name, ERROR_FILE as ERROR_MAP, IMAGE_FILE as IMAGE};
+use crate::output::dump::{events_view_file_name, raw_file_name, view_file_name};
+use crate::output::{ERROR_FILE as ERROR_MAP, IMAGE_FILE as IMAGE};
 use crate::render::table_rows;
 
 /// A CSS colour of [`error_colour`].
@@ -96,27 +99,71 @@ pub fn grid(h: &mut Html, s: &SceneRuns, index: usize) {
         };
         h.text(&format!("{:.3} s{error}", row.seconds()));
         h.void("br", &[]);
-        let buffers: Vec<String> = run
+        let dump_prefixes: Vec<String> = run
             .output
-            .raw_images
+            .dumps
             .iter()
-            .filter_map(|r| raw_image_file_name(r).ok())
+            .map(|d| format!("{}.", d.name))
             .collect();
+        let of_a_dump = |f: &str| dump_prefixes.iter().any(|p| f.starts_with(p.as_str()));
         h.open("span", &[("class", "files")]);
-        for file in files.iter().filter(|f| *f != IMAGE) {
-            let class = if buffers.contains(file) {
-                "buffer"
-            } else {
-                "file"
-            };
+        for file in files.iter().filter(|f| *f != IMAGE && !of_a_dump(f)) {
             h.element(
                 "a",
-                &[("href", &s.link(method, file)), ("class", class)],
+                &[("href", &s.link(method, file)), ("class", "file")],
                 file,
             );
             h.text(" ");
         }
         h.close();
+        let written = |f: &String| files.contains(f);
+        let dumps: Vec<_> = run
+            .output
+            .dumps
+            .iter()
+            .filter_map(|d| Some((d, raw_file_name(d).ok().filter(written)?)))
+            .collect();
+        if !dumps.is_empty() {
+            h.open("span", &[("class", "files buffers")]);
+            h.text("buffers: ");
+            for (d, raw) in dumps {
+                let view = Some(view_file_name(d)).filter(written);
+                let main = view.as_ref().unwrap_or(&raw);
+                let title = format!(
+                    "{} ({}×{}): {}",
+                    d.format.name(),
+                    d.width,
+                    d.height,
+                    d.about
+                );
+                h.element(
+                    "a",
+                    &[
+                        ("href", &s.link(method, main)),
+                        ("class", "buffer"),
+                        ("title", &title),
+                    ],
+                    &d.name,
+                );
+                if view.is_some() {
+                    h.text(" (");
+                    h.element("a", &[("href", &s.link(method, &raw))], "raw");
+                    let json = format!("{}.json", d.name);
+                    if written(&json) {
+                        h.text(", ");
+                        h.element("a", &[("href", &s.link(method, &json))], "json");
+                    }
+                    let events = events_view_file_name(d);
+                    if written(&events) {
+                        h.text(", ");
+                        h.element("a", &[("href", &s.link(method, &events))], "events");
+                    }
+                    h.text(")");
+                }
+                h.text(" ");
+            }
+            h.close();
+        }
         h.close();
         h.close();
     }

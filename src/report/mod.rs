@@ -69,6 +69,7 @@ figcaption { font-size: 12px; margin-top: 4px; }
 figcaption .paper { color: #666; display: block; }
 figcaption .files a { margin-right: .5em; }
 figcaption .files a.buffer { font-weight: bold; }
+figcaption .buffers { display: block; }
 img.err { display: none; }
 .toggle:checked ~ .grid img.swap { display: none; }
 .toggle:checked ~ .grid img.err { display: block; }

@@ -89,12 +89,24 @@
 //!   there: where two or more overlap is where the blending matters.
 //! * Receiver points are the depth-buffer points (f32), as `ssv`'s, so that one silhouette
 //!   gives `ssv`'s result and the error against `raycast` is the method's own.
+//!
+//! Buffer dumps ([`super::dump`]): `penumbrae` (always, `penumbrae.png`); with
+//! `--dump-buffers` the final vBuffer before the resolve — packed: `final-rects` and
+//! `final-occlusion`, the raw `PK4UB` words of its two RGBA32F targets; unpacked:
+//! `final-parts` ([`VBufferStorage::final_dumps`]) — whose last dump carries the event map of
+//! the blend pass's writes (per pixel: `PK4UB` clamps, special float patterns among the
+//! pixel's words) and the pixels the final clamp changed; and `stencil-sum`, per pixel the sum
+//! over the silhouettes of the signed stencil count the initialization read (the stencil is
+//! cleared after each silhouette, so no single state of it is left), with the stencil's wraps
+//! over all silhouettes. The silhouette vBuffer is cleared after each silhouette and is not
+//! dumped.
 
 pub mod blend;
 pub mod vbuffer;
 
+use super::dump::{row_major, BufferDump, DumpValues, ElementFormat, EventKind, EventMap};
 use super::hard_sv::{shadow_test, volume_stencil_state, ShadowTest, StencilOverflow};
-use super::output::{MethodOutput, PassStats, RawImage8, Visibility};
+use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, FULL_SCREEN};
 use crate::geometry::loops::silhouette_loops;
@@ -103,7 +115,7 @@ use crate::geometry::silhouette::{light_facing, possible_silhouettes};
 use crate::geometry::tight_wedge::{
     bounding_planes, quad_inner_halfspace, wedge_clip_box, wedge_halves_and_planes,
 };
-use crate::gpu::buffers::{alloc_tiles, StencilTile};
+use crate::gpu::buffers::{alloc_tiles, overflow_record, record_overflow, StencilTile};
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::pack4ub::{FloatTarget, StoreEvents};
@@ -393,6 +405,8 @@ pub struct BlendingRender {
     pub counters: BlendingCounters,
     /// The blend steps at the probed pixel ([`render_probed`]), in blending order.
     pub trace: Vec<ProbeStep>,
+    /// The buffer dumps of `--dump-buffers` (module doc), empty otherwise.
+    pub dumps: Vec<BufferDump>,
 }
 
 /// One silhouette blended at a probed pixel: the values the blend pass read and wrote there.
@@ -422,6 +436,11 @@ struct BlendTile<P> {
     /// Whether the current silhouette reached the tile.
     dirty: bool,
     counters: BlendingCounters,
+    /// For a dump: per sample the sum of the stencil counts the initialization read, and the
+    /// `PK4UB` clamps and special float patterns of the final vBuffer's writes (empty
+    /// otherwise, [`overflow_record`]).
+    stencil_sum: Vec<i32>,
+    final_events: [Vec<u32>; 2],
 }
 
 /// One half-wedge to draw.
@@ -608,14 +627,17 @@ fn render_with<S: VBufferStorage>(
     let eye_radius = frame.near_plane_radius();
     let (sil_bytes, fin_bytes) = (storage.silhouette_bytes(), storage.final_bytes());
     let cleared = storage.cleared();
+    let dumping = frame.dump_buffers;
     let mut tiles = alloc_tiles(tiling, |_, len| BlendTile {
         trace: Vec::new(),
-        stencil: StencilTile::cleared(0, len),
+        stencil: StencilTile::cleared(0, len).recording(dumping),
         silhouette: vec![cleared; len],
         last: vec![cleared; len],
         penumbrae: vec![0; len],
         dirty: false,
         counters: BlendingCounters::default(),
+        stencil_sum: if dumping { vec![0; len] } else { Vec::new() },
+        final_events: [overflow_record(dumping, len), overflow_record(dumping, len)],
     });
     let mut passes = [(Counters::default(), 0.0f64); 5];
     let mut counters = BlendingCounters::default();
@@ -658,6 +680,9 @@ fn render_with<S: VBufferStorage>(
             tile_pixels(tiling, t, |i, _| {
                 cnt.stencil_read_bytes += 1;
                 let count = tile.stencil.values[i] as i8 as i32;
+                if let Some(sum) = tile.stencil_sum.get_mut(i) {
+                    *sum += count;
+                }
                 if count != 0 {
                     let (px, clamps) = storage.store(
                         &[PartState::hard(count); PART_COUNT],
@@ -849,7 +874,12 @@ fn render_with<S: VBufferStorage>(
                         BlendCase::Accumulated => k.parts_accumulated += 1,
                     }
                 }
+                let special = |e: &StoreEvents| e.denormal + e.nan + e.infinite;
+                let before_store = special(&tile.counters.stores);
                 let (px, clamps) = storage.store(&fp, &mut tile.counters.stores);
+                let specials = special(&tile.counters.stores) - before_store;
+                record_overflow(&mut tile.final_events[0], i, clamps as u32);
+                record_overflow(&mut tile.final_events[1], i, specials as u32);
                 tile.last[i] = px;
                 if probe == Some(g) {
                     tile.trace.push(ProbeStep {
@@ -897,12 +927,18 @@ fn render_with<S: VBufferStorage>(
         });
     }
     let visibility: Vec<f32> = unclamped.iter().map(|v| v.clamp(0.0, 1.0)).collect();
-    counters.clamped_pixels = unclamped
+    let clamped: Vec<bool> = unclamped
         .iter()
         .zip(&visibility)
-        .filter(|(u, v)| u != v)
-        .count() as u64;
+        .map(|(u, v)| u != v)
+        .collect();
+    counters.clamped_pixels = clamped.iter().filter(|&&c| c).count() as u64;
     passes[4] = (resolve, t0.elapsed().as_secs_f64());
+    let dumps = if dumping {
+        blending_dumps(frame, storage, &tiles, clamped)
+    } else {
+        Vec::new()
+    };
     BlendingRender {
         visibility,
         unclamped,
@@ -910,7 +946,59 @@ fn render_with<S: VBufferStorage>(
         passes,
         counters,
         trace,
+        dumps,
     }
+}
+
+/// The dumps of `--dump-buffers` (module doc) from the tiles after the resolve.
+fn blending_dumps<S: VBufferStorage>(
+    frame: &Frame,
+    storage: &S,
+    tiles: &[BlendTile<S::Pixel>],
+    clamped: Vec<bool>,
+) -> Vec<BufferDump> {
+    let tiling = &frame.tiling;
+    let size = (frame.scene.width, frame.scene.height);
+    let n = frame.pixel_count();
+    let mut last = vec![storage.cleared(); n];
+    let mut sums = vec![0i32; n];
+    let mut events = [vec![0u32; n], vec![0u32; n]];
+    for (t, tile) in tiles.iter().enumerate() {
+        tile_pixels(tiling, t, |i, g| {
+            last[g] = tile.last[i];
+            sums[g] = tile.stencil_sum[i];
+            for (e, record) in events.iter_mut().zip(&tile.final_events) {
+                e[g] = record[i];
+            }
+        });
+    }
+    let mut dumps = storage.final_dumps(&last, size);
+    let [clamps, specials] = events;
+    if let Some(d) = dumps.pop() {
+        dumps.push(d.with_events(EventMap {
+            overflows: vec![
+                (EventKind::Saturate, clamps),
+                (EventKind::SpecialFloat, specials),
+            ],
+            clamped,
+        }));
+    }
+    let stencil = BufferDump::new(
+        "stencil-sum",
+        "per pixel, the sum over the silhouettes of the signed 8-bit stencil count of each \
+         silhouette's shadow volume as the initialization pass read it (§4.1; the stencil is \
+         cleared after each silhouette)",
+        size,
+        ElementFormat::CountI32,
+        DumpValues::I32(sums),
+    )
+    .with_events(EventMap::new(
+        EventKind::Wrap,
+        row_major(tiling, tiles, |t| &t.stencil.overflows),
+        Vec::new(),
+    ));
+    dumps.push(stencil);
+    dumps
 }
 
 /// Run `wedge-blending` on a rendered frame.
@@ -975,12 +1063,19 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     };
     let mut stats = super::method_stats("wedge-blending", frame, start, &plan, passes);
     stats.clamped_pixels = r.counters.clamped_pixels;
+    let mut dumps = vec![BufferDump::new(
+        "penumbrae",
+        "per pixel, the number of silhouettes whose occlusion (mean over the radial parts) \
+         lies strictly between 0.5/255 and 1 − 0.5/255 there: where two or more overlap, the \
+         blending of Forest et al. §3.2 matters",
+        (frame.scene.width, frame.scene.height),
+        ElementFormat::Count8,
+        DumpValues::U8(r.penumbrae),
+    )];
+    dumps.extend(r.dumps);
     Ok(MethodOutput {
         visibility: Visibility::Gray(r.visibility),
-        raw_images: vec![RawImage8 {
-            name: "penumbrae".into(),
-            values: r.penumbrae,
-        }],
+        dumps,
         stats,
     })
 }

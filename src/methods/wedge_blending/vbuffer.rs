@@ -29,6 +29,7 @@
 use super::blend::PartState;
 use crate::gpu::pack4ub::{pk4ub, up4ub, FloatTarget, StoreEvents};
 use crate::light::radial_parts::{BoundingRect, PART_COUNT};
+use crate::methods::dump::{BufferDump, DumpValues, ElementFormat};
 
 /// The four parts of one pixel.
 pub type PixelParts = [PartState; PART_COUNT];
@@ -50,6 +51,9 @@ pub trait VBufferStorage: Sync {
     fn final_bytes(&self) -> u64;
     /// The format, for the plan.
     fn describe(&self) -> String;
+    /// The final vBuffer's `pixels` (row-major, `size`) as buffer dumps, the one holding the
+    /// occlusion last (`crate::methods::dump`, `--dump-buffers`).
+    fn final_dumps(&self, pixels: &[Self::Pixel], size: (u32, u32)) -> Vec<BufferDump>;
 }
 
 /// The paper's packed 8-bit storage (module doc).
@@ -152,6 +156,39 @@ impl VBufferStorage for Packed8 {
         self.silhouette_bytes()
     }
 
+    fn final_dumps(&self, pixels: &[Self::Pixel], size: (u32, u32)) -> Vec<BufferDump> {
+        let target = |k: usize| -> Vec<u32> {
+            pixels
+                .iter()
+                .flat_map(|p| p[k * PART_COUNT..(k + 1) * PART_COUNT].iter().copied())
+                .collect()
+        };
+        let about = |what: &str| {
+            format!(
+                "render target {what} of the final vBuffer (Forest et al. 2006 §4.3, Fig. 11): \
+                 per radial part (channels x, y, z, w) the raw bits of a PK4UB word as the \
+                 RGBA32F target ({:?}) stored it",
+                self.target
+            )
+        };
+        vec![
+            BufferDump::new(
+                "final-rects",
+                &about("0, the bounding rectangles PK4UB(top, bottom, left, right)"),
+                size,
+                ElementFormat::Pk4ubRects,
+                DumpValues::U32(target(0)),
+            ),
+            BufferDump::new(
+                "final-occlusion",
+                &about("1, PK4UB(occlusion, max X, max Y, centroid index or 0)"),
+                size,
+                ElementFormat::Pk4ubOcclusion,
+                DumpValues::U32(target(1)),
+            ),
+        ]
+    }
+
     fn describe(&self) -> String {
         format!(
             "2×RGBA32F, per part PK4UB(top, bottom, left, right) + PK4UB(occlusion, max X, max Y, {}), target {:?}",
@@ -189,6 +226,26 @@ impl VBufferStorage for UnpackedF32 {
 
     fn final_bytes(&self) -> u64 {
         PART_COUNT as u64 * self.values_per_part() * 4
+    }
+
+    fn final_dumps(&self, pixels: &[Self::Pixel], size: (u32, u32)) -> Vec<BufferDump> {
+        let values = pixels
+            .iter()
+            .flat_map(|parts| {
+                parts.iter().flat_map(|p| {
+                    let r = p.rect;
+                    [p.occlusion, r.left, r.bottom, r.right, r.top]
+                })
+            })
+            .collect();
+        vec![BufferDump::new(
+            "final-parts",
+            "the final vBuffer unpacked (packing = f32; Forest et al. 2006 §3.2, §4.3): per \
+             radial part its occlusion and bounding rectangle (left, bottom, right, top)",
+            size,
+            ElementFormat::PartsF32,
+            DumpValues::F32(values),
+        )]
     }
 
     fn describe(&self) -> String {
