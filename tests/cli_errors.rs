@@ -691,7 +691,7 @@ fn dump_buffers_where_it_cannot_act_and_with_bad_input() {
     assert_bad_input(
         "--dump-buffers with a bad option",
         &bad,
-        "single-quad",
+        "--opt ssv.vbuffer=f64",
         &["vbuffer"],
     );
 }
