@@ -336,10 +336,11 @@ pub const MIN_CANDIDATE_SINE: f64 = 1e-6;
 /// the pyramids, [`hull_halfspaces`]). May be fewer than needed to bound the wedge when the
 /// edge crosses the light (the wedge is then everything on one side, §4.1). Candidate planes
 /// that rounding leaves undetermined are left out — spanned by nearly parallel generators
-/// (sine below `MIN_CANDIDATE_SINE`, 10⁻⁶), or with every generator within the relative 10⁻⁹
+/// (sine below `MIN_CANDIDATE_SINE`, 10⁻⁶), with every generator within the relative 10⁻⁹
 /// tolerance of the plane (the edge in the light's plane, or a light too small seen from the
-/// edge) — so the wedge may be larger than the hull but cuts into it by no more than that
-/// tolerance.
+/// edge), or with generators on both sides of it beyond the normal's rounding (a diagonal of
+/// a thin light) — so the wedge may be larger than the hull but cuts into it by no more than
+/// that tolerance.
 pub fn wedge_halfspaces(center: DVec3, corners: &[DVec3], e0: DVec3, e1: DVec3) -> Vec<HalfSpace> {
     hull_halfspaces(center, adjusted_edge(center, e0, e1), [corners, corners])
 }
@@ -400,22 +401,30 @@ pub fn hull_halfspaces(center: DVec3, apex: [DVec3; 2], corners: [&[DVec3]; 2]) 
         // lets near-facets cut into a hull thinner than it (found by fuzzing: two such planes
         // of opposite sides left nothing of the wedge of a light 3·10⁻¹⁰ rad wide).
         let eps = (64.0 * f64::EPSILON * lengths / len).min(1e-9);
+        // Directions on both sides of the plane beyond a few roundings of the normal (not
+        // eps) rule it out: a facet has every generator on one side up to that rounding, while
+        // the plane through an apex and a diagonal of a thin light has the other two corners'
+        // rays on either side by the light's thickness, which can be below eps (found by
+        // fuzzing: a rectangle 6·10⁻⁵ by 1.6·10⁻¹⁰ rad seen from the edge, eps 2.4·10⁻¹⁰; the
+        // two diagonal planes through each apex bounded the wedge to the edge's own length
+        // along the light at every distance). Leaving a plane out only makes the wedge larger.
+        let straddle = (4.0 * f64::EPSILON * lengths / len).min(eps);
         // The generators' signed distances along n, as the range [lo, hi] of the values:
         // the directions' part (the corners' rays over the longest, the center's rays over
-        // their own length) does not depend on the apex, and directions on both sides beyond
-        // eps rule the candidate out for both apexes (then it stops early).
+        // their own length) does not depend on the apex, and directions on both sides rule
+        // the candidate out for both apexes (then it stops early).
         let mut dir_range = (f64::INFINITY, f64::NEG_INFINITY);
         let mut nan = false;
         let corner_values = dirs.iter().map(|d| n.dot(*d) / scale);
         for v in corner_values.chain(center_rays.iter().map(|r| n.dot(*r))) {
             nan |= v.is_nan();
             dir_range = (dir_range.0.min(v), dir_range.1.max(v));
-            if dir_range.0 < -eps && dir_range.1 > eps {
+            if dir_range.0 < -straddle && dir_range.1 > straddle {
                 break;
             }
         }
         // A NaN value satisfies none of the tests below (each needs every value compared true).
-        if nan || (dir_range.0 < -eps && dir_range.1 > eps) {
+        if nan || (dir_range.0 < -straddle && dir_range.1 > straddle) {
             continue;
         }
         for a in apex {
@@ -1056,6 +1065,35 @@ mod tests {
                         h.distance(p)
                     );
                 }
+            }
+        }
+    }
+
+    /// A rectangle 1.7·10⁷ long and 60 thick seen from 2.7·10¹¹ (6·10⁻⁵ by 1.6·10⁻¹⁰ rad; found
+    /// by fuzzing): the planes through an apex and a diagonal of the light have the other two
+    /// corners' rays on either side, but only 1.6·10⁻¹⁰ of their length off, within the facet
+    /// tolerance for normals from rays 6·10⁻⁵ rad apart (2.4·10⁻¹⁰). Kept as facets, the two
+    /// diagonal planes through each apex, each within that tolerance of the penumbra, bounded
+    /// the wedge together to the edge's own x range at every distance, where the penumbra fans
+    /// out along the light's length (3·10⁹ at 10¹⁴). Every point on a ray from a light point
+    /// through the edge must be in the wedge clipped to a box holding them (within 10⁻⁸ of the
+    /// box, the fuzz target's margin).
+    #[test]
+    fn diagonal_planes_of_a_thin_light_are_not_facets() {
+        let c = DVec3::new(0.0, 0.0, 2.7e11);
+        let (u, v) = (DVec3::new(1.5, 21.0, 21.0), DVec3::new(-8.4e6, 0.0, 21.0));
+        let corners = [c - u - v, c + u - v, c + u + v, c - u + v];
+        let (a, b) = (
+            DVec3::new(-0.25, 0.0, -26.5),
+            DVec3::new(-6200.0, -1e-3, 10.0),
+        );
+        let planes = wedge_halfspaces(c, &corners, a, b);
+        let size = 1e15;
+        let whole = polyhedron_from_planes(&planes, DVec3::splat(-size), DVec3::splat(size));
+        for light_point in corners.iter().chain([&c]) {
+            for edge_point in [a, b, (a + b) * 0.5] {
+                let p = edge_point + (edge_point - *light_point) * 400.0;
+                assert!(whole.contains(p, 1e-8 * size), "{p} outside {whole:?}");
             }
         }
     }
