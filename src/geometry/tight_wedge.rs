@@ -332,27 +332,43 @@ pub const MIN_CANDIDATE_SINE: f64 = 1e-6;
 
 /// The facet half-spaces of the convex hull of the two end pyramids of edge `e0 e1` for a
 /// light with the given corners (module doc, "Construction"). `center` is the light center
-/// (for the edge adjustment). May be fewer than needed to bound the wedge when the edge
-/// crosses the light (the wedge is then everything on one side, §4.1). Candidate planes that
-/// rounding leaves undetermined are left out — spanned by nearly parallel generators (sine
-/// below `MIN_CANDIDATE_SINE`, 10⁻⁶), or with every generator within the relative 10⁻⁹
+/// (for the edge adjustment, and a point of the light whose rays through the apexes lie inside
+/// the pyramids, [`hull_halfspaces`]). May be fewer than needed to bound the wedge when the
+/// edge crosses the light (the wedge is then everything on one side, §4.1). Candidate planes
+/// that rounding leaves undetermined are left out — spanned by nearly parallel generators
+/// (sine below `MIN_CANDIDATE_SINE`, 10⁻⁶), with every generator within the relative 10⁻⁹
 /// tolerance of the plane (the edge in the light's plane, or a light too small seen from the
-/// edge) — so the wedge may be larger than the hull but cuts into it by no more than that
-/// tolerance.
+/// edge), or with generators on both sides of it beyond the normal's rounding (a diagonal of
+/// a thin light) — so the wedge may be larger than the hull but cuts into it by no more than
+/// that tolerance.
 pub fn wedge_halfspaces(center: DVec3, corners: &[DVec3], e0: DVec3, e1: DVec3) -> Vec<HalfSpace> {
-    hull_halfspaces(adjusted_edge(center, e0, e1), [corners, corners])
+    hull_halfspaces(center, adjusted_edge(center, e0, e1), [corners, corners])
 }
 
 /// The facet half-spaces of the convex hull of the end pyramids with apexes `apex[i]` over the
 /// corners `corners[i]` (rays `apex[i] + λ(apex[i] − l)`, `l ∈ corners[i]`, `λ ≥ 0`):
 /// [`wedge_halfspaces`] with a corner set per end (a sphere's circumscribed polygons,
 /// [`sphere_wedge_halfspaces`]). The same tolerances apply.
-pub fn hull_halfspaces(apex: [DVec3; 2], corners: [&[DVec3]; 2]) -> Vec<HalfSpace> {
+///
+/// `center` is a point inside the light (its center), so the ray from it through each apex
+/// lies inside that apex's pyramid; a facet must have those rays on its inner side as well as
+/// the corners' rays. The corners' rays alone cannot tell a facet's side when the light is
+/// seen nearly edge-on from both apexes (found by fuzzing: a rectangle 9·10¹² wide, 0.19 below
+/// an edge parallel to it): every corner ray then lies within the tolerance of the plane
+/// parallel to the light through an apex, rising above it by the apex's height over the
+/// corner's distance (2·10⁻¹⁴), and the other apex alone put the plane through the higher one
+/// on the wrong side, cutting the wedge, which holds the whole half-space above the light
+/// there, down to a slab as thick as the apexes' heights differ (1.4·10⁻³), which clipping to
+/// a scene box of 10³⁸ then lost. The center's ray rises by that height over its own length
+/// (10⁻² here), far beyond the tolerance, and rules the plane out.
+pub fn hull_halfspaces(center: DVec3, apex: [DVec3; 2], corners: [&[DVec3]; 2]) -> Vec<HalfSpace> {
     let dirs: Vec<DVec3> = apex
         .iter()
         .zip(corners)
         .flat_map(|(a, ls)| ls.iter().map(move |l| *a - *l))
         .collect();
+    // The rays from the center through the apexes, each measured against its own length.
+    let center_rays = apex.map(|a| (a - center).normalize_or_zero());
     let scale = dirs
         .iter()
         .map(|d| d.length())
@@ -385,21 +401,30 @@ pub fn hull_halfspaces(apex: [DVec3; 2], corners: [&[DVec3]; 2]) -> Vec<HalfSpac
         // lets near-facets cut into a hull thinner than it (found by fuzzing: two such planes
         // of opposite sides left nothing of the wedge of a light 3·10⁻¹⁰ rad wide).
         let eps = (64.0 * f64::EPSILON * lengths / len).min(1e-9);
+        // Directions on both sides of the plane beyond a few roundings of the normal (not
+        // eps) rule it out: a facet has every generator on one side up to that rounding, while
+        // the plane through an apex and a diagonal of a thin light has the other two corners'
+        // rays on either side by the light's thickness, which can be below eps (found by
+        // fuzzing: a rectangle 6·10⁻⁵ by 1.6·10⁻¹⁰ rad seen from the edge, eps 2.4·10⁻¹⁰; the
+        // two diagonal planes through each apex bounded the wedge to the edge's own length
+        // along the light at every distance). Leaving a plane out only makes the wedge larger.
+        let straddle = (4.0 * f64::EPSILON * lengths / len).min(eps);
         // The generators' signed distances along n, as the range [lo, hi] of the values:
-        // the directions' part does not depend on the apex, and directions on both sides
-        // beyond eps rule the candidate out for both apexes (then it stops early).
+        // the directions' part (the corners' rays over the longest, the center's rays over
+        // their own length) does not depend on the apex, and directions on both sides rule
+        // the candidate out for both apexes (then it stops early).
         let mut dir_range = (f64::INFINITY, f64::NEG_INFINITY);
         let mut nan = false;
-        for d in &dirs {
-            let v = n.dot(*d) / scale;
+        let corner_values = dirs.iter().map(|d| n.dot(*d) / scale);
+        for v in corner_values.chain(center_rays.iter().map(|r| n.dot(*r))) {
             nan |= v.is_nan();
             dir_range = (dir_range.0.min(v), dir_range.1.max(v));
-            if dir_range.0 < -eps && dir_range.1 > eps {
+            if dir_range.0 < -straddle && dir_range.1 > straddle {
                 break;
             }
         }
         // A NaN value satisfies none of the tests below (each needs every value compared true).
-        if nan || (dir_range.0 < -eps && dir_range.1 > eps) {
+        if nan || (dir_range.0 < -straddle && dir_range.1 > straddle) {
             continue;
         }
         for a in apex {
@@ -525,7 +550,7 @@ pub fn sphere_wedge_halfspaces(
     let (Some(p0), Some(p1)) = (polygon(apex[0]), polygon(apex[1])) else {
         return Vec::new();
     };
-    let hull = hull_halfspaces(apex, [&p0, &p1]);
+    let hull = hull_halfspaces(center, apex, [&p0, &p1]);
     let paper3 = paper3_halfspaces(&WedgeLight::Sphere { center, radius }, e0, e1);
     if paper3.is_empty() {
         return hull;
@@ -1008,6 +1033,68 @@ mod tests {
                 n_tight <= n_paper3 && n_tight < n_cube,
                 "{n_tight} {n_paper3} {n_cube}"
             );
+        }
+    }
+
+    /// A light 2·10¹³ by 2·10⁹ seen nearly edge-on from an edge 0.19 above it (found by
+    /// fuzzing): its corners' rays rise 10⁻¹⁴ of their length above the light's plane, within
+    /// the facet test's tolerance (10⁻¹⁰ for normals from rays 10⁻⁴ rad apart, across the
+    /// light's short side), but the penumbra fills the half-space above the light there. Every
+    /// point on a ray from a light point through the edge, here the rays from the light's
+    /// middle straight up through the edge and from beside it, must be inside every facet
+    /// (up to the tolerance, 10⁻⁹ of its distance); the plane through the higher apex parallel
+    /// to the light (y ≤ 0.1996) left them outside by their height above it (0.19 at λ = 1).
+    #[test]
+    fn light_seen_edge_on_keeps_the_half_space_above_it() {
+        let c = DVec3::ZERO;
+        let (u, v) = (DVec3::new(1e13, 0.0, 0.0), DVec3::new(0.0, 0.0, 1e9));
+        let corners = [c - u - v, c + u - v, c + u + v, c - u + v];
+        let (a, b) = (DVec3::new(-1.0, 0.19, 0.0), DVec3::new(1.0, 0.2, 0.0));
+        let planes = wedge_halfspaces(c, &corners, a, b);
+        for (edge_point, light_point) in [
+            (DVec3::new(0.0, 0.195, 0.0), c),
+            (a, DVec3::new(-3.0, 0.0, 2.0)),
+            (b, DVec3::new(1e6, 0.0, -1e6)),
+        ] {
+            for lambda in [1.0, 4.0, 1e3] {
+                let p = edge_point + (edge_point - light_point) * lambda;
+                for h in &planes {
+                    assert!(
+                        h.distance(p) <= 1e-9 * p.length(),
+                        "{p} outside {h:?} by {}",
+                        h.distance(p)
+                    );
+                }
+            }
+        }
+    }
+
+    /// A rectangle 1.7·10⁷ long and 60 thick seen from 2.7·10¹¹ (6·10⁻⁵ by 1.6·10⁻¹⁰ rad; found
+    /// by fuzzing): the planes through an apex and a diagonal of the light have the other two
+    /// corners' rays on either side, but only 1.6·10⁻¹⁰ of their length off, within the facet
+    /// tolerance for normals from rays 6·10⁻⁵ rad apart (2.4·10⁻¹⁰). Kept as facets, the two
+    /// diagonal planes through each apex, each within that tolerance of the penumbra, bounded
+    /// the wedge together to the edge's own x range at every distance, where the penumbra fans
+    /// out along the light's length (3·10⁹ at 10¹⁴). Every point on a ray from a light point
+    /// through the edge must be in the wedge clipped to a box holding them (within 10⁻⁸ of the
+    /// box, the fuzz target's margin).
+    #[test]
+    fn diagonal_planes_of_a_thin_light_are_not_facets() {
+        let c = DVec3::new(0.0, 0.0, 2.7e11);
+        let (u, v) = (DVec3::new(1.5, 21.0, 21.0), DVec3::new(-8.4e6, 0.0, 21.0));
+        let corners = [c - u - v, c + u - v, c + u + v, c - u + v];
+        let (a, b) = (
+            DVec3::new(-0.25, 0.0, -26.5),
+            DVec3::new(-6200.0, -1e-3, 10.0),
+        );
+        let planes = wedge_halfspaces(c, &corners, a, b);
+        let size = 1e15;
+        let whole = polyhedron_from_planes(&planes, DVec3::splat(-size), DVec3::splat(size));
+        for light_point in corners.iter().chain([&c]) {
+            for edge_point in [a, b, (a + b) * 0.5] {
+                let p = edge_point + (edge_point - *light_point) * 400.0;
+                assert!(whole.contains(p, 1e-8 * size), "{p} outside {whole:?}");
+            }
         }
     }
 

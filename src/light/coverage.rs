@@ -356,30 +356,53 @@ pub fn clip_to_light_cone(
         let d = e - center;
         DVec3::new(d.dot(x) / radius, d.dot(y) / radius, d.dot(z) / dist)
     };
+    // The edge is parametrized as o + s·d, s ∈ [lo, hi], from o, its point nearest the light
+    // center (found by fuzzing). A point q0 + d·t carries an error of ε·(|q0| + |d·t|) and
+    // the cone's quadratic has coefficients as large as |q0|² and |d|², so the chord, at most
+    // a few radii from the center, was lost to rounding when the parameter started at an end
+    // far from it: from the far end of an edge reaching 10⁶ radii away (coverage 0.261 one
+    // way, 0 the other), and from either end of an edge crossing the cone in the middle of
+    // 2·10⁸ radii. `o` is found from the end nearer the center, with an error of ε times that
+    // end's distance, and the quadratic in s has coefficients |o|² and |d|², whose roots are
+    // as accurate as the chord's own coordinates.
     let (q0, q1) = (to_light(e0), to_light(e1));
-    let d = q1 - q0;
-    let z0 = 1.0 + q0.z;
-    let g = |t: f64| {
-        let q = q0 + d * t;
+    let from_e1 = q1.length_squared() < q0.length_squared();
+    let (near, d) = if from_e1 {
+        (q1, q0 - q1)
+    } else {
+        (q0, q1 - q0)
+    };
+    // NaN for coincident ends: then o is that point (and lo ≤ hi keeps both candidates).
+    let foot = -near.dot(d) / d.length_squared();
+    let foot = if foot.is_nan() {
+        0.0
+    } else {
+        foot.clamp(0.0, 1.0)
+    };
+    let o = near + d * foot;
+    let (lo, hi) = (-foot, 1.0 - foot);
+    let zo = 1.0 + o.z;
+    let g = |s: f64| {
+        let q = o + d * s;
         let zq = 1.0 + q.z;
         q.x * q.x + q.y * q.y - zq * zq
     };
-    // Breakpoints: roots of g (the cone) and of z = 0 and z = 1 (u = −1, u = 0) in (0, 1).
+    // Breakpoints: roots of g (the cone) and of z = 0 and z = 1 (u = −1, u = 0) in (lo, hi).
     let qa = d.x * d.x + d.y * d.y - d.z * d.z;
-    let qb = q0.x * d.x + q0.y * d.y - z0 * d.z;
-    let qc = q0.x * q0.x + q0.y * q0.y - z0 * z0;
-    // At most 6 candidates (0, 1, two cone roots, z = 0, z = 1): a fixed array, since this
+    let qb = o.x * d.x + o.y * d.y - zo * d.z;
+    let qc = o.x * o.x + o.y * o.y - zo * zo;
+    // At most 6 candidates (lo, hi, two cone roots, z = 0, z = 1): a fixed array, since this
     // runs per fragment. NaN candidates fail the range test and are left out.
     let mut buf = [0.0f64; 6];
     let mut len = 0;
-    let mut push = |t: f64| {
-        if (0.0..=1.0).contains(&t) {
-            buf[len] = t;
+    let mut push = |s: f64| {
+        if (lo..=hi).contains(&s) {
+            buf[len] = s;
             len += 1;
         }
     };
-    push(0.0);
-    push(1.0);
+    push(lo);
+    push(hi);
     if qa.abs() > 1e-300 {
         let disc = qb * qb - qa * qc;
         if disc >= 0.0 {
@@ -388,36 +411,41 @@ pub fn clip_to_light_cone(
             if r != 0.0 {
                 push(r / qa);
                 push(qc / r);
+            } else {
+                // qb = 0 and a double root: at s = 0 (the line touches the cone at o).
+                push(0.0);
             }
         }
     } else if qb != 0.0 {
         push(-qc / (2.0 * qb));
     }
     if d.z != 0.0 {
-        push(-z0 / d.z);
-        push(-q0.z / d.z);
+        push(-zo / d.z);
+        push(-o.z / d.z);
     }
-    let ts = &mut buf[..len];
-    ts.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    let ss = &mut buf[..len];
+    ss.sort_by(|a, b| a.partial_cmp(b).unwrap());
     let mut span: Option<(f64, f64)> = None;
-    for k in 0..ts.len() - 1 {
-        let (t0, t1) = (ts[k], ts[k + 1]);
-        let m = 0.5 * (t0 + t1);
-        let um = (q0 + d * m).z;
-        if t1 > t0 && g(m) <= 0.0 && um > -1.0 && um <= 0.0 {
+    for k in 0..ss.len() - 1 {
+        let (s0, s1) = (ss[k], ss[k + 1]);
+        let m = 0.5 * (s0 + s1);
+        let um = (o + d * m).z;
+        if s1 > s0 && g(m) <= 0.0 && um > -1.0 && um <= 0.0 {
             span = Some(match span {
-                None => (t0, t1),
-                Some((s0, _)) => (s0, t1),
+                None => (s0, s1),
+                Some((first, _)) => (first, s1),
             });
         }
     }
-    let (t0, t1) = span?;
-    let project = |t: f64| {
-        let q = q0 + d * t;
+    let (s0, s1) = span?;
+    let project = |s: f64| {
+        let q = o + d * s;
         let zq = 1.0 + q.z;
         DVec2::new(q.x / zq, q.y / zq)
     };
-    let (a, b) = (project(t0), project(t1));
+    // The chord keeps the edge's direction.
+    let (a, b) = (project(s0), project(s1));
+    let (a, b) = if from_e1 { (b, a) } else { (a, b) };
     (a.is_finite() && b.is_finite()).then_some([a, b])
 }
 
@@ -610,6 +638,35 @@ mod tests {
         let (e0, e1) = edge(-1.0);
         assert_eq!(sphere_edge_coverage_exact(DVec3::ZERO, 0.5, p, e0, e1), 0.0);
         assert_eq!(clip_to_light_cone(DVec3::ZERO, 0.5, p, e0, e1), None);
+    }
+
+    /// A sphere of radius 1 at the origin seen from p = (0, 0, −10): an edge along x at
+    /// y = 0.3, z = −5 (half-way) projects onto the chord at 0.6 radii from the center, and the
+    /// region beyond it is (acos 0.6 − 0.6·0.8)/π of the disk whatever the edge's length, since
+    /// its part outside the cone hides nothing. Found by fuzzing: a clip started from an end
+    /// far from the cone lost the chord to rounding (a fuzzed edge reaching 10⁶ radii away got
+    /// coverage 0 one way and 0.261 the other; here one end 10⁶ away was off by 10⁻⁸ and both
+    /// ends 10⁸ away gave 0).
+    #[test]
+    fn sphere_coverage_does_not_depend_on_how_far_the_edge_reaches() {
+        let p = DVec3::new(0.0, 0.0, -10.0);
+        let expected = (libm::acos(0.6f64) - 0.6 * 0.8) / PI;
+        let at = |x: f64| DVec3::new(x, 0.3, -5.0);
+        for (x0, x1) in [
+            (-10.0, 10.0),
+            (-10.0, 1e6),
+            (-10.0, 1e12),
+            (-1e8, 1e8),
+            (-1e12, 1e15),
+        ] {
+            for (e0, e1) in [(at(x0), at(x1)), (at(x1), at(x0))] {
+                let c = sphere_edge_coverage_exact(DVec3::ZERO, 1.0, p, e0, e1);
+                assert!(
+                    (c.abs() - expected).abs() < 1e-12,
+                    "edge {e0} {e1}: {c} vs {expected}"
+                );
+            }
+        }
     }
 
     #[test]
