@@ -10,6 +10,7 @@ use crate::error::InputError;
 use crate::geometry::adjacency::{self, Adjacency};
 use crate::gpu::buffers::{alloc_tiles, DepthTile};
 use crate::gpu::depth::{DepthFormat, DepthState};
+use crate::gpu::probe::{PassProbe, Probe, ProbeEvent, Tap};
 use crate::gpu::raster::{bin, draw, no_tile_culling};
 pub use crate::gpu::setup::setup_all;
 use crate::gpu::setup::CullMode;
@@ -19,7 +20,7 @@ use crate::methods::output::PassStats;
 use crate::scene::{Mesh, Scene};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 /// How far off its triangle's plane a depth-buffer receiver may lie, relative to the scene's
@@ -107,6 +108,8 @@ pub struct Frame<'s> {
     prim_rows: OnceLock<Vec<u32>>,
     /// Row-major depth-buffer receivers, computed on first use ([`Frame::receivers`]).
     depth_receivers: OnceLock<(Vec<Option<Receiver>>, usize)>,
+    /// The probe the methods' passes record into ([`crate::gpu::probe`]), if one is attached.
+    pub probe: Option<Arc<Probe>>,
 }
 
 impl<'s> Frame<'s> {
@@ -198,6 +201,7 @@ impl<'s> Frame<'s> {
             pass,
             prim_rows: OnceLock::new(),
             depth_receivers: OnceLock::new(),
+            probe: None,
         })
     }
 
@@ -237,6 +241,22 @@ impl<'s> Frame<'s> {
             pass: self.pass.clone(),
             prim_rows: self.prim_rows.clone(),
             depth_receivers: self.depth_receivers.clone(),
+            probe: self.probe.clone(),
+        }
+    }
+
+    /// The pass `name` watching the probed pixel, when a probe is attached
+    /// ([`Frame::probe`]).
+    pub fn probe_pass(&self, name: &str) -> Option<PassProbe<'_>> {
+        self.probe.as_ref().map(|p| p.pass(name, &self.tiling))
+    }
+
+    /// Record one event of pass `name` at the probed pixel, when a probe is attached: `event`
+    /// gets the tap and the pixel's row-major index.
+    pub fn probe_record(&self, name: &str, event: impl FnOnce(Tap, usize) -> ProbeEvent) {
+        if let Some(p) = self.probe_pass(name) {
+            let [x, y] = p.probe().pixel();
+            p.record(|tap| event(tap, (y * self.scene.width + x) as usize));
         }
     }
 

@@ -58,6 +58,7 @@ pub mod methods;
 pub mod metrics;
 pub mod output;
 pub mod plan;
+pub mod probe;
 pub mod progress;
 pub mod render;
 pub mod report;

@@ -1,4 +1,4 @@
-//! The `penumbra` command line: `render`, `report`, `list`, `experiment`, `golden`. With no
+//! The `penumbra` command line: `render`, `report`, `probe`, `list`, `experiment`, `golden`. With no
 //! arguments it renders the built-in default scene with every available method into `out/`
 //! and its companions into `out/NAME/`, prints the error/time tables, and writes the HTML
 //! report `out/index.html`. Bad input prints one line naming the file and the problem and exits with code 2,
@@ -35,6 +35,8 @@ enum Cmd {
     Render(RenderArgs),
     /// Render scenes like `render` and write an HTML page showing them all, DIR/index.html.
     Report(ReportArgs),
+    /// Explain one pixel: every pass's contribution to it with one method, then the reference.
+    Probe(ProbeArgs),
     /// Print the built-in scenes and the methods, one per line.
     List,
     /// Run an experiment, or merge the shards of an accuracy–time sweep.
@@ -146,6 +148,26 @@ struct ReportArgs {
     /// Output directory: DIR/index.html and DIR/SCENE/METHOD/….
     #[arg(long, default_value = penumbra::render::DEFAULT_OUT)]
     out: PathBuf,
+}
+
+#[derive(clap::Args, Debug)]
+struct ProbeArgs {
+    /// Scene file (.toml/.json) or built-in scene name.
+    scene: String,
+    /// The method whose passes are traced.
+    #[arg(long)]
+    method: String,
+    /// The pixel, X,Y (column and row, row 0 at the top).
+    #[arg(long)]
+    pixel: String,
+    /// Print the report as JSON instead of the listing.
+    #[arg(long)]
+    json: bool,
+    /// List the events of every light sample (nsample, raycast), not only of the first few.
+    #[arg(long)]
+    verbose: bool,
+    #[command(flatten)]
+    overrides: SceneOverrides,
 }
 
 fn apply_overrides(scene: &mut Scene, a: &SceneOverrides) -> Result<(), InputError> {
@@ -288,6 +310,36 @@ fn report(a: &ReportArgs) -> Result<(), Box<dyn std::error::Error>> {
         dirs.push(dir);
     }
     write_report(&a.out, &rendered, &dirs)
+}
+
+/// `probe`: the report of one pixel, as a listing or JSON; nothing is written.
+fn probe(a: ProbeArgs) -> Result<(), Box<dyn std::error::Error>> {
+    if a.overrides.methods.is_some() {
+        return Err(InputError::at(
+            "--methods",
+            "probe",
+            "probe traces one method: give it as --method METHOD",
+        )
+        .into());
+    }
+    let bad_pixel = || InputError::at("--pixel", a.pixel.as_str(), "expected X,Y, e.g. 30,41");
+    let (x, y) = a.pixel.split_once(',').ok_or_else(bad_pixel)?;
+    let pixel = [x, y].map(|v| v.trim().parse::<u32>());
+    let [Ok(x), Ok(y)] = pixel else {
+        return Err(bad_pixel().into());
+    };
+    let overrides = SceneOverrides {
+        methods: Some(vec![a.method.clone()]),
+        ..a.overrides
+    };
+    let scene = prepare(&a.scene, &overrides)?;
+    let report = penumbra::probe::probe_pixel(&scene, &a.method, [x, y], a.verbose)?;
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", report.text());
+    }
+    Ok(())
 }
 
 /// A scene argument, loaded and validated.
@@ -459,6 +511,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
         Some(Cmd::Experiment(e)) => experiment(e),
         Some(Cmd::Render(a)) => render(&a).map(|_| ()),
         Some(Cmd::Report(a)) => report(&a),
+        Some(Cmd::Probe(a)) => probe(a),
         Some(Cmd::List) => {
             println!("# built-in scenes");
             for n in builtin::names() {
