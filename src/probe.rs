@@ -37,6 +37,10 @@ pub struct ProbeReport {
     pub events: Vec<ProbeEvent>,
     /// Events of further light samples left out of `events`.
     pub omitted_events: usize,
+    /// For methods that sample the light (`nsample`, `raycast`): how many light samples the
+    /// pixel has and how many of them light it (events with a `lit` value), over the whole
+    /// trace.
+    pub light_samples: Option<SampleCount>,
     /// The first event of the whole trace whose buffer value before differs from its value
     /// after the previous event ([`check_chains`]); `None` when every one chains.
     pub chain_break: Option<String>,
@@ -48,6 +52,15 @@ pub struct ProbeReport {
     pub reference_samples: u32,
     /// Method − reference, per channel.
     pub error: Vec<f32>,
+}
+
+/// Light samples of a pixel: all of them and those that light it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct SampleCount {
+    /// Light samples (summed over lights).
+    pub total: usize,
+    /// Samples that light the pixel.
+    pub lit: usize,
 }
 
 /// Probe pixel (`x`, `y`) of `scene` rendered with `method` (module doc); `verbose` keeps every
@@ -88,6 +101,16 @@ pub fn probe_pixel(
         .filter(|e| verbose || e.scope.sample.is_none_or(|s| s < SAMPLES_SHOWN))
         .cloned()
         .collect();
+    let verdicts: Vec<bool> = all
+        .iter()
+        .filter(|e| e.scope.sample.is_some())
+        .flat_map(|e| e.values.iter().filter(|v| v.name == "lit"))
+        .map(|v| v.value == 1.0)
+        .collect();
+    let light_samples = (!verdicts.is_empty()).then(|| SampleCount {
+        total: verdicts.len(),
+        lit: verdicts.iter().filter(|l| **l).count(),
+    });
     let error = visibility
         .iter()
         .zip(reference.iter().cycle())
@@ -99,6 +122,7 @@ pub fn probe_pixel(
         method: method.into(),
         pixel: [x, y],
         omitted_events: all.len() - shown.len(),
+        light_samples,
         chain_break: check_chains(&all).err(),
         events: shown,
         visibility,
@@ -231,8 +255,17 @@ impl ProbeReport {
             let _ = writeln!(
                 s,
                 "… {} events of light samples {SAMPLES_SHOWN} and later not listed (--verbose \
-                 lists them; the resolve above counts every sample)",
+                 lists them)",
                 self.omitted_events
+            );
+        }
+        if let Some(n) = self.light_samples {
+            let _ = writeln!(
+                s,
+                "light samples: {}, lighting the pixel {}, occluded {}",
+                n.total,
+                n.lit,
+                n.total - n.lit
             );
         }
         let join = |v: &[f32]| v.iter().map(f32::to_string).collect::<Vec<_>>().join(" ");

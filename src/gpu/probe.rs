@@ -28,10 +28,11 @@
 //!
 //! # Buffers
 //!
-//! An event that changes a buffer carries a [`BufferChange`]: the buffer's name, its value
-//! before (`None` for a clear, which starts the buffer) and after. For every buffer — one name
-//! in one scope at one sample — each event's "before" equals the previous event's "after"
-//! ([`check_chains`]).
+//! An event that reads or changes a buffer carries a [`BufferChange`]: the buffer's name, its
+//! value before (`None` for a clear, which starts the buffer) and after. For every buffer — one
+//! name at one sample, whatever the scope: a buffer the lights share is written in each
+//! light's scope, and a buffer used again is cleared first — each event's "before" equals the
+//! previous event's "after" ([`check_chains`]).
 
 use super::depth::{DepthFormat, DepthFunc};
 use super::tiling::Tiling;
@@ -354,9 +355,26 @@ impl ProbeEvent {
         self
     }
 
-    /// Override the light of the scope (a primitive of one light in a buffer shared by all).
+    /// Set a read of `buffer`, which holds `value` (before and after are the same).
+    pub fn read(mut self, buffer: &str, value: Raw) -> Self {
+        self.buffer = Some(BufferChange {
+            buffer: buffer.into(),
+            before: Some(value.clone()),
+            after: value,
+            overflow: None,
+        });
+        self
+    }
+
+    /// Set the light of the scope (a primitive of one light in a buffer shared by all).
     pub fn light(mut self, light: u32) -> Self {
         self.scope.light = Some(light);
+        self
+    }
+
+    /// Set the light sample of the scope.
+    pub fn sample(mut self, sample: u32) -> Self {
+        self.scope.sample = Some(sample);
         self
     }
 }
@@ -436,10 +454,12 @@ impl Probe {
 
     fn push(&self, mut e: ProbeEvent) {
         let mut st = self.state();
-        let scope = st.scope;
+        let (own, scope) = (e.scope, st.scope);
         e.scope = Scope {
-            light: e.scope.light.or(scope.light),
-            ..scope
+            light: own.light.or(scope.light),
+            sample: own.sample.or(scope.sample),
+            piece: own.piece.or(scope.piece),
+            group: own.group.or(scope.group),
         };
         st.events.push(e);
     }
@@ -568,27 +588,27 @@ impl PassProbe<'_> {
     }
 }
 
-/// Check that every buffer's writes chain (module doc, "Buffers"): per buffer name, scope
-/// and sample, the first event is a clear and every later event's `before` equals the
-/// previous `after`. Returns the first break as a message.
+/// Check that every buffer's writes chain (module doc, "Buffers"): per buffer name and
+/// sample, the first event is a clear and every later event's `before` equals the previous
+/// `after` (a clear starts the chain again). Returns the first break as a message.
 pub fn check_chains(events: &[ProbeEvent]) -> Result<(), String> {
-    let mut last: Vec<((String, Scope, [u32; 2]), (usize, Raw))> = Vec::new();
+    let mut last: Vec<((&str, [u32; 2]), (usize, &Raw))> = Vec::new();
     for (k, e) in events.iter().enumerate() {
         let Some(b) = &e.buffer else { continue };
-        let key = (b.buffer.clone(), e.scope, e.at);
+        let key = (b.buffer.as_str(), e.at);
         let slot = last.iter().position(|(kk, _)| *kk == key);
         match (&b.before, slot) {
-            (None, Some(s)) => last[s].1 = (k, b.after.clone()),
-            (None, None) => last.push((key, (k, b.after.clone()))),
+            (None, Some(s)) => last[s].1 = (k, &b.after),
+            (None, None) => last.push((key, (k, &b.after))),
             (Some(before), Some(s)) => {
-                let (j, after) = &last[s].1;
+                let (j, after) = last[s].1;
                 if before != after {
                     return Err(format!(
                         "event {k} ({}): {} before {before} but event {j} left {after}",
                         e.pass, b.buffer
                     ));
                 }
-                last[s].1 = (k, b.after.clone());
+                last[s].1 = (k, &b.after);
             }
             (Some(_), None) => {
                 return Err(format!(
@@ -617,18 +637,21 @@ mod tests {
         {
             let _light = probe.enter(|s| s.light = Some(1));
             let _sample = probe.enter(|s| s.sample = Some(4));
-            tap.push(tap.event().clear("stencil", Raw::U8(0)));
+            tap.push(tap.event().clear("stencil", Raw::U8(0)).sample(7));
         }
-        tap.push(
+        let write = |buffer, before, after| {
             tap.event()
-                .write("stencil", Raw::U8(0), Raw::U8(1), Overflow::Wrap, 0),
-        );
+                .write(buffer, Raw::U8(before), Raw::U8(after), Overflow::Wrap, 0)
+        };
+        tap.push(write("stencil", 0, 1));
+        tap.push(write("li", 0, 1));
         let events = probe.events();
         assert_eq!(events[0].scope.light, Some(1));
-        assert_eq!(events[0].scope.sample, Some(4));
+        assert_eq!(events[0].scope.sample, Some(7));
         assert_eq!(events[1].scope, Scope::default());
-        // The second write is in another scope, whose buffer was never cleared.
-        assert!(check_chains(&events).is_err());
+        // The stencil chains across scopes; the LI buffer was never cleared.
+        let e = check_chains(&events).unwrap_err();
+        assert!(e.starts_with("event 2 (p): li written before"), "{e}");
     }
 
     #[test]

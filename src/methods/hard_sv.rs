@@ -23,7 +23,7 @@ use crate::geometry::shadow_volume::{shadow_volume_parts, shadow_volume_triangle
 use crate::gpu::buffers::{alloc_tiles, StencilTile};
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
-use crate::gpu::probe::{Overflow, Raw};
+use crate::gpu::probe::Raw;
 use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
 use crate::gpu::setup::CullMode;
 use crate::gpu::stencil::{StencilFace, StencilOp, StencilState};
@@ -257,13 +257,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         .collect();
     frame.probe_record("resolve", |tap, i| {
         tap.event()
-            .write(
-                "stencil",
-                Raw::U8(stencil[i]),
-                Raw::U8(stencil[i]),
-                Overflow::Wrap,
-                0,
-            )
+            .read("stencil", Raw::U8(stencil[i]))
             .resolve(&[vis[i]], false)
             .note(if prims[i] == BACKGROUND {
                 "background: lit"

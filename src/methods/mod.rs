@@ -376,7 +376,9 @@ fn run_raycast(frame: &Frame) -> Result<MethodOutput, InputError> {
     } else {
         frame.receivers()
     };
-    let visibility = raycast::raycast_visibility(scene, receivers, &settings);
+    let probe = frame.probe_pass("raycast");
+    let visibility =
+        raycast::raycast_visibility_probed(scene, receivers, &settings, probe.as_ref());
     let pass = PassStats {
         name: "raycast".into(),
         wall_seconds: pass_start.elapsed().as_secs_f64(),
