@@ -132,6 +132,19 @@ pub fn probe_pixel(
     })
 }
 
+/// A computed value as the listing shows it: integers as such, others to 6 decimals (or in
+/// scientific notation when small or large); the JSON keeps every bit.
+fn short(v: f64) -> String {
+    if v.fract() == 0.0 && v.abs() < 1e15 {
+        format!("{v}")
+    } else if (1e-4..1e6).contains(&v.abs()) {
+        let s = format!("{v:.6}");
+        s.trim_end_matches('0').to_string()
+    } else {
+        format!("{v:.4e}")
+    }
+}
+
 /// The columns of one event line.
 fn columns(k: usize, e: &ProbeEvent) -> [String; 8] {
     let s = &e.scope;
@@ -176,7 +189,7 @@ fn columns(k: usize, e: &ProbeEvent) -> [String; 8] {
     let values = e
         .values
         .iter()
-        .map(|v| format!("{} {}", v.name, v.value))
+        .map(|v| format!("{} {}", v.name, short(v.value)))
         .collect::<Vec<_>>()
         .join(", ");
     let buffer = e.buffer.as_ref().map_or(String::new(), |b| {

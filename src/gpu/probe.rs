@@ -40,7 +40,8 @@ use serde::Serialize;
 use std::fmt;
 use std::sync::Mutex;
 
-/// A raw stored value, as the buffer holds its bits (module doc, "Buffers").
+/// A raw stored value, as the buffer holds its bits (module doc, "Buffers"). Displayed as the
+/// integer, or for floats as the value and (f32, f16) its bits in hexadecimal.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Raw {
@@ -71,8 +72,8 @@ impl fmt::Display for Raw {
         match self {
             Raw::U8(v) => write!(f, "{v}"),
             Raw::Int(v) => write!(f, "{v}"),
-            Raw::F32(b) => write!(f, "{}", f32::from_bits(*b)),
-            Raw::F16(b) => write!(f, "{}", half::f16::from_bits(*b)),
+            Raw::F32(b) => write!(f, "{} [{b:08x}]", f32::from_bits(*b)),
+            Raw::F16(b) => write!(f, "{} [{b:04x}]", half::f16::from_bits(*b)),
             Raw::F64(b) => write!(f, "{}", f64::from_bits(*b)),
             Raw::Depth(v) => write!(f, "{v:#x}"),
             Raw::Rg8([r, g]) => write!(f, "R{r} G{g}"),

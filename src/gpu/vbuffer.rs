@@ -30,6 +30,7 @@
 //! only, which the method merges with its stencil umbra.
 
 use super::counters::Counters;
+use super::probe::{Overflow, ProbeEvent, Raw, Tap};
 use half::f16;
 
 /// The storage formats of a V-buffer (module doc).
@@ -46,6 +47,15 @@ pub enum VBufferFormat {
 }
 
 impl VBufferFormat {
+    /// What the overflow events an accumulation counts are: saturation for the 8-bit version,
+    /// a result that is not finite for the float formats.
+    pub fn overflow(self) -> Overflow {
+        match self {
+            VBufferFormat::Split8 => Overflow::Saturate,
+            _ => Overflow::NonFinite,
+        }
+    }
+
     /// Bytes per pixel as stored (the 8-bit version occupies an RGBA8 pixel).
     pub fn bytes(self) -> u32 {
         match self {
@@ -70,6 +80,35 @@ pub trait VBufferTile: Send {
     /// The accumulated value of pixel `i` per channel (module doc; not counted: the final
     /// read-back).
     fn resolve(&self, i: usize) -> [f32; 3];
+    /// Pixel `i` as stored, for probes ([`super::probe`]; not counted).
+    fn raw(&self, i: usize) -> Raw;
+}
+
+/// [`VBufferTile::add`] that, given the watched fragment's tap and its event so far, records
+/// the write of the V-buffer there, before and after, with its overflow events
+/// ([`super::probe`]).
+#[inline]
+pub fn add_probed<V: VBufferTile>(
+    vb: &mut V,
+    i: usize,
+    delta: [f32; 3],
+    c: &mut Counters,
+    probe: Option<(Tap, ProbeEvent)>,
+) {
+    let Some((tap, e)) = probe else {
+        return vb.add(i, delta, c);
+    };
+    let (before, overflows) = (vb.raw(i), c.overflow_events);
+    vb.add(i, delta, c);
+    let kind = V::FORMAT.overflow();
+    let after = vb.raw(i);
+    tap.push(e.write(
+        "vbuffer",
+        before,
+        after,
+        kind,
+        c.overflow_events - overflows,
+    ));
 }
 
 /// One f32 per pixel (module doc).
@@ -94,6 +133,9 @@ impl VBufferTile for VBufferF32Tile {
     }
     fn resolve(&self, i: usize) -> [f32; 3] {
         [self.values[i]; 3]
+    }
+    fn raw(&self, i: usize) -> Raw {
+        Raw::f32(self.values[i])
     }
 }
 
@@ -122,6 +164,9 @@ impl VBufferTile for VBufferF16Tile {
     fn resolve(&self, i: usize) -> [f32; 3] {
         [self.values[i].to_f32(); 3]
     }
+    fn raw(&self, i: usize) -> Raw {
+        Raw::F16(self.values[i].to_bits())
+    }
 }
 
 /// Three f32 per pixel (module doc).
@@ -148,6 +193,9 @@ impl VBufferTile for VBufferRgbTile {
     }
     fn resolve(&self, i: usize) -> [f32; 3] {
         self.values[i]
+    }
+    fn raw(&self, i: usize) -> Raw {
+        Raw::Channels(self.values[i].map(Raw::f32).to_vec())
     }
 }
 
@@ -198,6 +246,9 @@ impl VBufferTile for VBuffer8Tile {
     }
     fn resolve(&self, i: usize) -> [f32; 3] {
         [(self.add[i] as f32 - self.sub[i] as f32) / VBUFFER8_FULL as f32; 3]
+    }
+    fn raw(&self, i: usize) -> Raw {
+        Raw::Rg8([self.add[i], self.sub[i]])
     }
 }
 
