@@ -144,6 +144,8 @@ pub enum PrimitiveKind {
     ShadowQuad,
     /// A front-cap triangle of a z-fail shadow volume.
     FrontCap,
+    /// A triangle of a hard shadow volume, quad or cap (`detail`: whose volume).
+    VolumeTriangle,
     /// A back-cap triangle (at infinity) of a z-fail shadow volume.
     BackCap,
     /// A face triangle of a penumbra wedge or soft-shadow-volume wedge.
@@ -178,6 +180,7 @@ impl PrimitiveKind {
         match self {
             PrimitiveKind::ShadowQuad => "shadow-quad",
             PrimitiveKind::FrontCap => "front-cap",
+            PrimitiveKind::VolumeTriangle => "volume-triangle",
             PrimitiveKind::BackCap => "back-cap",
             PrimitiveKind::Wedge => "wedge",
             PrimitiveKind::HalfWedge => "half-wedge",
