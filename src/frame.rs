@@ -10,6 +10,7 @@ use crate::error::InputError;
 use crate::geometry::adjacency::{self, Adjacency};
 use crate::gpu::buffers::{alloc_tiles, DepthTile};
 use crate::gpu::depth::{DepthFormat, DepthState};
+use crate::gpu::probe::{PassProbe, Probe, ProbeEvent, Tap};
 use crate::gpu::raster::{bin, draw, no_tile_culling};
 pub use crate::gpu::setup::setup_all;
 use crate::gpu::setup::CullMode;
@@ -20,7 +21,7 @@ use crate::options::{option_names, option_table, OptionTable, PowerOfTwo};
 use crate::scene::{Mesh, Scene};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 /// How far off its triangle's plane a depth-buffer receiver may lie, relative to the scene's
@@ -135,6 +136,8 @@ pub struct Frame<'s> {
     /// ([`crate::methods::dump`], `--dump-buffers`); false after [`Frame::render`], set with
     /// [`Frame::dumping`].
     pub dump_buffers: bool,
+    /// The probe the methods' passes record into ([`crate::gpu::probe`]), if one is attached.
+    pub probe: Option<Arc<Probe>>,
 }
 
 impl<'s> Frame<'s> {
@@ -227,6 +230,7 @@ impl<'s> Frame<'s> {
             prim_rows: OnceLock::new(),
             depth_receivers: OnceLock::new(),
             dump_buffers: false,
+            probe: None,
         })
     }
 
@@ -273,6 +277,22 @@ impl<'s> Frame<'s> {
             prim_rows: self.prim_rows.clone(),
             depth_receivers: self.depth_receivers.clone(),
             dump_buffers: self.dump_buffers,
+            probe: self.probe.clone(),
+        }
+    }
+
+    /// The pass `name` watching the probed pixel, when a probe is attached
+    /// ([`Frame::probe`]).
+    pub fn probe_pass(&self, name: &str) -> Option<PassProbe<'_>> {
+        self.probe.as_ref().map(|p| p.pass(name, &self.tiling))
+    }
+
+    /// Record one event of pass `name` at the probed pixel, when a probe is attached: `event`
+    /// gets the tap and the pixel's row-major index.
+    pub fn probe_record(&self, name: &str, event: impl FnOnce(Tap, usize) -> ProbeEvent) {
+        if let Some(p) = self.probe_pass(name) {
+            let [x, y] = p.probe().pixel();
+            p.record(|tap| event(tap, (y * self.scene.width + x) as usize));
         }
     }
 

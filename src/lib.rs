@@ -59,6 +59,7 @@ pub mod metrics;
 pub mod options;
 pub mod output;
 pub mod plan;
+pub mod probe;
 pub mod progress;
 pub mod render;
 pub mod report;

@@ -1,6 +1,7 @@
-//! The `penumbra` command line: `render`, `report`, `list`, `experiment`, `golden`. With no
-//! arguments it renders the built-in default scene with every available method into
-//! `out/cube-of-spheres/` and its companions into `out/NAME/`, prints the error/time tables, and writes the HTML
+//! The `penumbra` command line: `render`, `report`, `probe`, `list`, `experiment`, `golden`.
+//! With no arguments it renders the built-in default scene with every available method into
+//! `out/cube-of-spheres/` and its companions into `out/NAME/`, prints the error/time tables,
+//! and writes the HTML
 //! report `out/index.html`. Bad input prints one line naming the file and the problem and exits with code 2,
 //! before any output is written.
 
@@ -40,6 +41,8 @@ enum Cmd {
     Render(RenderArgs),
     /// Render scenes like `render` and write an HTML page showing them all, DIR/index.html.
     Report(ReportArgs),
+    /// Explain one pixel: every pass's contribution to it with one method, then the reference.
+    Probe(ProbeArgs),
     /// Print the built-in scenes and the methods, one per line.
     List {
         /// Print instead every option table's keys: values, default and meaning.
@@ -157,6 +160,26 @@ struct ReportArgs {
     /// Output directory: DIR/index.html and DIR/SCENE/METHOD/….
     #[arg(long, default_value = penumbra::render::DEFAULT_OUT)]
     out: PathBuf,
+}
+
+#[derive(clap::Args, Debug)]
+struct ProbeArgs {
+    /// Scene file (.toml/.json) or built-in scene name.
+    scene: String,
+    /// The method whose passes are traced.
+    #[arg(long)]
+    method: String,
+    /// The pixel, X,Y (column and row, row 0 at the top).
+    #[arg(long)]
+    pixel: String,
+    /// Print the report as JSON instead of the listing.
+    #[arg(long)]
+    json: bool,
+    /// List the events of every light sample (nsample, raycast), not only of the first few.
+    #[arg(long)]
+    verbose: bool,
+    #[command(flatten)]
+    overrides: SceneOverrides,
 }
 
 fn apply_overrides(scene: &mut Scene, a: &SceneOverrides) -> Result<(), InputError> {
@@ -321,6 +344,36 @@ fn scene_dir_name(source: &str) -> String {
     penumbra::experiment::accuracy_time::plot_stem(source)
 }
 
+/// `probe`: the report of one pixel, as a listing or JSON; nothing is written.
+fn probe(a: ProbeArgs) -> Result<(), Box<dyn std::error::Error>> {
+    if a.overrides.methods.is_some() {
+        return Err(InputError::at(
+            "--methods",
+            "probe",
+            "probe traces one method: give it as --method METHOD",
+        )
+        .into());
+    }
+    let bad_pixel = || InputError::at("--pixel", a.pixel.as_str(), "expected X,Y, e.g. 30,41");
+    let (x, y) = a.pixel.split_once(',').ok_or_else(bad_pixel)?;
+    let pixel = [x, y].map(|v| v.trim().parse::<u32>());
+    let [Ok(x), Ok(y)] = pixel else {
+        return Err(bad_pixel().into());
+    };
+    let overrides = SceneOverrides {
+        methods: Some(vec![a.method.clone()]),
+        ..a.overrides
+    };
+    let scene = prepare(&a.scene, &overrides, false)?;
+    let report = penumbra::probe::probe_pixel(&scene, &a.method, [x, y], a.verbose)?;
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{}", report.text());
+    }
+    Ok(())
+}
+
 /// A scene argument, loaded and validated, its option tables checked.
 fn load_scene(arg: &str) -> Result<Scene, InputError> {
     let scene = file::resolve(arg)?;
@@ -459,7 +512,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
     if dumps
         && matches!(
             cli.cmd,
-            Some(Cmd::List { .. } | Cmd::Experiment(_) | Cmd::Golden { .. })
+            Some(Cmd::List { .. } | Cmd::Probe(_) | Cmd::Experiment(_) | Cmd::Golden { .. })
         )
     {
         return Err(InputError::new(
@@ -510,6 +563,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
         Some(Cmd::Experiment(e)) => experiment(e),
         Some(Cmd::Render(a)) => render(&a, dumps).map(|_| ()),
         Some(Cmd::Report(a)) => report(&a, dumps),
+        Some(Cmd::Probe(a)) => probe(a),
         Some(Cmd::List { options: true }) => {
             print!(
                 "{}",

@@ -83,6 +83,17 @@ pub fn render_scene(scene: &Scene) -> Result<Vec<MethodRun>, InputError> {
     render_scene_with(scene, |_| {})
 }
 
+/// The scene pass of `scene` with `[options.gpu]`, after every method's options were checked,
+/// also of methods not rendered now, so that a bad option stops a run before any method runs
+/// (the table names are [`methods::check_option_tables`]'s, which callers run first).
+pub fn checked_frame(scene: &Scene) -> Result<Frame<'_>, InputError> {
+    let frame = Frame::render(scene, gpu_settings(scene)?)?;
+    for method in scene.options.keys().filter(|k| k.as_str() != "gpu") {
+        methods::check_options(method, &frame)?;
+    }
+    Ok(frame)
+}
+
 /// The methods [`render_scene`] runs on `scene`, in the order it runs them: the reference
 /// first when selected, then the others in their selected order.
 pub fn render_order(scene: &Scene) -> Result<Vec<String>, InputError> {
@@ -112,12 +123,7 @@ pub fn render_scene_dumping(
 ) -> Result<Vec<MethodRun>, InputError> {
     methods::check_option_tables(scene)?;
     let order = render_order(scene)?;
-    let gpu = gpu_settings(scene)?;
-    let frame = Frame::render(scene, gpu)?.dumping(dump_buffers);
-    // Every option table is checked before anything runs, also for methods not rendered now.
-    for method in scene.options.keys().filter(|k| k.as_str() != "gpu") {
-        methods::check_options(method, &frame)?;
-    }
+    let frame = checked_frame(scene)?.dumping(dump_buffers);
     let mut runs: Vec<MethodRun> = Vec::new();
     for m in &order {
         starting(m);

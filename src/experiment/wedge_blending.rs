@@ -16,7 +16,7 @@
 //!    among receivers that see the whole light in front of their tangent plane and lie on no
 //!    mesh blended there (elsewhere the receiver's own surface hides light, which no wedge
 //!    method models — `ssv` errs as much there), with every silhouette's radial parts,
-//!    rectangles and ε ([`render_probed`]).
+//!    rectangles and ε, from the render's probe trace ([`blend_steps`]).
 //! 4. **Time**: the median of [`TIMING_RUNS`] interleaved runs of `ssv`, `ssv-optimized` and
 //!    `wedge-blending` (packed, unpacked) at `size`² and 2·`size`², and the ratios to `ssv`.
 //!
@@ -32,10 +32,11 @@
 use super::{configured, sized};
 use crate::error::InputError;
 use crate::frame::{Frame, GpuSettings};
+use crate::gpu::probe;
 use crate::light::coverage::RectLight;
 use crate::light::radial_parts::{PART_COUNT, PART_SIGNS};
 use crate::methods::output::Visibility;
-use crate::methods::wedge_blending::{self, render_probed, ProbeStep};
+use crate::methods::wedge_blending::{self, blend_steps, BlendStep};
 use crate::metrics::{compare_where, ErrorStats};
 use crate::plan::segment_hits_mesh;
 use crate::scene::{builtin, Scene};
@@ -194,7 +195,7 @@ pub struct Probe {
     /// The packed wedge-blending visibility there.
     pub packed: f32,
     /// Every blend step with what the receiver really sees ([`ProbeTruth`]).
-    pub steps: Vec<(ProbeStep, ProbeTruth)>,
+    pub steps: Vec<(BlendStep, ProbeTruth)>,
 }
 
 /// Everything the experiment measured on one overlap scene.
@@ -304,7 +305,11 @@ pub fn measure_scene(scene: &Scene) -> Result<SceneReport, InputError> {
     for &i in candidates.iter().take(PROBE_CANDIDATES) {
         let xy = ((i as u32) % scene.width, (i as u32) / scene.width);
         let receiver_mesh = frame.prim_owner[frame.prim_ids()[i] as usize].0 as usize;
-        let trace = render_probed(&frame, &packed_settings, Some(xy))?.trace;
+        let mut probed = frame.lit_by(scene);
+        let recorder = std::sync::Arc::new(probe::Probe::new(xy.0, xy.1));
+        probed.probe = Some(recorder.clone());
+        wedge_blending::render(&probed, &packed_settings)?;
+        let trace = blend_steps(&recorder.events(), &packed_settings);
         if trace.iter().all(|st| st.mesh != receiver_mesh) {
             let p = receivers[i].expect("an overlap pixel has a receiver").point;
             let truths = probe_truths(scene, p.as_dvec3(), &trace);
@@ -345,7 +350,7 @@ pub struct ProbeTruth {
 }
 
 /// The [`ProbeTruth`] of every step of `trace` at receiver `p`.
-fn probe_truths(scene: &Scene, p: DVec3, trace: &[ProbeStep]) -> Vec<ProbeTruth> {
+fn probe_truths(scene: &Scene, p: DVec3, trace: &[BlendStep]) -> Vec<ProbeTruth> {
     let Some(light) = RectLight::from_light(scene.light()) else {
         return Vec::new();
     };

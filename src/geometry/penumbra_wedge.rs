@@ -276,18 +276,50 @@ pub struct WedgeSet {
     /// (0 on every built-in scene; reported in the stats so that a scene where the
     /// construction fails is visible).
     pub open_wedges: usize,
+    /// Per set appended ([`WedgeSet::append`], one per light): the index of its first wedge,
+    /// top cap and bottom cap.
+    pub appended_at: Vec<[usize; 3]>,
 }
 
 impl WedgeSet {
     /// Append `other`'s wedges and caps after this set's (several lights, Paper I §7: the
     /// wedges of every light are submitted in light order).
     pub fn append(&mut self, other: WedgeSet) {
+        self.appended_at.push([
+            self.wedges.len(),
+            self.top_caps.len(),
+            self.bottom_caps.len(),
+        ]);
         self.wedges.extend(other.wedges);
         self.top_caps.extend(other.top_caps);
         self.bottom_caps.extend(other.bottom_caps);
         self.removed_parallel += other.removed_parallel;
         self.extra_wedges += other.extra_wedges;
         self.open_wedges += other.open_wedges;
+    }
+}
+
+impl WedgeSet {
+    /// The light (the set appended, in order) of wedge `wi`; `None` for a set built at once.
+    pub fn light_of_wedge(&self, wi: usize) -> Option<u32> {
+        self.appended(0, wi)
+    }
+
+    /// The light of cap `ci` in [`cap_triangles`] order (top caps, then bottom caps).
+    pub fn light_of_cap(&self, ci: usize) -> Option<u32> {
+        match ci.checked_sub(self.top_caps.len()) {
+            None => self.appended(1, ci),
+            Some(b) => self.appended(2, b),
+        }
+    }
+
+    fn appended(&self, column: usize, index: usize) -> Option<u32> {
+        let k = self
+            .appended_at
+            .iter()
+            .filter(|a| a[column] <= index)
+            .count();
+        k.checked_sub(1).map(|k| k as u32)
     }
 }
 

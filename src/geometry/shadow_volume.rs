@@ -13,6 +13,7 @@
 
 use super::adjacency::Adjacency;
 use super::silhouette::{away_from_light, light_facing, possible_silhouettes};
+use crate::gpu::probe::PrimitiveKind;
 use crate::gpu::transform::{ClipVertex, Projection};
 use crate::scene::Mesh;
 use glam::Vec3;
@@ -41,6 +42,56 @@ pub fn silhouette_quad(proj: &Projection, light: Vec3, a: Vec3, b: Vec3) -> [[Cl
     quad_triangles([proj.clip_point(a), proj.clip_point(b)], [far(a), far(b)])
 }
 
+/// What one shadow-volume triangle is (for probes, [`crate::gpu::probe`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum VolumePart {
+    /// Front-cap triangle `triangle` of the mesh.
+    FrontCap {
+        /// Index of the mesh in the meshes given.
+        mesh: usize,
+        /// The mesh's triangle.
+        triangle: usize,
+    },
+    /// Triangle `half` (0 or 1) of the quad of the mesh's possible silhouette edge `edge`
+    /// (its index in [`possible_silhouettes`] order).
+    Quad {
+        /// Index of the mesh in the meshes given.
+        mesh: usize,
+        /// The silhouette edge.
+        edge: usize,
+        /// Which of the quad's two triangles.
+        half: usize,
+    },
+    /// Back-cap triangle `triangle` of the mesh, at infinity.
+    BackCap {
+        /// Index of the mesh in the meshes given.
+        mesh: usize,
+        /// The mesh's triangle.
+        triangle: usize,
+    },
+}
+
+impl VolumePart {
+    /// The primitive a probe names for the triangle ([`crate::gpu::probe`]): its kind and what
+    /// it belongs to.
+    pub fn describe(&self) -> (PrimitiveKind, String) {
+        match *self {
+            VolumePart::FrontCap { mesh, triangle } => (
+                PrimitiveKind::FrontCap,
+                format!("triangle {triangle} of caster {mesh}"),
+            ),
+            VolumePart::Quad { mesh, edge, half } => (
+                PrimitiveKind::ShadowQuad,
+                format!("edge {edge} of caster {mesh}, half {half}"),
+            ),
+            VolumePart::BackCap { mesh, triangle } => (
+                PrimitiveKind::BackCap,
+                format!("triangle {triangle} of caster {mesh}"),
+            ),
+        }
+    }
+}
+
 /// The clip-space triangles of the shadow volumes of `meshes` from light point `light`,
 /// in submission order.
 pub fn shadow_volume_triangles(
@@ -50,7 +101,31 @@ pub fn shadow_volume_triangles(
     capping: Capping,
 ) -> Vec<[ClipVertex; 3]> {
     let mut out = Vec::new();
-    for (mesh, adj) in meshes {
+    each_volume_triangle(meshes, light, proj, capping, |t, _| out.push(t));
+    out
+}
+
+/// What each triangle of [`shadow_volume_triangles`] (same arguments) is, in the same order.
+pub fn shadow_volume_parts(
+    meshes: &[(&Mesh, &Adjacency)],
+    light: Vec3,
+    proj: &Projection,
+    capping: Capping,
+) -> Vec<VolumePart> {
+    let mut out = Vec::new();
+    each_volume_triangle(meshes, light, proj, capping, |_, part| out.push(part));
+    out
+}
+
+/// Every shadow-volume triangle in submission order (module doc) with what it is.
+fn each_volume_triangle(
+    meshes: &[(&Mesh, &Adjacency)],
+    light: Vec3,
+    proj: &Projection,
+    capping: Capping,
+    mut emit: impl FnMut([ClipVertex; 3], VolumePart),
+) {
+    for (mi, (mesh, adj)) in meshes.iter().enumerate() {
         let facing = light_facing(mesh, light);
         let near: Vec<ClipVertex> = mesh.positions.iter().map(|p| proj.clip_point(*p)).collect();
         let far: Vec<ClipVertex> = mesh
@@ -59,23 +134,38 @@ pub fn shadow_volume_triangles(
             .map(|p| proj.clip_direction(away_from_light(*p, light)))
             .collect();
         if capping == Capping::Capped {
-            for (t, f) in mesh.triangles.iter().zip(&facing) {
+            for (ti, (t, f)) in mesh.triangles.iter().zip(&facing).enumerate() {
                 if *f {
-                    out.push(t.map(|i| near[i as usize]));
+                    let part = VolumePart::FrontCap {
+                        mesh: mi,
+                        triangle: ti,
+                    };
+                    emit(t.map(|i| near[i as usize]), part);
                 }
             }
         }
-        for e in possible_silhouettes(mesh, adj, &facing) {
+        for (ei, e) in possible_silhouettes(mesh, adj, &facing).iter().enumerate() {
             let (a, b) = (e.va as usize, e.vb as usize);
-            out.extend(quad_triangles([near[a], near[b]], [far[a], far[b]]));
+            let quad = quad_triangles([near[a], near[b]], [far[a], far[b]]);
+            for (half, t) in quad.into_iter().enumerate() {
+                let part = VolumePart::Quad {
+                    mesh: mi,
+                    edge: ei,
+                    half,
+                };
+                emit(t, part);
+            }
         }
         if capping == Capping::Capped {
-            for (t, f) in mesh.triangles.iter().zip(&facing) {
+            for (ti, (t, f)) in mesh.triangles.iter().zip(&facing).enumerate() {
                 if !*f {
-                    out.push(t.map(|i| far[i as usize]));
+                    let part = VolumePart::BackCap {
+                        mesh: mi,
+                        triangle: ti,
+                    };
+                    emit(t.map(|i| far[i as usize]), part);
                 }
             }
         }
     }
-    out
 }

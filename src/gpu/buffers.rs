@@ -5,10 +5,11 @@
 //! Storage is tile-major (see [`super::tiling`]): one value per sample of a T×T tile.
 
 use super::counters::Counters;
-use super::depth::{DepthFormat, DepthState};
+use super::depth::{DepthFormat, DepthFunc, DepthState};
+use super::probe::{Overflow, ProbeEvent, Raw};
 use super::raster::Fragment;
 use super::setup::RasterTriangle;
-use super::stencil::StencilState;
+use super::stencil::{StencilOp, StencilState};
 use super::tiling::Tiling;
 
 /// The depth samples of one tile, plus its hierarchical-Z bounds.
@@ -98,6 +99,20 @@ impl DepthTile {
         pass
     }
 
+    /// A probe's record ([`super::probe`]) of a depth test with `func` of the quantized fragment
+    /// depth `z` against sample `i`, which `pass`ed or not (the stored value read again,
+    /// uncounted).
+    pub fn record_test(
+        &self,
+        e: ProbeEvent,
+        func: DepthFunc,
+        i: usize,
+        z: u32,
+        pass: bool,
+    ) -> ProbeEvent {
+        e.depth(self.format, func, z, self.values[i], pass)
+    }
+
     /// Hierarchical-Z rejection for a LESS test against this tile: true when every sample of
     /// the triangle is at or behind every stored sample (triangle zmin ≥ tile zmax), i.e. no
     /// fragment of it can pass. Reads the tile's zmax (not counted as depth traffic: on-chip).
@@ -154,7 +169,7 @@ impl StencilTile {
 
     /// Apply the stencil state to fragment `f` of a triangle with the given facing, given the
     /// depth-test outcome. Reads and (when the value changes or an op writes) writes are
-    /// counted; clamps and wraps are counted as overflow events.
+    /// counted; clamps and wraps are counted as overflow events. Returns what happened.
     #[inline]
     pub fn apply(
         &mut self,
@@ -163,17 +178,60 @@ impl StencilTile {
         f: &Fragment,
         depth_pass: bool,
         c: &mut Counters,
-    ) {
+    ) -> StencilUpdate {
         let face = state.face(front_facing);
         c.stencil_read_bytes += 1;
         let stored = self.values[f.local];
         let stencil_pass = face.func.test(face.reference, stored, face.read_mask);
+        let mut update = StencilUpdate {
+            before: stored,
+            after: stored,
+            stencil_pass,
+            op: face.op(stencil_pass, depth_pass),
+            overflow: false,
+        };
         if let Some((v, overflow)) = face.update(stored, stencil_pass, depth_pass) {
             c.stencil_write_bytes += 1;
             c.overflow_events += overflow as u64;
             record_overflow(&mut self.overflows, f.local, overflow as u32);
             self.values[f.local] = v;
+            (update.after, update.overflow) = (v, overflow);
         }
+        update
+    }
+}
+
+/// What [`StencilTile::apply`] did to one sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StencilUpdate {
+    /// The stored value before.
+    pub before: u8,
+    /// And after.
+    pub after: u8,
+    /// Whether the stencil test passed.
+    pub stencil_pass: bool,
+    /// The op that ran.
+    pub op: StencilOp,
+    /// Whether it over- or underflowed (wrapped or saturated).
+    pub overflow: bool,
+}
+
+impl StencilUpdate {
+    /// The probe's record of this update ([`super::probe`]): a write of `buffer`.
+    pub fn record(&self, e: ProbeEvent, buffer: &str) -> ProbeEvent {
+        let kind = if self.op.wraps() {
+            Overflow::Wrap
+        } else {
+            Overflow::Saturate
+        };
+        e.write(
+            buffer,
+            Raw::U8(self.before),
+            Raw::U8(self.after),
+            kind,
+            self.overflow as u64,
+        )
+        .note(format!("stencil {:?}", self.op))
     }
 }
 

@@ -20,6 +20,7 @@
 
 use super::buffers::{overflow_record, record_overflow};
 use super::counters::Counters;
+use super::probe::{Overflow, ProbeEvent, Raw};
 
 /// Storage format of the LI buffer.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -143,16 +144,38 @@ impl LiTile {
     }
 
     /// `addToLIBuffer(delta)` at sample `i` (Paper I §4 line 10): a counted read-modify-write;
-    /// overflow events are counted.
+    /// overflow events are counted. Returns the values before and after and whether it
+    /// overflowed.
     #[inline]
-    pub fn add(&mut self, i: usize, delta: i32, c: &mut Counters) {
+    pub fn add(&mut self, i: usize, delta: i32, c: &mut Counters) -> (i32, i32, bool) {
         let b = self.format.bytes();
         c.color_read_bytes += b;
         c.color_write_bytes += b;
-        let (v, overflowed) = li_add(self.format, self.overflow, self.values[i], delta);
+        let before = self.values[i];
+        let (v, overflowed) = li_add(self.format, self.overflow, before, delta);
         c.overflow_events += overflowed as u64;
         record_overflow(&mut self.overflows, i, overflowed as u32);
         self.values[i] = v;
+        (before, v, overflowed)
+    }
+
+    /// A probe's record ([`super::probe`]) of an [`LiTile::add`] that returned `added`.
+    pub fn record_add(
+        &self,
+        e: ProbeEvent,
+        (before, after, overflowed): (i32, i32, bool),
+    ) -> ProbeEvent {
+        let kind = match self.overflow {
+            LiOverflow::Wrap => Overflow::Wrap,
+            LiOverflow::Saturate => Overflow::Saturate,
+        };
+        e.write(
+            "li",
+            Raw::Int(before),
+            Raw::Int(after),
+            kind,
+            overflowed as u64,
+        )
     }
 }
 

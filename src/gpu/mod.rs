@@ -7,7 +7,8 @@
 //! [`tiling`] and [`raster`] (tile traversal, parallel draw), [`depth`] and [`stencil`]
 //! (fixed-function tests and ops), [`buffers`] (typed, counted per-tile storage and
 //! hierarchical Z), [`vbuffer`] (the V-buffer formats of Paper III §4), [`pack4ub`] (8-bit values
-//! packed into 32-bit float channels, Forest et al. 2006 §4.3), [`counters`],
+//! packed into 32-bit float channels, Forest et al. 2006 §4.3), [`counters`], [`probe`] (what
+//! the passes did to one pixel),
 //! [`texture`] (texel addressing and filtering), [`color`] (colour-buffer formats) and
 //! [`light_view`] (render targets seen from a light: shadow maps and the maps built on them).
 
@@ -20,6 +21,7 @@ pub mod fixed;
 pub mod li_buffer;
 pub mod light_view;
 pub mod pack4ub;
+pub mod probe;
 pub mod raster;
 pub mod setup;
 pub mod split_blend;

@@ -8,6 +8,7 @@
 //! tests (edge functions are linear, so corners bound the whole tile).
 
 use super::counters::Counters;
+use super::probe::{PassProbe, Tap};
 use super::setup::RasterTriangle;
 use super::tiling::{TileRect, Tiling};
 use rayon::prelude::*;
@@ -142,6 +143,34 @@ where
     S: Fn(usize, &T, &RasterTriangle, &mut Counters) -> bool + Sync,
     F: Fn(usize, &mut T, &RasterTriangle, Fragment, &mut Counters) + Sync,
 {
+    draw_probed(
+        tiling,
+        tiles,
+        tris,
+        bins,
+        None,
+        skip_tile,
+        |t, storage, tri, f, c, _| fragment(t, storage, tri, f, c),
+    )
+}
+
+/// [`draw`] with a probe ([`super::probe`]): `fragment` gets a [`Tap`] for the fragments of
+/// the samples `probe` watches and `None` for every other one. The tile index is compared with
+/// the watched tiles once per tile; only in a watched tile is each fragment's sample compared.
+pub fn draw_probed<T, S, F>(
+    tiling: &Tiling,
+    tiles: &mut [T],
+    tris: &[RasterTriangle],
+    bins: &Bins,
+    probe: Option<&PassProbe>,
+    skip_tile: S,
+    fragment: F,
+) -> Counters
+where
+    T: Send,
+    S: Fn(usize, &T, &RasterTriangle, &mut Counters) -> bool + Sync,
+    F: Fn(usize, &mut T, &RasterTriangle, Fragment, &mut Counters, Option<Tap>) + Sync,
+{
     assert_eq!(tiles.len(), tiling.tile_count());
     tiles
         .par_iter_mut()
@@ -149,13 +178,20 @@ where
         .map(|(t, storage)| {
             let mut c = Counters::default();
             let rect = tiling.rect(t);
+            let watched = probe.filter(|p| p.watches_tile(t));
             for &k in &bins.tiles[t] {
                 let tri = &tris[k as usize];
                 if skip_tile(t, storage, tri, &mut c) {
                     continue;
                 }
-                let (visited, n) =
-                    rasterize_in_tile(tiling, tri, &rect, |f| fragment(t, storage, tri, f, &mut c));
+                let (visited, n) = match watched {
+                    None => rasterize_in_tile(tiling, tri, &rect, |f| {
+                        fragment(t, storage, tri, f, &mut c, None)
+                    }),
+                    Some(p) => rasterize_in_tile(tiling, tri, &rect, |f| {
+                        fragment(t, storage, tri, f, &mut c, p.tap(t, f.local))
+                    }),
+                };
                 c.tiles_visited += visited as u64;
                 c.fragments_rasterized += n;
             }

@@ -22,6 +22,7 @@
 
 use super::buffers::{overflow_record, record_overflow};
 use super::counters::Counters;
+use super::probe::{Overflow, ProbeEvent, Raw};
 
 /// The channel layout of a split value: how many upper bits of each 8-bit channel are reserved
 /// for carries.
@@ -101,6 +102,40 @@ pub struct SplitVTile {
     pub saturations: [Vec<u32>; 2],
 }
 
+/// What one [`SplitVTile::blend`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SplitBlend {
+    /// The buffer blended into.
+    pub target: SplitTarget,
+    /// Its pixel before.
+    pub before: [u8; 4],
+    /// And after.
+    pub after: [u8; 4],
+    /// Channels that saturated at 255.
+    pub saturated: u64,
+}
+
+impl SplitBlend {
+    /// The buffer's name in a probe ([`super::probe`]).
+    pub fn buffer(target: SplitTarget) -> &'static str {
+        match target {
+            SplitTarget::Add => "v-add",
+            SplitTarget::Sub => "v-sub",
+        }
+    }
+
+    /// A probe's record of this blend: the write of the target buffer.
+    pub fn record(&self, e: ProbeEvent) -> ProbeEvent {
+        e.write(
+            Self::buffer(self.target),
+            Raw::Rgba8(self.before),
+            Raw::Rgba8(self.after),
+            Overflow::Saturate,
+            self.saturated,
+        )
+    }
+}
+
 /// Which of the two buffers a contribution goes to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SplitTarget {
@@ -130,8 +165,15 @@ impl SplitVTile {
 
     /// Blend the split value `src` into sample `i` of `target`: read the destination (4 bytes),
     /// add with saturation, write (4 bytes). Every saturated channel counts one overflow event.
+    /// Returns the pixel before and after and the number of saturated channels.
     #[inline]
-    pub fn blend(&mut self, target: SplitTarget, i: usize, src: [u8; 4], c: &mut Counters) {
+    pub fn blend(
+        &mut self,
+        target: SplitTarget,
+        i: usize,
+        src: [u8; 4],
+        c: &mut Counters,
+    ) -> SplitBlend {
         let (buf, record) = match target {
             SplitTarget::Add => (&mut self.add, &mut self.saturations[0]),
             SplitTarget::Sub => (&mut self.sub, &mut self.saturations[1]),
@@ -139,11 +181,20 @@ impl SplitVTile {
         c.color_read_bytes += 4;
         c.color_write_bytes += 4;
         let dst = &mut buf[i];
+        let before = *dst;
+        let mut saturated = 0;
         for k in 0..4 {
             let (v, sat) = blend_add_u8(dst[k], src[k]);
             dst[k] = v;
-            c.overflow_events += sat as u64;
-            record_overflow(record, i, sat as u32);
+            saturated += sat as u64;
+        }
+        c.overflow_events += saturated;
+        record_overflow(record, i, saturated as u32);
+        SplitBlend {
+            target,
+            before,
+            after: *dst,
+            saturated,
         }
     }
 

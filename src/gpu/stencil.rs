@@ -42,6 +42,11 @@ impl StencilOp {
             StencilOp::Invert => (!stored, false),
         }
     }
+
+    /// Whether the op wraps modulo 256 on over/underflow (else it saturates).
+    pub fn wraps(self) -> bool {
+        matches!(self, StencilOp::IncrWrap | StencilOp::DecrWrap)
+    }
 }
 
 /// The stencil comparison (`glStencilFunc`): `(ref & mask) FUNC (stored & mask)`.
@@ -116,17 +121,23 @@ impl StencilFace {
         }
     }
 
-    /// The stored value after a fragment with the given test outcomes, and whether the op
-    /// over/underflowed. `None` means the value is unchanged (no write happens).
+    /// The op a fragment with the given test outcomes runs.
     #[inline]
-    pub fn update(&self, stored: u8, stencil_pass: bool, depth_pass: bool) -> Option<(u8, bool)> {
-        let op = if !stencil_pass {
+    pub fn op(&self, stencil_pass: bool, depth_pass: bool) -> StencilOp {
+        if !stencil_pass {
             self.stencil_fail
         } else if !depth_pass {
             self.depth_fail
         } else {
             self.depth_pass
-        };
+        }
+    }
+
+    /// The stored value after a fragment with the given test outcomes, and whether the op
+    /// over/underflowed. `None` means the value is unchanged (no write happens).
+    #[inline]
+    pub fn update(&self, stored: u8, stencil_pass: bool, depth_pass: bool) -> Option<(u8, bool)> {
+        let op = self.op(stencil_pass, depth_pass);
         if op == StencilOp::Keep || self.write_mask == 0 {
             return None;
         }

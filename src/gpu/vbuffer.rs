@@ -31,6 +31,7 @@
 
 use super::buffers::{overflow_record, record_overflow};
 use super::counters::Counters;
+use super::probe::{Overflow, ProbeEvent, Raw, Tap};
 use half::f16;
 
 /// The storage formats of a V-buffer (module doc).
@@ -47,6 +48,15 @@ pub enum VBufferFormat {
 }
 
 impl VBufferFormat {
+    /// What the overflow events an accumulation counts are: saturation for the 8-bit version,
+    /// a result that is not finite for the float formats.
+    pub fn overflow(self) -> Overflow {
+        match self {
+            VBufferFormat::Split8 => Overflow::Saturate,
+            _ => Overflow::NonFinite,
+        }
+    }
+
     /// Bytes per pixel as stored (the 8-bit version occupies an RGBA8 pixel).
     pub fn bytes(self) -> u32 {
         match self {
@@ -79,6 +89,35 @@ pub trait VBufferTile: Send {
     fn overflows(&self) -> &[u32] {
         &[]
     }
+    /// Pixel `i` as stored, for probes ([`super::probe`]; not counted).
+    fn raw(&self, i: usize) -> Raw;
+}
+
+/// [`VBufferTile::add`] that, given the watched fragment's tap and its event so far, records
+/// the write of the V-buffer there, before and after, with its overflow events
+/// ([`super::probe`]).
+#[inline]
+pub fn add_probed<V: VBufferTile>(
+    vb: &mut V,
+    i: usize,
+    delta: [f32; 3],
+    c: &mut Counters,
+    probe: Option<(Tap, ProbeEvent)>,
+) {
+    let Some((tap, e)) = probe else {
+        return vb.add(i, delta, c);
+    };
+    let (before, overflows) = (vb.raw(i), c.overflow_events);
+    vb.add(i, delta, c);
+    let kind = V::FORMAT.overflow();
+    let after = vb.raw(i);
+    tap.push(e.write(
+        "vbuffer",
+        before,
+        after,
+        kind,
+        c.overflow_events - overflows,
+    ));
 }
 
 /// One f32 per pixel (module doc).
@@ -103,6 +142,9 @@ impl VBufferTile for VBufferF32Tile {
     }
     fn resolve(&self, i: usize) -> [f32; 3] {
         [self.values[i]; 3]
+    }
+    fn raw(&self, i: usize) -> Raw {
+        Raw::f32(self.values[i])
     }
 }
 
@@ -141,6 +183,9 @@ impl VBufferTile for VBufferF16Tile {
     fn overflows(&self) -> &[u32] {
         &self.overflows
     }
+    fn raw(&self, i: usize) -> Raw {
+        Raw::F16(self.values[i].to_bits())
+    }
 }
 
 /// Three f32 per pixel (module doc).
@@ -167,6 +212,9 @@ impl VBufferTile for VBufferRgbTile {
     }
     fn resolve(&self, i: usize) -> [f32; 3] {
         self.values[i]
+    }
+    fn raw(&self, i: usize) -> Raw {
+        Raw::Channels(self.values[i].map(Raw::f32).to_vec())
     }
 }
 
@@ -227,6 +275,9 @@ impl VBufferTile for VBuffer8Tile {
     }
     fn overflows(&self) -> &[u32] {
         &self.overflows
+    }
+    fn raw(&self, i: usize) -> Raw {
+        Raw::Rg8([self.add[i], self.sub[i]])
     }
 }
 

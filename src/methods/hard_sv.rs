@@ -22,11 +22,12 @@ use super::dump::{row_major, BufferDump, DumpValues, ElementFormat, EventKind, E
 use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, BACKGROUND};
-use crate::geometry::shadow_volume::{shadow_volume_triangles, Capping};
+use crate::geometry::shadow_volume::{shadow_volume_parts, shadow_volume_triangles, Capping};
 use crate::gpu::buffers::{alloc_tiles, StencilTile};
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
-use crate::gpu::raster::{bin, draw, no_tile_culling};
+use crate::gpu::probe::Raw;
+use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
 use crate::gpu::setup::CullMode;
 use crate::gpu::stencil::{StencilFace, StencilOp, StencilState};
 use crate::options::{option_names, option_table, OptionTable, OptionType};
@@ -137,10 +138,19 @@ pub fn volume_stencil_state(test: ShadowTest, overflow: StencilOverflow) -> Sten
     }
 }
 
+/// The name of the stencil pass of shadow-volume test `test`.
+pub fn shadow_volume_pass(test: ShadowTest) -> &'static str {
+    match test {
+        ShadowTest::ZPass => "shadow-volume-zpass",
+        ShadowTest::ZFail => "shadow-volume-zfail",
+    }
+}
+
 /// Render the hard shadow volumes of every mesh from light point `light` into a fresh 8-bit
 /// stencil buffer (tile-major) against the frame's depth buffer. Returns the stencil tiles and
 /// the counters (setup + rasterization). The tiles record their overflow events per sample
-/// when the frame asks for buffer dumps ([`Frame::dump_buffers`]).
+/// when the frame asks for buffer dumps ([`Frame::dump_buffers`]). A probe attached to the
+/// frame records the clear and every fragment at its pixel ([`crate::gpu::probe`]).
 pub fn stencil_shadow(
     frame: &Frame,
     light: Vec3,
@@ -152,37 +162,61 @@ pub fn stencil_shadow(
     };
     let meshes = frame.caster_meshes();
     let prims = shadow_volume_triangles(&meshes, light, &frame.proj, capping);
+    let parts = frame
+        .probe
+        .as_ref()
+        .map(|_| shadow_volume_parts(&meshes, light, &frame.proj, capping));
     let state = volume_stencil_state(s.test, s.overflow);
     let depth = DepthState {
         func: DepthFunc::Less,
         write: false,
     };
-    let passes: Vec<CullMode> = match (s.submission, s.test) {
-        (Submission::TwoSided, _) => vec![CullMode::None],
+    let passes: Vec<(CullMode, &str)> = match (s.submission, s.test) {
+        (Submission::TwoSided, _) => vec![(CullMode::None, "")],
         // z-pass increments on front faces: draw them first (cull back), then the back faces.
-        (Submission::TwoPass, ShadowTest::ZPass) => vec![CullMode::Back, CullMode::Front],
+        (Submission::TwoPass, ShadowTest::ZPass) => vec![
+            (CullMode::Back, "/front-faces"),
+            (CullMode::Front, "/back-faces"),
+        ],
         // z-fail increments on back faces: draw them first (cull front).
-        (Submission::TwoPass, ShadowTest::ZFail) => vec![CullMode::Front, CullMode::Back],
+        (Submission::TwoPass, ShadowTest::ZFail) => vec![
+            (CullMode::Front, "/back-faces"),
+            (CullMode::Back, "/front-faces"),
+        ],
     };
     let tiling = &frame.tiling;
+    let name = shadow_volume_pass(s.test);
     let mut stencil = alloc_tiles(tiling, |_, len| {
         StencilTile::cleared(0, len).recording(frame.dump_buffers)
     });
+    frame.probe_record(name, |tap, _| tap.event().clear("stencil", Raw::U8(0)));
     let mut counters = Counters::default();
-    for cull in passes {
+    for (cull, suffix) in passes {
         let (tris, c) = setup_all(&prims, cull, tiling);
         counters += c;
         let bins = bin(tiling, &tris);
-        counters += draw(
+        let probe = frame.probe_pass(&format!("{name}{suffix}"));
+        counters += draw_probed(
             tiling,
             &mut stencil,
             &tris,
             &bins,
+            probe.as_ref(),
             no_tile_culling,
-            |t, st, tri, f, c| {
-                let (pass, _) = frame.tiles[t].depth.test(&depth, &f, c);
+            |t, st, tri, f, c, tap| {
+                let (pass, z) = frame.tiles[t].depth.test(&depth, &f, c);
                 c.depth_passed += pass as u64;
-                st.apply(&state, tri.front_facing, &f, pass, c);
+                let update = st.apply(&state, tri.front_facing, &f, pass, c);
+                if let (Some(tap), Some(parts)) = (tap, &parts) {
+                    let (kind, detail) = parts[tri.prim as usize].describe();
+                    let e = tap
+                        .event()
+                        .primitive(kind, tri.prim, detail, Some(tri.front_facing));
+                    let e = frame.tiles[t]
+                        .depth
+                        .record_test(e, depth.func, f.local, z, pass);
+                    tap.push(update.record(e, "stencil"));
+                }
             },
         );
     }
@@ -235,10 +269,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let settings = options.stencil_settings(frame, &[center]);
     let pass_start = Instant::now();
     let (tiles, counters) = stencil_shadow(frame, center, &settings);
-    let name = match settings.test {
-        ShadowTest::ZPass => "shadow-volume-zpass",
-        ShadowTest::ZFail => "shadow-volume-zfail",
-    };
+    let name = shadow_volume_pass(settings.test);
     let pass = PassStats {
         name: name.into(),
         wall_seconds: pass_start.elapsed().as_secs_f64(),
@@ -258,6 +289,16 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             }
         })
         .collect();
+    frame.probe_record("resolve", |tap, i| {
+        tap.event()
+            .read("stencil", Raw::U8(stencil[i]))
+            .resolve(&[vis[i]], false)
+            .note(if prims[i] == BACKGROUND {
+                "background: lit"
+            } else {
+                "lit where the stencil count is 0, else shadowed"
+            })
+    });
     let plan = MethodPlan {
         method: "hard-sv".into(),
         passes: vec![frame.pass.name.clone(), name.into()],

@@ -29,9 +29,23 @@ pub fn run(
     let mut outputs = Vec::with_capacity(lights);
     for k in 0..lights {
         let scene: Scene = frame.scene.with_only_light(k);
+        let _scope = frame
+            .probe
+            .as_ref()
+            .map(|p| p.enter(|s| s.light = Some(k as u32)));
         outputs.push(run_one(method, &frame.lit_by(&scene))?);
     }
     let visibility = average(outputs.iter().map(|o| &o.visibility));
+    frame.probe_record("average-lights", |tap, i| {
+        outputs
+            .iter()
+            .enumerate()
+            .fold(tap.event(), |e, (k, o)| {
+                e.value(&format!("light {k}"), o.visibility.gray(i) as f64)
+            })
+            .resolve(&visibility.channels(i), false)
+            .note(format!("mean of the {lights} lights' visibilities"))
+    });
     let clamped_pixels = outputs.iter().map(|o| o.stats.clamped_pixels).sum();
     let warnings = outputs
         .iter()

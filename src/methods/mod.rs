@@ -141,19 +141,25 @@ pub fn selected(scene: &Scene) -> Result<Vec<String>, InputError> {
             .collect()),
         Some(list) => {
             for m in list {
-                if !ALL.contains(&m.as_str()) {
-                    return Err(InputError::at(
-                        &scene.source,
-                        "methods",
-                        format!("unknown method {m:?}; known: {}", ALL.join(", ")),
-                    ));
-                }
-                if let Some(why) = unsupported_light(m, scene) {
-                    return Err(InputError::at(&scene.source, "methods", why));
-                }
+                check_method(m, scene)?;
             }
             Ok(list.clone())
         }
+    }
+}
+
+/// Check that `method` is a known method that can render every light of `scene`.
+pub fn check_method(method: &str, scene: &Scene) -> Result<(), InputError> {
+    if !ALL.contains(&method) {
+        return Err(InputError::at(
+            &scene.source,
+            "methods",
+            format!("unknown method {method:?}; known: {}", ALL.join(", ")),
+        ));
+    }
+    match unsupported_light(method, scene) {
+        Some(why) => Err(InputError::at(&scene.source, "methods", why)),
+        None => Ok(()),
     }
 }
 
@@ -436,7 +442,9 @@ fn run_raycast(frame: &Frame) -> Result<MethodOutput, InputError> {
     } else {
         frame.receivers()
     };
-    let visibility = raycast::raycast_visibility(scene, receivers, &settings);
+    let probe = frame.probe_pass("raycast");
+    let visibility =
+        raycast::raycast_visibility_probed(scene, receivers, &settings, probe.as_ref());
     let pass = PassStats {
         name: "raycast".into(),
         wall_seconds: pass_start.elapsed().as_secs_f64(),
@@ -496,31 +504,7 @@ pub fn reference_noise_floor(
                 .any(|yy| (x.saturating_sub(1)..(x + 2).min(w)).any(|xx| fractional(yy * w + xx)))
         })
         .collect();
-    let next_seed = |f: &Frame| -> Result<Visibility, InputError> {
-        let (mut settings, receiver) = raycast_options(f.scene)?;
-        settings.seed = settings.seed.wrapping_add(1);
-        let all = if receiver == ReceiverPoint::PrimaryRay {
-            f.primary_ray_receivers()
-        } else {
-            f.receivers().to_vec()
-        };
-        let some: Vec<_> = all
-            .iter()
-            .zip(&again)
-            .map(|(r, &a)| r.filter(|_| a))
-            .collect();
-        Ok(raycast::raycast_visibility(f.scene, &some, &settings))
-    };
-    let second = if frame.scene.is_multi_light() {
-        let mut per_light = Vec::new();
-        for k in 0..frame.scene.lights.len() {
-            let scene = frame.scene.with_only_light(k);
-            per_light.push(next_seed(&frame.lit_by(&scene))?);
-        }
-        light_average::average(per_light.iter())
-    } else {
-        next_seed(frame)?
-    };
+    let second = raycast_where(frame, &again, 1)?;
     let merged = match (reference, &second) {
         (Visibility::Gray(r), Visibility::Gray(s)) => Visibility::Gray(
             (0..r.len())
@@ -574,6 +558,46 @@ option_table! {
         /// a sphere light as the disk facing each receiver (the papers'), or as nsample's one disk facing the center of the mesh bounds
         sphere: SphereAs = SphereAs::FacingReceiver;
     }
+}
+
+/// `raycast` with its options but the seed advanced by `seed_offset`, evaluated only at the
+/// pixels where `mask` (row-major) is true (1 elsewhere); several lights averaged like the
+/// reference ([`light_average`]).
+pub fn raycast_where(
+    frame: &Frame,
+    mask: &[bool],
+    seed_offset: u64,
+) -> Result<Visibility, InputError> {
+    let one_light = |f: &Frame| -> Result<Visibility, InputError> {
+        let (mut settings, receiver) = raycast_options(f.scene)?;
+        settings.seed = settings.seed.wrapping_add(seed_offset);
+        let all = if receiver == ReceiverPoint::PrimaryRay {
+            f.primary_ray_receivers()
+        } else {
+            f.receivers().to_vec()
+        };
+        let some: Vec<_> = all
+            .iter()
+            .zip(mask)
+            .map(|(r, &a)| r.filter(|_| a))
+            .collect();
+        Ok(raycast::raycast_visibility(f.scene, &some, &settings))
+    };
+    if frame.scene.is_multi_light() {
+        let mut per_light = Vec::new();
+        for k in 0..frame.scene.lights.len() {
+            let scene = frame.scene.with_only_light(k);
+            per_light.push(one_light(&frame.lit_by(&scene))?);
+        }
+        Ok(light_average::average(per_light.iter()))
+    } else {
+        one_light(frame)
+    }
+}
+
+/// The light samples per pixel of the reference (`[options.raycast]`'s `samples`).
+pub fn reference_samples(scene: &Scene) -> Result<u32, InputError> {
+    Ok(raycast_options(scene)?.0.samples)
 }
 
 /// Read and check `[options.raycast]`: the settings and the receiver choice.

@@ -26,6 +26,7 @@ use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
 use crate::frame::{Frame, BACKGROUND};
 use crate::gpu::counters::Counters;
+use crate::gpu::probe::{Overflow, PrimitiveKind, Raw};
 use crate::light::sampling::{stratified, LightSample, Pattern};
 use crate::options::{option_table, OptionTable, OptionType};
 use crate::plan::{representative_light_points, BufferPlan, CountMode, MethodPlan};
@@ -100,7 +101,15 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         }
     ];
     let pass_start = Instant::now();
-    for s in &samples {
+    let f64_bits = |px: &[f64; 3]| Raw::Channels(px.map(|v| Raw::F64(v.to_bits())).to_vec());
+    frame.probe_record("accumulate", |tap, _| {
+        tap.event().clear("accumulator", f64_bits(&[0.0; 3]))
+    });
+    for (k, s) in samples.iter().enumerate() {
+        let _scope = frame
+            .probe
+            .as_ref()
+            .map(|p| p.enter(|sc| sc.sample = Some(k as u32)));
         let (stencil, c) = stencil_shadow(frame, s.position, &settings);
         counters += c;
         if frame.dump_buffers {
@@ -108,15 +117,48 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             overflows.iter_mut().zip(sample).for_each(|(a, b)| *a += b);
         }
         let w = s.weight.map(f64::from);
-        acc.par_iter_mut().zip(&stencil).for_each(|(a, st)| {
-            for (px, v) in a.iter_mut().zip(&st.values) {
-                if *v == 0 {
-                    for ch in 0..3 {
-                        px[ch] += w[ch];
-                    }
+        let add = |px: &mut [f64; 3], v: u8| {
+            if v == 0 {
+                for ch in 0..3 {
+                    px[ch] += w[ch];
                 }
             }
-        });
+        };
+        let probe = frame.probe_pass("accumulate");
+        acc.par_iter_mut()
+            .zip(&stencil)
+            .enumerate()
+            .for_each(
+                |(t, (a, st))| match probe.as_ref().filter(|p| p.watches_tile(t)) {
+                    None => a.iter_mut().zip(&st.values).for_each(|(px, v)| add(px, *v)),
+                    Some(p) => {
+                        for (i, (px, v)) in a.iter_mut().zip(&st.values).enumerate() {
+                            let before = *px;
+                            add(px, *v);
+                            if let Some(tap) = p.tap(t, i) {
+                                let e = tap
+                                    .event()
+                                    .primitive(PrimitiveKind::LightSample, k as u32, "", None)
+                                    .value("lit", (*v == 0) as u8 as f64)
+                                    .value("weight", w[0]);
+                                tap.push(e.read("stencil", Raw::U8(*v)));
+                                let e = tap.event().write(
+                                    "accumulator",
+                                    f64_bits(&before),
+                                    f64_bits(px),
+                                    Overflow::NonFinite,
+                                    0,
+                                );
+                                tap.push(e.note(if *v == 0 {
+                                    "stencil 0: the sample lights the pixel"
+                                } else {
+                                    "stencil ≠ 0: in the sample's shadow"
+                                }));
+                            }
+                        }
+                    }
+                },
+            );
     }
     let pass_name = match settings.test {
         ShadowTest::ZPass => "sample-shadow-volume-zpass",
@@ -153,6 +195,16 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
                 .collect(),
         )
     };
+    frame.probe_record("resolve", |tap, i| {
+        tap.event()
+            .read("accumulator", f64_bits(&rows[i]))
+            .resolve(&visibility.channels(i), rows[i].iter().any(|v| *v > 1.0))
+            .note(if prims[i] == BACKGROUND {
+                "background: lit"
+            } else {
+                "the lit samples' weights, clamped to [0, 1], as f32"
+            })
+    });
     let plan = MethodPlan {
         method: "nsample".into(),
         passes: vec![

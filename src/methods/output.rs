@@ -37,6 +37,14 @@ impl Visibility {
         }
     }
 
+    /// The visibility of pixel `i` per stored channel: one value for gray, three for RGB.
+    pub fn channels(&self, i: usize) -> Vec<f32> {
+        match self {
+            Visibility::Gray(v) => vec![v[i]],
+            Visibility::Rgb(v) => v[i].to_vec(),
+        }
+    }
+
     /// The visibility of pixel `i` as one value (RGB averaged with equal weights).
     pub fn gray(&self, i: usize) -> f32 {
         match self {

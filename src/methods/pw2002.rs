@@ -43,9 +43,10 @@ use crate::geometry::penumbra_wedge::{
 };
 use crate::gpu::buffers::alloc_tiles;
 use crate::gpu::depth::{DepthFunc, DepthState};
-use crate::gpu::li_buffer::{li_clamped, li_visibility, LiFormat, LiOverflow, LiTile};
-use crate::gpu::raster::{bin, draw, no_tile_culling};
-use crate::gpu::setup::CullMode;
+use crate::gpu::li_buffer::{li_clamped, li_visibility, LiFormat, LiOverflow, LiTile, LI_CLEAR};
+use crate::gpu::probe::{PrimitiveKind, ProbeEvent, Raw};
+use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
+use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::options::{option_names, option_table, OptionTable, Switch};
 use crate::plan::{eye_in_shadow, representative_light_points, BufferPlan, MethodPlan};
 use crate::scene::{LightShape, Scene};
@@ -218,7 +219,7 @@ pub fn li_row_major(frame: &Frame, tiles: &[LiTile]) -> Vec<i32> {
 pub fn resolve(frame: &Frame, li: &[i32]) -> (Visibility, Vec<bool>) {
     let prims = frame.prim_ids();
     let mut clamped = vec![false; li.len()];
-    let v = li
+    let v: Vec<f32> = li
         .iter()
         .zip(prims)
         .zip(&mut clamped)
@@ -230,6 +231,17 @@ pub fn resolve(frame: &Frame, li: &[i32]) -> (Visibility, Vec<bool>) {
             li_visibility(*v)
         })
         .collect();
+    frame.probe_record("resolve", |tap, i| {
+        let background = prims[i] == BACKGROUND;
+        tap.event()
+            .read("li", Raw::Int(li[i]))
+            .resolve(&[v[i]], !background && li_clamped(li[i]))
+            .note(if background {
+                "background: lit"
+            } else {
+                "clamp(LI, 0, 255) / 255"
+            })
+    });
     (Visibility::Gray(v), clamped)
 }
 
@@ -278,6 +290,10 @@ pub fn render_li(
     let mut li = alloc_tiles(tiling, |_, len| {
         LiTile::cleared(s.li, s.overflow, len).recording(frame.dump_buffers)
     });
+    frame.probe_record("wedges", |tap, _| {
+        tap.event().clear("li", Raw::Int(LI_CLEAR))
+    });
+    let probe = frame.probe_pass("wedges");
     let depth_state = DepthState {
         func: DepthFunc::Less,
         write: false,
@@ -285,16 +301,32 @@ pub fn render_li(
     let eye = frame.scene.camera.eye;
     let full = li_amount(1.0, s.lights);
     let far = frame.gpu.depth.far();
-    counters += draw(
+    counters += draw_probed(
         tiling,
         &mut li,
         &rt,
         &bins,
+        probe.as_ref(),
         no_tile_culling,
-        |t, tile, tri, f, c| {
+        |t, tile, tri, f, c, tap| {
             let depth = &frame.tiles[t].depth;
-            let (pass, _) = depth.test(&depth_state, &f, c);
+            let (pass, z) = depth.test(&depth_state, &f, c);
+            let event = tap.map(|tap| {
+                let wt = &tris[tri.prim as usize];
+                let e = tap.event();
+                let e = match (wt.wedge, wt.kind) {
+                    (Some(wi), Some(kind)) => wedge_primitive(e, set, wi, kind, tri),
+                    _ => e,
+                };
+                (
+                    tap,
+                    depth.record_test(e, depth_state.func, f.local, z, pass),
+                )
+            });
             if !pass {
+                if let Some((tap, e)) = event {
+                    tap.push(e.note("depth test failed: not a visible fragment"));
+                }
                 return;
             }
             c.depth_passed += 1;
@@ -330,12 +362,47 @@ pub fn render_li(
                 w.exit(eye, dir).map_or(0, |(k, t)| boundary(k, t))
             };
             let delta = v_i - v_f;
-            if delta != 0 {
-                tile.add(f.local, delta, c);
+            let added = (delta != 0).then(|| tile.add(f.local, delta, c));
+            if let Some((tap, e)) = event {
+                let e = e
+                    .value("v_f", v_f as f64)
+                    .value("v_i", v_i as f64)
+                    .value("delta", delta as f64);
+                let inside = stored != far && w.contains(p);
+                let e = e.note(if inside {
+                    "p inside the wedge: v_i at p"
+                } else {
+                    "p outside the wedge: v_i at the exit point"
+                });
+                tap.push(match added {
+                    Some(a) => tile.record_add(e, a),
+                    None => e.read("li", Raw::Int(tile.values[f.local])),
+                });
             }
         },
     );
     (li, counters)
+}
+
+/// A probe's record of the primitive of fragment `tri`, a triangle of wedge `wi`'s `kind` face
+/// (with its light when the scene has several).
+pub fn wedge_primitive(
+    e: ProbeEvent,
+    set: &WedgeSet,
+    wi: u32,
+    kind: FaceKind,
+    tri: &RasterTriangle,
+) -> ProbeEvent {
+    let e = e.primitive(
+        PrimitiveKind::Wedge,
+        wi,
+        format!("{kind:?} face, triangle {}", tri.prim),
+        Some(tri.front_facing),
+    );
+    match set.light_of_wedge(wi as usize) {
+        Some(l) if set.appended_at.len() > 1 => e.light(l),
+        _ => e,
+    }
 }
 
 /// Read and check `[options.pw2002]`.

@@ -69,8 +69,8 @@
 
 use super::output::{MethodOutput, PassStats};
 use super::pw2002::{
-    frame_wedges, li_buffer_plan, li_dump, li_row_major, resolve, MultiLight, WedgeKeys,
-    WedgeSettings,
+    frame_wedges, li_buffer_plan, li_dump, li_row_major, resolve, wedge_primitive, MultiLight,
+    WedgeKeys, WedgeSettings,
 };
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame};
@@ -80,8 +80,10 @@ use crate::geometry::penumbra_wedge::{
 };
 use crate::gpu::buffers::{alloc_tiles, StencilTile};
 use crate::gpu::counters::Counters;
-use crate::gpu::li_buffer::LiTile;
-use crate::gpu::raster::{bin, draw, Fragment};
+use crate::gpu::depth::DepthFunc;
+use crate::gpu::li_buffer::{LiTile, LI_CLEAR};
+use crate::gpu::probe::{PassProbe, PrimitiveKind, ProbeEvent, Raw};
+use crate::gpu::raster::{bin, draw_probed, Fragment};
 use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::stencil::{StencilFace, StencilOp, StencilState};
 use crate::options::{option_names, option_table, OptionTable, OptionType};
@@ -280,6 +282,50 @@ impl Ctx<'_> {
         )
     }
 
+    /// A probe's record of the primitive of fragment `tri` (wedge face, cap or umbra quad).
+    fn primitive(&self, e: ProbeEvent, tri: &RasterTriangle) -> ProbeEvent {
+        let prim = tri.prim as usize;
+        let wt = &self.tris[prim];
+        let facing = Some(tri.front_facing);
+        match (wt.wedge, wt.kind) {
+            (Some(wi), _) if prim >= self.umbra_quads_from => {
+                let e = e.primitive(
+                    PrimitiveKind::UmbraQuad,
+                    wi,
+                    format!("of degenerate wedge {wi}, triangle {prim}"),
+                    facing,
+                );
+                match self.set.light_of_wedge(wi as usize) {
+                    Some(l) if self.set.appended_at.len() > 1 => e.light(l),
+                    _ => e,
+                }
+            }
+            (Some(wi), Some(kind)) => wedge_primitive(e, self.set, wi, kind, tri),
+            _ => {
+                let e = e.primitive(PrimitiveKind::WedgeCap, tri.prim, "", facing);
+                match self.set.light_of_cap(prim) {
+                    Some(l) if self.set.appended_at.len() > 1 => e.light(l),
+                    _ => e,
+                }
+            }
+        }
+    }
+
+    /// Record (in the watched tile) that `tri`, which covers the probed pixel, was culled for
+    /// its tile before rasterization (§4).
+    fn record_culled(&self, probe: Option<&PassProbe>, t: usize, tri: &RasterTriangle, what: &str) {
+        let Some(p) = probe.filter(|p| p.watches_tile(t)) else {
+            return;
+        };
+        let [x, y] = p.probe().pixel();
+        if tri.covers(x, y) {
+            p.record(|tap| {
+                self.primitive(tap.event(), tri)
+                    .note(format!("{what} culled for the tile by zmin/zmax (§4)"))
+            });
+        }
+    }
+
     /// The penumbra amount of fragment `f` of `tri` given the stored depth and the depth test.
     fn penumbra_amount(&self, tri: &RasterTriangle, f: &Fragment, stored: u32, pass: bool) -> i32 {
         let behind_face = match self.s.test {
@@ -321,6 +367,7 @@ fn li_pass(
     rt: &[RasterTriangle],
     umbra: bool,
     penumbra: bool,
+    probe: Option<&PassProbe>,
 ) -> Counters {
     let tiling = &ctx.frame.tiling;
     let bins = bin(tiling, rt);
@@ -330,20 +377,24 @@ fn li_pass(
         let p = !(penumbra && roles.penumbra) || ctx.penumbra_culled(t, tri);
         (u, p)
     };
-    draw(
+    draw_probed(
         tiling,
         tiles,
         rt,
         &bins,
+        probe,
         |t, _, tri, c| {
             let roles = ctx.roles(tri);
             let (u, p) = culls(t, tri);
             ctx.count_tile_test();
             c.tiles_culled_hiz += (umbra && roles.umbra && u) as u64;
             c.tiles_culled_hiz += (penumbra && roles.penumbra && p) as u64;
+            if u && p {
+                ctx.record_culled(probe, t, tri, "umbra and penumbra");
+            }
             u && p
         },
-        |t, tile, tri, f, c| {
+        |t, tile, tri, f, c, tap| {
             let key = tri as *const RasterTriangle as usize;
             if tile.memo.0 != key {
                 let (u, p) = culls(t, tri);
@@ -352,9 +403,11 @@ fn li_pass(
             let (_, u_culled, p_culled) = tile.memo;
             let depth = &ctx.frame.tiles[t].depth;
             let stored = depth.read(f.local, c);
-            let pass = depth.format.quantize(f.z) < stored;
+            let z = depth.format.quantize(f.z);
+            let pass = z < stored;
             c.depth_passed += pass as u64;
             let mut delta = 0;
+            let mut umbra_delta = None;
             if !u_culled {
                 let counts = match ctx.s.test {
                     WedgeTest::ZPass => pass,
@@ -363,13 +416,36 @@ fn li_pass(
                 if counts {
                     delta += ctx.umbra_value(tri.front_facing);
                 }
+                umbra_delta = Some(delta);
             }
+            let mut penumbra_delta = None;
             if !p_culled {
                 c.fragments_shaded += 1;
-                delta += ctx.penumbra_amount(tri, &f, stored, pass);
+                let amount = ctx.penumbra_amount(tri, &f, stored, pass);
+                delta += amount;
+                penumbra_delta = Some(amount);
             }
-            if delta != 0 {
-                tile.li.add(f.local, delta, c);
+            let added = (delta != 0).then(|| tile.li.add(f.local, delta, c));
+            if let Some(tap) = tap {
+                let e = ctx.primitive(tap.event(), tri);
+                let mut e = depth.record_test(e, DepthFunc::Less, f.local, z, pass);
+                let mut notes = Vec::new();
+                let roles = ctx.roles(tri);
+                for (name, part, role) in [
+                    ("umbra", umbra_delta, umbra && roles.umbra),
+                    ("penumbra", penumbra_delta, penumbra && roles.penumbra),
+                ] {
+                    match part {
+                        Some(v) => e = e.value(name, v as f64),
+                        None if role => notes.push(format!("{name} culled for the tile (§4)")),
+                        None => {}
+                    }
+                }
+                let e = e.note(notes.join("; "));
+                tap.push(match added {
+                    Some(a) => tile.li.record_add(e, a),
+                    None => e.read("li", Raw::Int(tile.li.values[f.local])),
+                });
             }
         },
     )
@@ -430,6 +506,9 @@ pub fn render_li(
         li: LiTile::cleared(s.wedge.li, s.wedge.overflow, len).recording(frame.dump_buffers),
         memo: (0, false, false),
     });
+    frame.probe_record("clear", |tap, _| {
+        tap.event().clear("li", Raw::Int(LI_CLEAR))
+    });
     let mut stats = Vec::new();
     let mut timed = |name: &str, f: &mut dyn FnMut() -> Counters| {
         let start = Instant::now();
@@ -444,16 +523,19 @@ pub fn render_li(
     match s.passes {
         Passes::Single => timed("wedges-single-pass", &mut || {
             let (rt, mut c) = raster_triangles(&ctx, |r, _| r.umbra || r.penumbra);
-            c += li_pass(&ctx, &mut tiles, &rt, true, true);
+            let probe = frame.probe_pass("wedges-single-pass");
+            c += li_pass(&ctx, &mut tiles, &rt, true, true, probe.as_ref());
             c
         }),
         Passes::Three => {
             let mut stencil = alloc_tiles(tiling, |_, len| StencilTile::cleared(128, len));
+            frame.probe_record("clear", |tap, _| tap.event().clear("stencil", Raw::U8(128)));
             for (name, front) in [("umbra-stencil-front", true), ("umbra-stencil-back", false)] {
                 timed(name, &mut || {
                     let (rt, mut c) =
                         raster_triangles(&ctx, |r, t| r.umbra && t.front_facing == front);
-                    c += stencil_pass(&ctx, &mut stencil, &rt);
+                    let probe = frame.probe_pass(name);
+                    c += stencil_pass(&ctx, &mut stencil, &rt, probe.as_ref());
                     c
                 });
             }
@@ -462,13 +544,24 @@ pub fn render_li(
                     WedgeTest::ZPass => li_amount(1.0, s.wedge.lights),
                     WedgeTest::ZFail => -li_amount(1.0, s.wedge.lights),
                 };
+                let probe = frame.probe_pass("umbra-to-li");
                 let mut c = Counters::default();
-                for (tile, st) in tiles.iter_mut().zip(&stencil) {
+                for (t, (tile, st)) in tiles.iter_mut().zip(&stencil).enumerate() {
+                    let watched = probe.as_ref().filter(|p| p.watches_tile(t));
                     for (i, v) in st.values.iter().enumerate() {
                         c.stencil_read_bytes += 1;
                         let d = mult * (*v as i32 - 128);
-                        if d != 0 {
-                            tile.li.add(i, d, &mut c);
+                        let added = (d != 0).then(|| tile.li.add(i, d, &mut c));
+                        if let Some(tap) = watched.and_then(|p| p.tap(t, i)) {
+                            let e = tap
+                                .event()
+                                .value("stencil", *v as f64)
+                                .value("delta", d as f64);
+                            let e = e.note(format!("±255·(stencil − 128), multiplier {mult}"));
+                            tap.push(match added {
+                                Some(a) => tile.li.record_add(e, a),
+                                None => e.read("li", Raw::Int(tile.li.values[i])),
+                            });
                         }
                     }
                 }
@@ -476,7 +569,8 @@ pub fn render_li(
             });
             timed("penumbra", &mut || {
                 let (rt, mut c) = raster_triangles(&ctx, |r, _| r.penumbra);
-                c += li_pass(&ctx, &mut tiles, &rt, false, true);
+                let probe = frame.probe_pass("penumbra");
+                c += li_pass(&ctx, &mut tiles, &rt, false, true, probe.as_ref());
                 c
             });
         }
@@ -487,7 +581,12 @@ pub fn render_li(
 
 /// One stencil pass of the three-pass umbra: DECR for front-facing, INCR for back-facing
 /// fragments, on depth pass (z-pass) or depth fail (z-fail), saturating (offset 128).
-fn stencil_pass(ctx: &Ctx, stencil: &mut [StencilTile], rt: &[RasterTriangle]) -> Counters {
+fn stencil_pass(
+    ctx: &Ctx,
+    stencil: &mut [StencilTile],
+    rt: &[RasterTriangle],
+    probe: Option<&PassProbe>,
+) -> Counters {
     let keep = StencilOp::Keep;
     let state = match ctx.s.test {
         WedgeTest::ZPass => StencilState {
@@ -501,23 +600,33 @@ fn stencil_pass(ctx: &Ctx, stencil: &mut [StencilTile], rt: &[RasterTriangle]) -
     };
     let tiling = &ctx.frame.tiling;
     let bins = bin(tiling, rt);
-    draw(
+    draw_probed(
         tiling,
         stencil,
         rt,
         &bins,
+        probe,
         |t, _, tri, c| {
             let culled = ctx.umbra_culled(t, tri);
             ctx.count_tile_test();
             c.tiles_culled_hiz += culled as u64;
+            if culled {
+                ctx.record_culled(probe, t, tri, "umbra");
+            }
             culled
         },
-        |t, st, tri, f, c| {
+        |t, st, tri, f, c, tap| {
             let depth = &ctx.frame.tiles[t].depth;
             let stored = depth.read(f.local, c);
-            let pass = depth.format.quantize(f.z) < stored;
+            let z = depth.format.quantize(f.z);
+            let pass = z < stored;
             c.depth_passed += pass as u64;
-            st.apply(&state, tri.front_facing, &f, pass, c);
+            let update = st.apply(&state, tri.front_facing, &f, pass, c);
+            if let Some(tap) = tap {
+                let e = ctx.primitive(tap.event(), tri);
+                let e = depth.record_test(e, DepthFunc::Less, f.local, z, pass);
+                tap.push(update.record(e, "stencil"));
+            }
         },
     )
 }

@@ -94,6 +94,7 @@
 //! jitter (a pure function of `seed` and the stratum), hence the error of the estimate is
 //! correlated between neighbouring pixels rather than noisy.
 
+use crate::gpu::probe::{PassProbe, PrimitiveKind};
 use crate::light::sampling::{self, LightSample, Pattern};
 use crate::methods::output::Visibility;
 use crate::scene::{Light, LightShape, Scene};
@@ -816,6 +817,21 @@ pub fn raycast_visibility(
     receivers: &[Option<Receiver>],
     settings: &RaycastSettings,
 ) -> Visibility {
+    raycast_visibility_probed(scene, receivers, settings, None)
+}
+
+/// [`raycast_visibility`] recording, at the pixel `probe` watches (the pass's tiling is the
+/// image's), every shadow ray's verdict and the resolve ([`crate::gpu::probe`]).
+pub fn raycast_visibility_probed(
+    scene: &Scene,
+    receivers: &[Option<Receiver>],
+    settings: &RaycastSettings,
+    probe: Option<&PassProbe>,
+) -> Visibility {
+    let watched = probe.map(|p| {
+        let [x, y] = p.probe().pixel();
+        (p, (y * scene.width + x) as usize)
+    });
     let caster = ShadowRayCaster::new(scene);
     let light = scene.light();
     // Only sphere lights seen as the disk facing each receiver depend on the receiver; sample
@@ -831,29 +847,70 @@ pub fn raycast_visibility(
             sampling::bounding_quad(light, light.center),
         )),
     };
-    let pixel = |scratch: &mut Scratch, r: &Option<Receiver>| -> [f32; 3] {
-        match (r, &shared) {
-            (None, _) => [1.0; 3],
-            (Some(r), Some((samples, quad))) => {
-                caster.visibility_of_samples(r, samples, quad.as_ref(), scratch)
-            }
+    let pixel = |scratch: &mut Scratch, (i, r): (usize, &Option<Receiver>)| -> [f32; 3] {
+        let own;
+        let (v, samples) = match (r, &shared) {
+            (None, _) => ([1.0; 3], &[][..]),
+            (Some(r), Some((samples, quad))) => (
+                caster.visibility_of_samples(r, samples, quad.as_ref(), scratch),
+                &samples[..],
+            ),
             (Some(r), None) => {
-                let samples = light_samples(light, r.point, settings);
+                own = light_samples(light, r.point, settings);
                 let quad = sampling::bounding_quad(light, r.point);
-                caster.visibility_of_samples(r, &samples, quad.as_ref(), scratch)
+                let v = caster.visibility_of_samples(r, &own, quad.as_ref(), scratch);
+                (v, &own[..])
             }
+        };
+        if let Some((p, _)) = watched.filter(|(_, w)| *w == i) {
+            p.record(|tap| {
+                for (k, (s, lit)) in samples.iter().zip(&scratch.lit).enumerate() {
+                    let q = s.position;
+                    tap.push(
+                        tap.event()
+                            .sample(k as u32)
+                            .primitive(
+                                PrimitiveKind::LightSample,
+                                k as u32,
+                                format!("at ({}, {}, {})", q.x, q.y, q.z),
+                                None,
+                            )
+                            .value("lit", *lit as u8 as f64)
+                            .value("weight", f64::from(s.weight[0]))
+                            .note(if *lit {
+                                "the ray reaches the light"
+                            } else {
+                                "blocked"
+                            }),
+                    );
+                }
+                let channels = match light.shape {
+                    LightShape::TexturedRect { .. } => 3,
+                    _ => 1,
+                };
+                tap.event()
+                    .resolve(&v[..channels], false)
+                    .note(if r.is_none() {
+                        "background: lit"
+                    } else {
+                        "the lit samples' share of the total weight"
+                    })
+            });
         }
+        v
     };
     match light.shape {
         LightShape::TexturedRect { .. } => Visibility::Rgb(
             receivers
                 .par_iter()
+                .enumerate()
                 .map_init(Scratch::default, pixel)
                 .collect(),
         ),
         _ => Visibility::Gray(
             receivers
                 .par_iter()
+                .enumerate()
                 .map_init(Scratch::default, |s, r| pixel(s, r)[0])
                 .collect(),
         ),

@@ -59,16 +59,18 @@ use super::hard_sv::{StencilShadowSettings, Submission};
 use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, Receiver, FULL_SCREEN};
-use crate::geometry::shadow_volume::{shadow_volume_triangles, Capping};
+use crate::geometry::shadow_volume::{shadow_volume_parts, shadow_volume_triangles, Capping};
 use crate::geometry::silhouette::{light_facing, possible_silhouettes};
 use crate::geometry::ssv_wedge::{SsvWedge, WedgeLight};
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
-use crate::gpu::raster::{bin, draw, no_tile_culling};
+use crate::gpu::probe::PrimitiveKind;
+use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
 use crate::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
 use crate::gpu::transform::ClipVertex;
 use crate::gpu::vbuffer::{
-    VBuffer8Tile, VBufferF16Tile, VBufferF32Tile, VBufferFormat, VBufferRgbTile, VBufferTile,
+    add_probed, VBuffer8Tile, VBufferF16Tile, VBufferF32Tile, VBufferFormat, VBufferRgbTile,
+    VBufferTile,
 };
 use crate::light::coverage::{
     edge_coverage_exact, projected_edge_in_light, quad_side, sphere_edge_coverage_exact,
@@ -256,6 +258,9 @@ impl CoverageSource<'_> {
     }
 }
 
+/// The name of pass 1.
+const HARD_QUADS: &str = "ssv-hard-quads";
+
 /// The result of the two passes.
 pub struct SsvRender {
     /// Visibility per pixel, row-major, clamped to [0, 1]; background 1.
@@ -297,6 +302,9 @@ fn render_with<V: VBufferDump>(frame: &Frame, settings: &SsvSettings) -> SsvRend
         vbuf.iter_mut().for_each(V::record_overflows);
     }
     let mut dumps = Vec::new();
+    frame.probe_record("clear", |tap, _| {
+        tap.event().clear("vbuffer", vbuf[0].raw(0))
+    });
 
     // Pass 1: hard shadow quads, ±1 (float V-buffers) or the stencil (8-bit version).
     let t1 = Instant::now();
@@ -381,24 +389,46 @@ fn render_with<V: VBufferDump>(frame: &Frame, settings: &SsvSettings) -> SsvRend
         width: scene.width,
     };
     let bins = bin(tiling, &tris);
-    pass2 += draw(
+    let probe = frame.probe_pass("ssv-wedges");
+    pass2 += draw_probed(
         tiling,
         &mut vbuf,
         &tris,
         &bins,
+        probe.as_ref(),
         no_tile_culling,
-        |t, vb, tri, f, c| {
+        |t, vb, tri, f, c, tap| {
             frame.tiles[t].depth.read(f.local, c);
+            let k = owner[tri.prim as usize];
+            let ew = &edges[k as usize];
+            let event = tap.map(|tap| {
+                let (kind, how) = match ew.wedge {
+                    Some(_) => (PrimitiveKind::Wedge, "face"),
+                    None => (PrimitiveKind::FullScreen, "full-screen"),
+                };
+                let detail = format!("of silhouette edge {k}, {how} triangle {}", tri.prim);
+                let e = tap
+                    .event()
+                    .primitive(kind, k, detail, Some(tri.front_facing));
+                (tap, e)
+            });
             let Some(rcv) = source.receivers[(f.y * source.width + f.x) as usize] else {
+                if let Some((tap, e)) = event {
+                    tap.push(e.note("background: no receiver"));
+                }
                 return;
             };
             let p = rcv.point.as_dvec3();
-            let ew = &edges[owner[tri.prim as usize] as usize];
             if ew.wedge.as_ref().is_some_and(|w| !w.contains(p)) {
+                if let Some((tap, e)) = event {
+                    tap.push(e.note("receiver outside the wedge: discarded"));
+                }
                 return;
             }
             c.fragments_shaded += 1;
-            vb.add(f.local, source.coverage(ew, p), c);
+            let coverage = source.coverage(ew, p);
+            let event = event.map(|(tap, e)| (tap, e.value("coverage", coverage[0] as f64)));
+            add_probed(vb, f.local, coverage, c, event);
         },
     );
 
@@ -427,9 +457,11 @@ fn render_with<V: VBufferDump>(frame: &Frame, settings: &SsvSettings) -> SsvRend
     if frame.dump_buffers {
         let overflows = || row_major(tiling, &vbuf, |t| t.overflows());
         let events = match V::FORMAT {
-            VBufferFormat::F16 => EventMap::new(EventKind::NonFinite, overflows(), clamped),
-            VBufferFormat::Split8 => EventMap::new(EventKind::Saturate, overflows(), clamped),
-            _ => EventMap::clamps(clamped),
+            VBufferFormat::F16 => EventMap::new(EventKind::NonFinite, overflows(), clamped.clone()),
+            VBufferFormat::Split8 => {
+                EventMap::new(EventKind::Saturate, overflows(), clamped.clone())
+            }
+            _ => EventMap::clamps(clamped.clone()),
         };
         dumps.push(
             BufferDump::new(
@@ -450,6 +482,24 @@ fn render_with<V: VBufferDump>(frame: &Frame, settings: &SsvSettings) -> SsvRend
     } else {
         Visibility::Gray(rgb.iter().map(|v| v[0]).collect())
     };
+    frame.probe_record("resolve", |tap, i| {
+        let [x, y] = [i as u32 % tiling.width, i as u32 / tiling.width];
+        let e = tap.event().read(
+            "vbuffer",
+            vbuf[tiling.tile_of(x, y)].raw(tiling.local(x, y)),
+        );
+        let e = match &stencil {
+            Some(s) => e.value("stencil", s[i] as f64),
+            None => e,
+        };
+        e.resolve(&visibility.channels(i), clamped[i]).note(
+            match (receivers[i].is_none(), &stencil) {
+                (true, _) => "background: lit",
+                (false, Some(_)) => "1 − stencil + (R − G)/63, clamped to [0, 1]",
+                (false, None) => "the V-buffer clamped to [0, 1]",
+            },
+        )
+    });
     SsvRender {
         visibility,
         clamped_pixels,
@@ -492,28 +542,51 @@ fn hard_quads_pass<V: VBufferTile>(frame: &Frame, test: ShadowTest, vbuf: &mut [
         ShadowTest::ZFail => Capping::Capped,
     };
     let meshes = frame.caster_meshes();
-    let prims = shadow_volume_triangles(&meshes, frame.scene.light().center, &frame.proj, capping);
+    let center = frame.scene.light().center;
+    let prims = shadow_volume_triangles(&meshes, center, &frame.proj, capping);
+    let parts = frame
+        .probe
+        .as_ref()
+        .map(|_| shadow_volume_parts(&meshes, center, &frame.proj, capping));
     let (tris, mut counters) = setup_all(&prims, CullMode::None, &frame.tiling);
     let bins = bin(&frame.tiling, &tris);
     let depth = DepthState {
         func: DepthFunc::Less,
         write: false,
     };
-    counters += draw(
+    let probe = frame.probe_pass(HARD_QUADS);
+    counters += draw_probed(
         &frame.tiling,
         vbuf,
         &tris,
         &bins,
+        probe.as_ref(),
         no_tile_culling,
-        |t, vb, tri, f, c| {
-            let (pass, _) = frame.tiles[t].depth.test(&depth, &f, c);
+        |t, vb, tri, f, c, tap| {
+            let (pass, z) = frame.tiles[t].depth.test(&depth, &f, c);
             c.depth_passed += pass as u64;
+            let event = tap.zip(parts.as_ref()).map(|(tap, parts)| {
+                let (kind, detail) = parts[tri.prim as usize].describe();
+                let e = tap
+                    .event()
+                    .primitive(kind, tri.prim, detail, Some(tri.front_facing));
+                let e = frame.tiles[t]
+                    .depth
+                    .record_test(e, depth.func, f.local, z, pass);
+                (tap, e)
+            });
             let delta = match (test, pass, tri.front_facing) {
                 (ShadowTest::ZPass, true, true) | (ShadowTest::ZFail, false, false) => -1.0,
                 (ShadowTest::ZPass, true, false) | (ShadowTest::ZFail, false, true) => 1.0,
-                _ => return,
+                _ => {
+                    if let Some((tap, e)) = event {
+                        tap.push(e.read("vbuffer", vb.raw(f.local)).note("no count"));
+                    }
+                    return;
+                }
             };
-            vb.add(f.local, [delta; 3], c);
+            let event = event.map(|(tap, e)| (tap, e.value("delta", delta as f64)));
+            add_probed(vb, f.local, [delta; 3], c, event);
         },
     );
     counters
@@ -527,7 +600,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let passes = vec![
         frame.pass.clone(),
         PassStats {
-            name: "ssv-hard-quads".into(),
+            name: HARD_QUADS.into(),
             wall_seconds: r.seconds[0],
             runs: 1,
             counters: r.pass1,

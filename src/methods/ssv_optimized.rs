@@ -92,8 +92,9 @@ use crate::geometry::tight_wedge::{
 use crate::gpu::buffers::{alloc_tiles, StencilTile};
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
-use crate::gpu::raster::{bin, draw, no_tile_culling};
-use crate::gpu::setup::CullMode;
+use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw, Tap};
+use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
+use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::split_blend::{SplitFormat, SplitTarget, SplitVTile};
 use crate::gpu::stencil::{StencilFace, StencilFunc, StencilOp, StencilState};
 use crate::gpu::transform::ClipVertex;
@@ -432,6 +433,8 @@ struct HalfJob {
     reference: u8,
     /// The polyhedron (for the shader's inside test when the stencil cannot be used).
     shape: ConvexPolyhedron,
+    /// Index of the silhouette edge in the group (for probes).
+    edge_index: usize,
 }
 
 /// Per-tile storage of the method.
@@ -485,12 +488,19 @@ fn render_group(
         v: SplitVTile::cleared(full, len).recording(frame.dump_buffers),
         stencil: StencilTile::cleared(0, len),
     });
+    frame.probe_record("clear", |tap, _| {
+        tap.event().clear("v-add", Raw::Rgba8(full))
+    });
+    frame.probe_record("clear", |tap, _| {
+        tap.event().clear("v-sub", Raw::Rgba8([0; 4]))
+    });
+    frame.probe_record("clear", |tap, _| tap.event().clear("stencil", Raw::U8(0)));
     let (lo, hi) = wedge_clip_box(frame.scene);
     let c = light.center();
 
     // Wedge halves in edge order (inner, then outer).
     let mut jobs: Vec<HalfJob> = Vec::new();
-    for e in edges {
+    for (edge_index, e) in edges.iter().enumerate() {
         match s.split {
             HalfSplit::Stencil => {
                 let planes = light.wedge_halfspaces(s.tight_wedges, s.sphere_sides, e[0], e[1]);
@@ -502,6 +512,7 @@ fn render_group(
                             target: Some(target),
                             reference: 0,
                             shape,
+                            edge_index,
                         });
                     }
                 }
@@ -515,6 +526,7 @@ fn render_group(
                         target: None,
                         reference: 0,
                         shape,
+                        edge_index,
                     });
                 }
             }
@@ -543,6 +555,9 @@ fn render_group(
                 t.stencil.values.fill(0);
             }
             counters.stencil_write_bytes += frame.pixel_count() as u64;
+            frame.probe_record("stencil-clear", |tap, _| {
+                tap.event().clear("stencil", Raw::U8(0))
+            });
         }
         for (k, j) in chunk.iter().enumerate() {
             let h = (base + k) as u32;
@@ -582,15 +597,36 @@ fn render_group(
             write: false,
         };
         let zfail = s.zfail;
-        counters += draw(
+        let probe = frame.probe_pass("soft-shadow-volumes");
+        // The primitive a probe names: a hard-quad triangle or a face of wedge half `h`.
+        let primitive = |e: ProbeEvent, tri: &RasterTriangle| match roles[tri.prim as usize] {
+            Role::Quad => e.primitive(
+                PrimitiveKind::ShadowQuad,
+                tri.prim,
+                "",
+                Some(tri.front_facing),
+            ),
+            Role::Mark(h) | Role::Shade(h) | Role::ShadeTested(h) => {
+                let job = &jobs[h as usize];
+                let half = match job.target {
+                    Some(SplitTarget::Add) => "inner half",
+                    Some(SplitTarget::Sub) => "outer half",
+                    None => "whole wedge",
+                };
+                let detail = format!("{half} of silhouette edge {}", job.edge_index);
+                e.primitive(PrimitiveKind::HalfWedge, h, detail, Some(tri.front_facing))
+            }
+        };
+        counters += draw_probed(
             tiling,
             &mut tiles,
             &tris,
             &bins,
+            probe.as_ref(),
             no_tile_culling,
-            |t, st, tri, f, cnt| match roles[tri.prim as usize] {
+            |t, st, tri, f, cnt, tap| match roles[tri.prim as usize] {
                 Role::Quad => {
-                    let (pass, _) = frame.tiles[t].depth.test(&less, &f, cnt);
+                    let (pass, z) = frame.tiles[t].depth.test(&less, &f, cnt);
                     cnt.depth_passed += pass as u64;
                     // z-pass: front faces passing decrement, back faces increment.
                     // z-fail: back faces failing decrement, front faces failing increment.
@@ -599,8 +635,16 @@ fn render_group(
                         (false, true, false) | (true, false, true) => Some(SplitTarget::Add),
                         _ => None,
                     };
-                    if let Some(target) = target {
-                        st.v.blend(target, f.local, full, cnt);
+                    let blend = target.map(|target| st.v.blend(target, f.local, full, cnt));
+                    if let Some(tap) = tap {
+                        let e = primitive(tap.event(), tri);
+                        let e = frame.tiles[t]
+                            .depth
+                            .record_test(e, less.func, f.local, z, pass);
+                        tap.push(match blend {
+                            Some(b) => b.record(e.value("split value", format.full() as f64)),
+                            None => e.note("no count"),
+                        });
                     }
                 }
                 Role::Mark(h) => {
@@ -608,7 +652,7 @@ fn render_group(
                         return;
                     }
                     let job = &jobs[h as usize];
-                    let (pass, _) = frame.tiles[t].depth.test(&less, &f, cnt);
+                    let (pass, z) = frame.tiles[t].depth.test(&less, &f, cnt);
                     let face = StencilFace {
                         func: StencilFunc::Always,
                         reference: job.reference,
@@ -622,7 +666,15 @@ fn render_group(
                         front: face,
                         back: face,
                     };
-                    st.stencil.apply(&state, true, &f, pass, cnt);
+                    let update = st.stencil.apply(&state, true, &f, pass, cnt);
+                    if let Some(tap) = tap {
+                        let e = primitive(tap.event(), tri);
+                        let e = frame.tiles[t]
+                            .depth
+                            .record_test(e, less.func, f.local, z, pass);
+                        let e = e.value("reference", job.reference as f64);
+                        tap.push(update.record(e, "stencil"));
+                    }
                 }
                 Role::Shade(h) | Role::ShadeTested(h) => {
                     if tri.front_facing {
@@ -630,29 +682,55 @@ fn render_group(
                     }
                     let job = &jobs[h as usize];
                     let tested = matches!(roles[tri.prim as usize], Role::ShadeTested(_));
-                    if !tested {
-                        cnt.stencil_read_bytes += 1;
-                        if st.stencil.values[f.local] != job.reference {
-                            return;
+                    let event = tap.map(|tap| (tap, primitive(tap.event(), tri)));
+                    // Each early return records why the fragment stopped there.
+                    let stop = |e: Option<(Tap, ProbeEvent)>, why: &str| {
+                        if let Some((tap, e)) = e {
+                            tap.push(e.note(why));
                         }
-                    }
-                    let (pass, _) = frame.tiles[t].depth.test(&gequal, &f, cnt);
+                    };
+                    let event = if tested {
+                        event
+                    } else {
+                        cnt.stencil_read_bytes += 1;
+                        let stored = st.stencil.values[f.local];
+                        let event = event.map(|(tap, e)| {
+                            let e = e.value("reference", job.reference as f64);
+                            (tap, e.read("stencil", Raw::U8(stored)))
+                        });
+                        if stored != job.reference {
+                            return stop(event, "stencil ≠ reference: not in this half");
+                        }
+                        event
+                    };
+                    let (pass, z) = frame.tiles[t].depth.test(&gequal, &f, cnt);
+                    let event = event.map(|(tap, e)| {
+                        let depth = &frame.tiles[t].depth;
+                        (tap, depth.record_test(e, gequal.func, f.local, z, pass))
+                    });
                     if !pass {
-                        return;
+                        return stop(event, "receiver behind the back face");
                     }
                     cnt.depth_passed += 1;
                     let Some(p) = receivers[t][f.local] else {
-                        return;
+                        return stop(event, "background");
                     };
                     if tested && !job.shape.contains(p, 0.0) {
-                        return;
+                        return stop(event, "receiver outside the half (shader test)");
                     }
                     cnt.fragments_shaded += 1;
                     let target = job
                         .target
                         .unwrap_or_else(|| plane_split_target(light.center(), &job.edge, p));
                     let cov = light.coverage(p, job.edge[0], job.edge[1], s.coverage);
-                    st.v.blend(target, f.local, table.lookup(cov), cnt);
+                    let split = table.lookup(cov);
+                    let blend = st.v.blend(target, f.local, split, cnt);
+                    if let Some((tap, e)) = event {
+                        let e = e
+                            .value("coverage", cov)
+                            .value("split value", format.reconstruct(split) as f64);
+                        tap.push(blend.record(e));
+                    }
                 }
             },
         );
@@ -663,7 +741,17 @@ fn render_group(
         .collect();
     let values = tiling.to_row_major(&flat);
     let clamped: Vec<bool> = values.iter().map(|v| !(0.0..=1.0).contains(v)).collect();
-    let vis = values.iter().map(|v| v.clamp(0.0, 1.0) as f32).collect();
+    let vis: Vec<f32> = values.iter().map(|v| v.clamp(0.0, 1.0) as f32).collect();
+    frame.probe_record("resolve-group", |tap, i| {
+        let [x, y] = [i as u32 % tiling.width, i as u32 / tiling.width];
+        let (tile, local) = (&tiles[tiling.tile_of(x, y)].v, tiling.local(x, y));
+        tap.push(tap.event().read("v-add", Raw::Rgba8(tile.add[local])));
+        tap.event()
+            .read("v-sub", Raw::Rgba8(tile.sub[local]))
+            .value("V", values[i])
+            .resolve(&[vis[i]], clamped[i])
+            .note("(add − sub)/full, clamped to [0, 1]")
+    });
     let dumps = if frame.dump_buffers {
         split_dumps(frame, s, &tiles, &clamped)
     } else {
@@ -776,21 +864,44 @@ fn piece_visibility(
     let mut clamped = vec![false; frame.pixel_count()];
     let mut counters = Counters::default();
     let mut dumps = Vec::new();
+    frame.probe_record("overlap", |tap, _| {
+        tap.event().clear("coverage", Raw::f32(0.0))
+    });
     for (k, l) in loops.iter().enumerate() {
         let quads: Vec<[ClipVertex; 3]> = l
             .iter()
             .flat_map(|e| silhouette_quad(&frame.proj, c, e[0].as_vec3(), e[1].as_vec3()))
             .collect();
+        let scope = frame
+            .probe
+            .as_ref()
+            .map(|p| p.enter(|sc| sc.group = Some(k as u32)));
         let (v, cnt, cl, group_dumps) = render_group(frame, light, quads, l, s, receivers);
+        drop(scope);
         dumps.extend(group_dumps.into_iter().map(|mut d| {
             d.name = format!("{}-loop{k}", d.name);
             d.about = format!("silhouette loop {k} alone (§5.1): {}", d.about);
             d
         }));
         counters += cnt;
+        let before = frame.probe.as_ref().map(|_| covered.clone());
         for (acc, v) in covered.iter_mut().zip(&v) {
             *acc = overlap_combine(*acc, 1.0 - v);
         }
+        frame.probe_record("overlap", |tap, i| {
+            let before = before.as_ref().map_or(0.0, |b| b[i]);
+            tap.event()
+                .value("loop", k as f64)
+                .value("loop coverage", (1.0 - v[i]) as f64)
+                .write(
+                    "coverage",
+                    Raw::f32(before),
+                    Raw::f32(covered[i]),
+                    Overflow::Clamp,
+                    0,
+                )
+                .note("c = max(c_A, c_B) + ½·min(c_A, c_B) (§5.1 eq. 1)")
+        });
         for (a, b) in clamped.iter_mut().zip(cl) {
             *a |= b;
         }
@@ -827,7 +938,18 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let mut counters = Counters::default();
     let mut dumps = Vec::new();
     for (k, piece) in pieces.iter().enumerate() {
+        let scope = frame
+            .probe
+            .as_ref()
+            .filter(|_| pieces.len() > 1)
+            .map(|p| p.enter(|sc| sc.piece = Some(k as u32)));
         let (v, c, cl, piece_dumps) = piece_visibility(frame, piece, &s, &receivers)?;
+        drop(scope);
+        frame.probe_record("pieces", |tap, i| {
+            tap.event()
+                .value("piece", k as f64)
+                .value("visibility", v[i] as f64)
+        });
         dumps.extend(piece_dumps.into_iter().map(|mut d| {
             if pieces.len() > 1 {
                 d.name = format!("{}-piece{k}", d.name);
@@ -856,6 +978,15 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             }
         })
         .collect();
+    frame.probe_record("resolve", |tap, i| {
+        tap.event()
+            .resolve(&[vis[i]], clamped[i] && prims[i] != BACKGROUND)
+            .note(if prims[i] == BACKGROUND {
+                "background: lit".to_string()
+            } else {
+                format!("mean of {} light piece(s), clamped to [0, 1]", pieces.len())
+            })
+    });
     let pass = PassStats {
         name: "soft-shadow-volumes".into(),
         wall_seconds: pass_start.elapsed().as_secs_f64(),

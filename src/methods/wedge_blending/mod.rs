@@ -119,7 +119,8 @@ use crate::gpu::buffers::{alloc_tiles, overflow_record, record_overflow, Stencil
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::pack4ub::{FloatTarget, StoreEvents};
-use crate::gpu::raster::{bin, draw, no_tile_culling};
+use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw, Tap};
+use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
 use crate::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
 use crate::gpu::tiling::Tiling;
 use crate::gpu::transform::{ClipVertex, WindowPlane};
@@ -403,15 +404,14 @@ pub struct BlendingRender {
     pub passes: [(Counters, f64); 5],
     /// Method counters.
     pub counters: BlendingCounters,
-    /// The blend steps at the probed pixel ([`render_probed`]), in blending order.
-    pub trace: Vec<ProbeStep>,
     /// The buffer dumps of `--dump-buffers` (module doc), empty otherwise.
     pub dumps: Vec<BufferDump>,
 }
 
-/// One silhouette blended at a probed pixel: the values the blend pass read and wrote there.
+/// One silhouette blended at a probed pixel, decoded from the probe's trace ([`blend_steps`]):
+/// the values the blend pass read and wrote there.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct ProbeStep {
+pub struct BlendStep {
     /// Index of the silhouette in blending order.
     pub silhouette: usize,
     /// The mesh it belongs to.
@@ -426,9 +426,59 @@ pub struct ProbeStep {
     pub eps: [f32; PART_COUNT],
 }
 
+/// The blend steps of a probe's `events` of a render with settings `s` (the `wb-blend` pass's
+/// read of the silhouette vBuffer and write of the final vBuffer, unpacked by the storage the
+/// render used), in blending order.
+pub fn blend_steps(events: &[ProbeEvent], s: &Settings) -> Vec<BlendStep> {
+    match s.packing {
+        Packing::Bit8 => decode_steps(
+            events,
+            &Packed8 {
+                target: s.target,
+                centroid: s.centroid,
+            },
+        ),
+        Packing::F32 => decode_steps(
+            events,
+            &UnpackedF32 {
+                centroid: s.centroid,
+            },
+        ),
+    }
+}
+
+fn decode_steps<S: VBufferStorage>(events: &[ProbeEvent], storage: &S) -> Vec<BlendStep> {
+    let load = |raw: &Raw| storage.from_raw(raw).map(|px| storage.load(&px));
+    let mut silhouette = None;
+    let mut steps = Vec::new();
+    for e in events.iter().filter(|e| e.pass == PASS_NAMES[3]) {
+        let Some(b) = &e.buffer else { continue };
+        match (b.buffer.as_str(), &b.before) {
+            ("silhouette-vbuffer", Some(_)) => silhouette = load(&b.after),
+            ("final-vbuffer", Some(before)) => {
+                let (Some(sp), Some(before), Some(after), Some(p)) =
+                    (silhouette, load(before), load(&b.after), &e.primitive)
+                else {
+                    continue;
+                };
+                let value = |name: &str| e.values.iter().find(|v| v.name == name).map(|v| v.value);
+                steps.push(BlendStep {
+                    silhouette: p.index as usize,
+                    mesh: value("mesh").unwrap_or(0.0) as usize,
+                    silhouette_parts: sp,
+                    before,
+                    after,
+                    eps: std::array::from_fn(|k| value(&format!("eps{k}")).unwrap_or(0.0) as f32),
+                });
+            }
+            _ => {}
+        }
+    }
+    steps
+}
+
 /// Per-tile storage.
 struct BlendTile<P> {
-    trace: Vec<ProbeStep>,
     stencil: StencilTile,
     silhouette: Vec<P>,
     last: Vec<P>,
@@ -541,19 +591,9 @@ struct PrimRole {
     depth_tested: bool,
 }
 
-/// Render `wedge-blending` on `frame` with settings `s`.
+/// Render `wedge-blending` on `frame` with settings `s`. A probe attached to the frame records
+/// every pass at its pixel ([`crate::gpu::probe`]; the blend steps: [`blend_steps`]).
 pub fn render(frame: &Frame, s: &Settings) -> Result<BlendingRender, InputError> {
-    render_probed(frame, s, None)
-}
-
-/// [`render`], also recording every blend step at pixel `probe` = (column, row) in
-/// [`BlendingRender::trace`].
-pub fn render_probed(
-    frame: &Frame,
-    s: &Settings,
-    probe: Option<(u32, u32)>,
-) -> Result<BlendingRender, InputError> {
-    let probe = probe.map(|(x, y)| (y * frame.scene.width + x) as usize);
     let silhouettes = silhouettes(frame, s)?;
     Ok(match s.packing {
         Packing::Bit8 => render_with(
@@ -564,7 +604,6 @@ pub fn render_probed(
                 target: s.target,
                 centroid: s.centroid,
             },
-            probe,
         ),
         Packing::F32 => render_with(
             frame,
@@ -573,7 +612,6 @@ pub fn render_probed(
             &UnpackedF32 {
                 centroid: s.centroid,
             },
-            probe,
         ),
     })
 }
@@ -615,7 +653,6 @@ fn render_with<S: VBufferStorage>(
     s: &Settings,
     silhouettes: &[Silhouette],
     storage: &S,
-    probe: Option<usize>,
 ) -> BlendingRender {
     let tiling = &frame.tiling;
     let light = RectLight::from_light(frame.scene.light()).expect("options checked a rect light");
@@ -629,7 +666,6 @@ fn render_with<S: VBufferStorage>(
     let cleared = storage.cleared();
     let dumping = frame.dump_buffers;
     let mut tiles = alloc_tiles(tiling, |_, len| BlendTile {
-        trace: Vec::new(),
         stencil: StencilTile::cleared(0, len).recording(dumping),
         silhouette: vec![cleared; len],
         last: vec![cleared; len],
@@ -639,6 +675,23 @@ fn render_with<S: VBufferStorage>(
         stencil_sum: if dumping { vec![0; len] } else { Vec::new() },
         final_events: [overflow_record(dumping, len), overflow_record(dumping, len)],
     });
+    frame.probe_record("clear", |tap, _| tap.event().clear("stencil", Raw::U8(0)));
+    for buffer in ["silhouette-vbuffer", "final-vbuffer"] {
+        frame.probe_record("clear", |tap, _| {
+            tap.event().clear(buffer, storage.raw(&cleared))
+        });
+    }
+    let probes: Vec<_> = PASS_NAMES.iter().map(|p| frame.probe_pass(p)).collect();
+    // The silhouette a probe's events name.
+    let silhouette_primitive = |e: ProbeEvent, si: usize| {
+        e.primitive(
+            PrimitiveKind::Silhouette,
+            si as u32,
+            format!("of mesh {}", silhouettes[si].mesh),
+            None,
+        )
+        .value("mesh", silhouettes[si].mesh as f64)
+    };
     let mut passes = [(Counters::default(), 0.0f64); 5];
     let mut counters = BlendingCounters::default();
     let less = DepthState {
@@ -657,18 +710,32 @@ fn render_with<S: VBufferStorage>(
         let t0 = Instant::now();
         let (tris, mut c1) = setup_all(&sil.volume, CullMode::None, tiling);
         let bins = bin(tiling, &tris);
-        c1 += draw(
+        c1 += draw_probed(
             tiling,
             &mut tiles,
             &tris,
             &bins,
+            probes[0].as_ref(),
             no_tile_culling,
-            |t, tile, tri, f, cnt| {
-                let (pass, _) = frame.tiles[t].depth.test(&less, &f, cnt);
+            |t, tile, tri, f, cnt, tap| {
+                let (pass, z) = frame.tiles[t].depth.test(&less, &f, cnt);
                 cnt.depth_passed += pass as u64;
-                tile.stencil
+                let update = tile
+                    .stencil
                     .apply(&stencil_state, tri.front_facing, &f, pass, cnt);
                 tile.dirty = true;
+                if let Some(tap) = tap {
+                    let e = tap.event().primitive(
+                        PrimitiveKind::VolumeTriangle,
+                        tri.prim,
+                        format!("of silhouette {si}"),
+                        Some(tri.front_facing),
+                    );
+                    let e = frame.tiles[t]
+                        .depth
+                        .record_test(e, less.func, f.local, z, pass);
+                    tap.push(update.record(e, "stencil"));
+                }
             },
         );
         passes[0].0 += c1;
@@ -677,20 +744,40 @@ fn render_with<S: VBufferStorage>(
         // Initialization: shaded pixels get the hard count in every part.
         let t0 = Instant::now();
         passes[1].0 += on_dirty_tiles(&mut tiles, |t, tile, cnt| {
+            let watched = probes[1].as_ref().filter(|p| p.watches_tile(t));
             tile_pixels(tiling, t, |i, _| {
                 cnt.stencil_read_bytes += 1;
                 let count = tile.stencil.values[i] as i8 as i32;
                 if let Some(sum) = tile.stencil_sum.get_mut(i) {
                     *sum += count;
                 }
+                let before = tile.silhouette[i];
+                let mut clamps = 0;
                 if count != 0 {
-                    let (px, clamps) = storage.store(
+                    let (px, c) = storage.store(
                         &[PartState::hard(count); PART_COUNT],
                         &mut tile.counters.stores,
                     );
+                    clamps = c;
                     tile.silhouette[i] = px;
                     tile.counters.packing_clamps += clamps;
                     cnt.color_write_bytes += sil_bytes;
+                }
+                if let Some(tap) = watched.and_then(|p| p.tap(t, i)) {
+                    let e = silhouette_primitive(tap.event(), si).value("count", count as f64);
+                    let e = e.read("stencil", Raw::U8(tile.stencil.values[i]));
+                    if count == 0 {
+                        return tap.push(e.note("count 0: nothing stored"));
+                    }
+                    tap.push(e);
+                    let e = silhouette_primitive(tap.event(), si).write(
+                        "silhouette-vbuffer",
+                        storage.raw(&before),
+                        storage.raw(&tile.silhouette[i]),
+                        Overflow::Clamp,
+                        clamps,
+                    );
+                    tap.push(e.note("every part: occlusion = count, the whole part as rectangle"));
                 }
             });
         });
@@ -774,29 +861,51 @@ fn render_with<S: VBufferStorage>(
             );
         }
         let bins = bin(tiling, &tris);
-        c2 += draw(
+        c2 += draw_probed(
             tiling,
             &mut tiles,
             &tris,
             &bins,
+            probes[2].as_ref(),
             no_tile_culling,
-            |t, tile, tri, f, cnt| {
+            |t, tile, tri, f, cnt, tap| {
                 let role = roles[tri.prim as usize];
                 let job = &jobs[role.job as usize];
                 let depth = &frame.tiles[t].depth;
-                let stored = if !role.depth_tested {
-                    depth.read(f.local, cnt)
+                let event = tap.map(|tap| {
+                    let half = if job.inner { "inner" } else { "outer" };
+                    let detail = format!("{half} half of edge {} of silhouette {si}", job.edge);
+                    let kind = if job.full_screen {
+                        PrimitiveKind::FullScreen
+                    } else {
+                        PrimitiveKind::HalfWedge
+                    };
+                    let e = tap
+                        .event()
+                        .primitive(kind, role.job, detail, Some(tri.front_facing));
+                    (tap, e)
+                });
+                // Each rejection records why the fragment stopped there.
+                let stop = |e: Option<(Tap, ProbeEvent)>, why: &str| {
+                    if let Some((tap, e)) = e {
+                        tap.push(e.note(why));
+                    }
+                };
+                let (stored, event) = if !role.depth_tested {
+                    (depth.read(f.local, cnt), event)
                 } else {
-                    let (pass, _) = depth.test(&less, &f, cnt);
+                    let (pass, z) = depth.test(&less, &f, cnt);
+                    let event = event
+                        .map(|(tap, e)| (tap, depth.record_test(e, less.func, f.local, z, pass)));
                     if !pass {
                         tile.counters.rejected_depth += 1;
-                        return;
+                        return stop(event, "depth test failed: the receiver is in front");
                     }
                     cnt.depth_passed += 1;
-                    depth.values[f.local]
+                    (depth.values[f.local], event)
                 };
                 let Some(rcv) = receivers[(f.y * tiling.width + f.x) as usize] else {
-                    return;
+                    return stop(event, "background");
                 };
                 let z_w = frame.gpu.depth.to_window(stored);
                 if job
@@ -805,23 +914,31 @@ fn render_with<S: VBufferStorage>(
                     .any(|pl| pl.footprint_outside(f.x, f.y, z_w))
                 {
                     tile.counters.rejected_outside_planes += 1;
-                    return;
+                    return stop(event, "outside a bounding plane (Fig. 7)");
                 }
                 let [a, b] = sil.edges[job.edge];
                 let (side, p) = quads[job.edge].side(f.x, f.y, stored, rcv.point.as_dvec3(), frame);
                 if side == 0.0 || (side > 0.0) != job.inner {
                     tile.counters.rejected_quad_side += 1;
-                    return;
+                    return stop(event, "the other side of the hard quad (Fig. 8)");
                 }
                 cnt.fragments_shaded += 1;
                 tile.dirty = true;
                 let regions = edge_in_parts(&light, p, a, b);
                 if regions.iter().all(Option::is_none) {
                     tile.counters.missed_light += 1;
-                    return;
+                    return stop(event, "the edge reaches no part of the light");
                 }
                 cnt.color_read_bytes += sil_bytes;
-                let mut parts = storage.load(&tile.silhouette[f.local]);
+                let before = tile.silhouette[f.local];
+                let mut parts = storage.load(&before);
+                let event = event.map(|(tap, e)| {
+                    let areas = regions
+                        .iter()
+                        .enumerate()
+                        .filter_map(|(k, r)| r.as_ref().map(|r| (format!("area{k}"), r.area)));
+                    (tap, areas.fold(e, |e, (name, a)| e.value(&name, a)))
+                });
                 for (part, region) in parts.iter_mut().zip(&regions) {
                     let Some(r) = region else { continue };
                     tile.counters.part_updates += 1;
@@ -835,6 +952,20 @@ fn render_with<S: VBufferStorage>(
                 tile.silhouette[f.local] = px;
                 tile.counters.packing_clamps += clamps;
                 cnt.color_write_bytes += sil_bytes;
+                if let Some((tap, e)) = event {
+                    let e = e.write(
+                        "silhouette-vbuffer",
+                        storage.raw(&before),
+                        storage.raw(&px),
+                        Overflow::Clamp,
+                        clamps,
+                    );
+                    tap.push(e.note(if job.inner {
+                        "inner: the regions' areas subtracted, max X/Y raised"
+                    } else {
+                        "outer: the regions' areas added, rectangles grown"
+                    }));
+                }
             },
         );
         passes[2].0 += c2;
@@ -843,9 +974,15 @@ fn render_with<S: VBufferStorage>(
         // Pass 3: blend into the final vBuffer, then clear the silhouette vBuffer and stencil.
         let t0 = Instant::now();
         passes[3].0 += on_dirty_tiles(&mut tiles, |t, tile, cnt| {
-            tile_pixels(tiling, t, |i, g| {
+            let watched = probes[3].as_ref().filter(|p| p.watches_tile(t));
+            tile_pixels(tiling, t, |i, _| {
                 cnt.color_read_bytes += sil_bytes;
                 let sp = storage.load(&tile.silhouette[i]);
+                let tap = watched.and_then(|p| p.tap(t, i));
+                if let Some(tap) = tap {
+                    let e = silhouette_primitive(tap.event(), si);
+                    tap.push(e.read("silhouette-vbuffer", storage.raw(&tile.silhouette[i])));
+                }
                 if sp.iter().all(|p| p.occlusion == 0.0) {
                     return;
                 }
@@ -856,7 +993,6 @@ fn render_with<S: VBufferStorage>(
                 tile.counters.blended_pixels += 1;
                 cnt.color_read_bytes += fin_bytes;
                 let mut fp = storage.load(&tile.last[i]);
-                let before = fp;
                 let mut eps = [0.0; PART_COUNT];
                 for (k, (f, sp)) in fp.iter_mut().zip(&sp).enumerate() {
                     let (out, o) = blend_part(f, sp, rules);
@@ -880,17 +1016,23 @@ fn render_with<S: VBufferStorage>(
                 let specials = special(&tile.counters.stores) - before_store;
                 record_overflow(&mut tile.final_events[0], i, clamps as u32);
                 record_overflow(&mut tile.final_events[1], i, specials as u32);
-                tile.last[i] = px;
-                if probe == Some(g) {
-                    tile.trace.push(ProbeStep {
-                        silhouette: si,
-                        mesh: sil.mesh,
-                        silhouette_parts: sp,
-                        before,
-                        after: storage.load(&px),
-                        eps,
-                    });
+                if let Some(tap) = tap {
+                    let e = eps
+                        .iter()
+                        .enumerate()
+                        .fold(silhouette_primitive(tap.event(), si), |e, (k, x)| {
+                            e.value(&format!("eps{k}"), *x as f64)
+                        });
+                    let e = e.write(
+                        "final-vbuffer",
+                        storage.raw(&tile.last[i]),
+                        storage.raw(&px),
+                        Overflow::Clamp,
+                        clamps,
+                    );
+                    tap.push(e.note("A = A_f + A_s − ε per part (§3.2)"));
                 }
+                tile.last[i] = px;
                 tile.counters.packing_clamps += clamps;
                 cnt.color_write_bytes += fin_bytes;
             });
@@ -901,6 +1043,13 @@ fn render_with<S: VBufferStorage>(
             cnt.color_write_bytes += pixels * sil_bytes;
             cnt.stencil_write_bytes += pixels;
             tile.dirty = false;
+            if let Some(p) = watched {
+                p.record(|tap| tap.event().clear("stencil", Raw::U8(0)));
+                p.record(|tap| {
+                    tap.event()
+                        .clear("silhouette-vbuffer", storage.raw(&cleared))
+                });
+            }
         });
         passes[3].1 += t0.elapsed().as_secs_f64();
     }
@@ -911,10 +1060,8 @@ fn render_with<S: VBufferStorage>(
     let mut unclamped = vec![1.0f32; n];
     let mut penumbrae = vec![0u8; n];
     let mut resolve = Counters::default();
-    let mut trace = Vec::new();
     for (t, tile) in tiles.iter_mut().enumerate() {
         counters += tile.counters;
-        trace.append(&mut tile.trace);
         tile_pixels(tiling, t, |i, g| {
             penumbrae[g] = tile.penumbrae[i];
             if receivers[g].is_none() {
@@ -934,6 +1081,24 @@ fn render_with<S: VBufferStorage>(
         .collect();
     counters.clamped_pixels = clamped.iter().filter(|&&c| c).count() as u64;
     passes[4] = (resolve, t0.elapsed().as_secs_f64());
+    if let Some(p) = &probes[4] {
+        let [x, y] = p.probe().pixel();
+        let (g, t) = ((y * tiling.width + x) as usize, tiling.tile_of(x, y));
+        p.record(|tap| {
+            tap.event()
+                .read(
+                    "final-vbuffer",
+                    storage.raw(&tiles[t].last[tiling.local(x, y)]),
+                )
+                .value("unclamped", unclamped[g] as f64)
+                .resolve(&[visibility[g]], unclamped[g] != visibility[g])
+                .note(if receivers[g].is_none() {
+                    "background: lit"
+                } else {
+                    "1 − (Σ parts' occlusion)/4, clamped to [0, 1]"
+                })
+        });
+    }
     let dumps = if dumping {
         blending_dumps(frame, storage, &tiles, clamped)
     } else {
@@ -945,7 +1110,6 @@ fn render_with<S: VBufferStorage>(
         penumbrae,
         passes,
         counters,
-        trace,
         dumps,
     }
 }

@@ -28,6 +28,7 @@
 
 use super::blend::PartState;
 use crate::gpu::pack4ub::{pk4ub, up4ub, FloatTarget, StoreEvents};
+use crate::gpu::probe::Raw;
 use crate::light::radial_parts::{BoundingRect, PART_COUNT};
 use crate::methods::dump::{BufferDump, DumpValues, ElementFormat};
 
@@ -54,6 +55,11 @@ pub trait VBufferStorage: Sync {
     /// The final vBuffer's `pixels` (row-major, `size`) as buffer dumps, the one holding the
     /// occlusion last (`crate::methods::dump`, `--dump-buffers`).
     fn final_dumps(&self, pixels: &[Self::Pixel], size: (u32, u32)) -> Vec<BufferDump>;
+    /// A pixel as stored, for probes ([`crate::gpu::probe`]).
+    fn raw(&self, px: &Self::Pixel) -> Raw;
+    /// The pixel a probe recorded as `raw` ([`VBufferStorage::raw`]'s inverse); `None` for a
+    /// value of another format.
+    fn from_raw(&self, raw: &Raw) -> Option<Self::Pixel>;
 }
 
 /// The paper's packed 8-bit storage (module doc).
@@ -196,6 +202,26 @@ impl VBufferStorage for Packed8 {
             self.target
         )
     }
+
+    /// The eight packed words: the four rectangles, then the four occlusion scalars.
+    fn raw(&self, px: &Self::Pixel) -> Raw {
+        Raw::Channels(px.iter().map(|w| Raw::Word(*w)).collect())
+    }
+
+    fn from_raw(&self, raw: &Raw) -> Option<Self::Pixel> {
+        let Raw::Channels(words) = raw else {
+            return None;
+        };
+        let mut px = [0u32; 2 * PART_COUNT];
+        if words.len() != px.len() {
+            return None;
+        }
+        for (p, w) in px.iter_mut().zip(words) {
+            let Raw::Word(w) = w else { return None };
+            *p = *w;
+        }
+        Some(px)
+    }
 }
 
 impl UnpackedF32 {
@@ -256,6 +282,53 @@ impl VBufferStorage for UnpackedF32 {
             self.silhouette_bytes(),
             self.final_bytes()
         )
+    }
+
+    /// Per part the f32 bits of occlusion, left, bottom, right, top, max X, max Y and the
+    /// centroid.
+    fn raw(&self, px: &Self::Pixel) -> Raw {
+        Raw::Channels(
+            px.iter()
+                .flat_map(|p| {
+                    let r = p.rect;
+                    [p.occlusion, r.left, r.bottom, r.right, r.top]
+                        .into_iter()
+                        .chain(p.max_edge)
+                        .chain(p.centroid)
+                })
+                .map(Raw::f32)
+                .collect(),
+        )
+    }
+
+    fn from_raw(&self, raw: &Raw) -> Option<Self::Pixel> {
+        let Raw::Channels(values) = raw else {
+            return None;
+        };
+        let floats: Vec<f32> = values
+            .iter()
+            .map(|v| match v {
+                Raw::F32(b) => Some(f32::from_bits(*b)),
+                _ => None,
+            })
+            .collect::<Option<_>>()?;
+        if floats.len() != 9 * PART_COUNT {
+            return None;
+        }
+        Some(std::array::from_fn(|k| {
+            let v = &floats[9 * k..9 * k + 9];
+            PartState {
+                occlusion: v[0],
+                rect: BoundingRect {
+                    left: v[1],
+                    bottom: v[2],
+                    right: v[3],
+                    top: v[4],
+                },
+                max_edge: [v[5], v[6]],
+                centroid: [v[7], v[8]],
+            }
+        }))
     }
 }
 
@@ -329,6 +402,24 @@ mod tests {
         assert_eq!(e.nan, PART_COUNT as u64);
         assert_eq!(e.altered, PART_COUNT as u64);
         assert_ne!(s.load(&px)[0].rect, part.rect);
+    }
+
+    #[test]
+    fn probe_raw_round_trips_in_both_storages() {
+        let mut part = PartState::hard(1);
+        part.max_edge = [0.25, 0.5];
+        let parts = [part, PartState::CLEARED, PartState::hard(-1), part];
+        let mut e = StoreEvents::default();
+        let packed = Packed8 {
+            target: FloatTarget::Raw,
+            centroid: true,
+        };
+        let (px, _) = packed.store(&parts, &mut e);
+        assert_eq!(packed.from_raw(&packed.raw(&px)), Some(px));
+        let unpacked = UnpackedF32 { centroid: true };
+        let (px, _) = unpacked.store(&parts, &mut e);
+        assert_eq!(unpacked.from_raw(&unpacked.raw(&px)), Some(px));
+        assert_eq!(unpacked.from_raw(&packed.raw(&packed.cleared())), None);
     }
 
     #[test]
