@@ -9,7 +9,7 @@ use std::sync::OnceLock;
 /// The embedded font (DejaVu Sans 2.37).
 const FONT: &[u8] = include_bytes!("font/DejaVuSans.ttf");
 
-/// Registers [`FONT`] as plotters' `sans-serif` once per process. Every plot of this crate
+/// Registers the embedded font (DejaVu Sans) as plotters' `sans-serif` once per process. Every plot of this crate
 /// calls it (also the legends of buffer dumps, [`crate::output::dump`]); a program that draws
 /// with plotters through another crate (the benchmarks' criterion HTML reports) calls it
 /// first, since no system font is looked up.
