@@ -8,7 +8,8 @@
 //! (fixed-function tests and ops), [`buffers`] (typed, counted per-tile storage and
 //! hierarchical Z), [`vbuffer`] (the V-buffer formats of Paper III §4), [`pack4ub`] (8-bit values
 //! packed into 32-bit float channels, Forest et al. 2006 §4.3), [`counters`],
-//! [`texture`] (texel addressing and filtering), [`color`] (colour-buffer formats) and
+//! [`texture`] (texel addressing and filtering), [`shader_float`] (the fragment programs'
+//! scalar at the shader precision), [`color`] (colour-buffer formats) and
 //! [`light_view`] (render targets seen from a light: shadow maps and the maps built on them).
 
 pub mod buffers;
@@ -22,6 +23,7 @@ pub mod light_view;
 pub mod pack4ub;
 pub mod raster;
 pub mod setup;
+pub mod shader_float;
 pub mod split_blend;
 pub mod stencil;
 pub mod texture;
