@@ -24,6 +24,7 @@ pub mod pack4ub;
 pub mod raster;
 pub mod setup;
 pub mod shader_float;
+pub mod shader_vec;
 pub mod split_blend;
 pub mod stencil;
 pub mod texture;
