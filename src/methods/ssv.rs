@@ -13,7 +13,7 @@
 //!   paper's "negative half space"). The sum over the silhouette is Green's theorem: exact for
 //!   occluders without the single-silhouette or overlap artifacts (§5.3).
 //! * **Coverage** (`coverage`): `exact` clips the projected quad against the light
-//!   ([`edge_coverage_exact`], §3.2.2; for a sphere [`sphere_edge_coverage_exact`], below);
+//!   ([`edge_coverage_exact`](crate::light::coverage::edge_coverage_exact), §3.2.2; for a sphere [`sphere_edge_coverage_exact`], below);
 //!   `texture` looks the clipped projected edge up in the 4D coverage texture (§3.3) of
 //!   `texture-n` (8…64, default 32) with `filter` (`nearest` (default; the paper: "for normal
 //!   scenes, this filtering is not necessary"), `bilinear`, `quadrilinear`).
