@@ -14,6 +14,7 @@ use crate::gpu::probe::{PassProbe, Probe, ProbeEvent, Tap};
 use crate::gpu::raster::{bin, draw, no_tile_culling};
 pub use crate::gpu::setup::setup_all;
 use crate::gpu::setup::CullMode;
+use crate::gpu::shader_float::ShaderPrecision;
 use crate::gpu::tiling::Tiling;
 use crate::gpu::transform::{ClipVertex, Projection};
 use crate::methods::output::PassStats;
@@ -56,6 +57,8 @@ pub struct GpuSettings {
     pub tile_size: u32,
     /// Depth buffer format.
     pub depth: DepthFormat,
+    /// Arithmetic of the fragment programs ([`crate::gpu::shader_float`]).
+    pub shader: ShaderPrecision,
 }
 
 impl Default for GpuSettings {
@@ -70,6 +73,13 @@ option_names!(DepthFormat {
     D32F = "d32f",
 });
 
+option_names!(ShaderPrecision {
+    F64 = "f64",
+    Fp32 = "fp32",
+    Fp24 = "fp24",
+    Fp16 = "fp16",
+});
+
 option_table! {
     /// `[options.gpu]`: the pipeline settings of every pass ([`GpuSettings`]).
     pub struct GpuOptions["gpu"] {
@@ -77,6 +87,8 @@ option_table! {
         tile_size: PowerOfTwo [2..=256] = PowerOfTwo(crate::limits::DEFAULT_TILE_SIZE);
         /// depth format of every pass (the maps seen from a light default to it too)
         depth: DepthFormat = DepthFormat::D24;
+        /// arithmetic of the fragment programs, every operation rounded: f64, IEEE fp32, ATI R300 fp24 (7-bit exponent, 16-bit mantissa, no denormals) or IEEE fp16 (half)
+        shader: ShaderPrecision = ShaderPrecision::F64;
     }
 }
 
@@ -86,6 +98,7 @@ impl GpuOptions {
         GpuSettings {
             tile_size: self.tile_size.0,
             depth: self.depth,
+            shader: self.shader,
         }
     }
 }

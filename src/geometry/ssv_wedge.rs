@@ -40,6 +40,8 @@
 //! because the coverage it then computes for every pixel is exactly 0 outside the real
 //! penumbra volume (Paper III §3.2.2 and [`crate::light::coverage`]), only slower.
 
+use crate::gpu::shader_float::ShaderFloat;
+use crate::gpu::shader_vec::SVec3;
 use crate::gpu::transform::{ClipVertex, Projection};
 use crate::light::coverage::RectLight;
 use crate::scene::{Light, LightShape};
@@ -226,7 +228,16 @@ impl SsvWedge {
     /// Whether `p` is inside the wedge (Paper III §3.2.2 pseudo code line 4): inside all four
     /// planes (points on a plane count as inside).
     pub fn contains(&self, p: DVec3) -> bool {
-        self.planes.iter().all(|h| h.distance(p) >= 0.0)
+        self.shader_contains::<f64>(p)
+    }
+
+    /// [`SsvWedge::contains`] evaluated by a fragment program in the shader precision `T`
+    /// (`[options.gpu] shader`): the planes and `p` rounded to `T`, every operation rounded.
+    pub fn shader_contains<T: ShaderFloat>(&self, p: DVec3) -> bool {
+        let p = SVec3::<T>::from_f64(p);
+        self.planes
+            .iter()
+            .all(|h| SVec3::from_f64(h.normal).dot(p - SVec3::from_f64(h.origin)) >= T::zero())
     }
 
     /// Whether `p` is within distance `r` of the inside of every plane (a conservative test

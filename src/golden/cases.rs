@@ -13,7 +13,7 @@
 //! that change what a method computes ([`VARIANTS`]): coverage textures and their filters,
 //! V-buffer formats, LI formats and overflow, the restructured passes and culling, z-fail,
 //! textured lights, the overlap approximation, light splitting, the plane split, depth
-//! formats, tile sizes, and the wedge-blending and penumbra-map options.
+//! formats, tile sizes, shader precisions, and the wedge-blending and penumbra-map options.
 
 use super::{bless, check};
 use crate::frame::Frame;
@@ -327,6 +327,9 @@ pub const VARIANTS: &[GoldenCase] = &[
     GoldenCase::variant("cube-of-spheres", "ssv", "d32f", &[]).gpu(&[("depth", "d32f")]),
     GoldenCase::variant("cube-of-spheres", "ssv", "tile16", &[]).gpu(&[("tile-size", "16")]),
     GoldenCase::variant("cube-of-spheres", "ssv", "tile2", &[]).gpu(&[("tile-size", "2")]),
+    // Shader precision (issue 11): ssv's fragment program in ATI R300 fp24 and in fp16.
+    GoldenCase::variant("cube-of-spheres", "ssv", "shader-fp24", &[]).gpu(&[("shader", "fp24")]),
+    GoldenCase::variant("cube-of-spheres", "ssv", "shader-fp16", &[]).gpu(&[("shader", "fp16")]),
     GoldenCase::variant("cube-of-spheres", "wedge-blending", "tile32", &[])
         .gpu(&[("tile-size", "32")]),
     // wedge-blending (Forest et al. 2006): packing, knobs, float targets, order.

@@ -9,7 +9,8 @@
 //! hierarchical Z), [`vbuffer`] (the V-buffer formats of Paper III §4), [`pack4ub`] (8-bit values
 //! packed into 32-bit float channels, Forest et al. 2006 §4.3), [`counters`], [`probe`] (what
 //! the passes did to one pixel),
-//! [`texture`] (texel addressing and filtering), [`color`] (colour-buffer formats) and
+//! [`texture`] (texel addressing and filtering), [`shader_float`] (the fragment programs'
+//! scalar at the shader precision), [`color`] (colour-buffer formats) and
 //! [`light_view`] (render targets seen from a light: shadow maps and the maps built on them).
 
 pub mod buffers;
@@ -24,6 +25,8 @@ pub mod pack4ub;
 pub mod probe;
 pub mod raster;
 pub mod setup;
+pub mod shader_float;
+pub mod shader_vec;
 pub mod split_blend;
 pub mod stencil;
 pub mod texture;

@@ -29,6 +29,15 @@
 //! Paper IV §4.2.2 uses in its shader). The clipped polygon is convex; its area is the shoelace
 //! formula on the dehomogenised vertices.
 //!
+//! # Shader precision
+//!
+//! The per-fragment computations ([`shader_edge_coverage`], [`shader_quad_side`],
+//! [`shader_projected_edge_in_light`]) are generic over the fragment program's scalar
+//! ([`ShaderFloat`], `[options.gpu] shader`): the light frame, the edge and the receiver are
+//! rounded to it on input and every operation after that is rounded. The f64 functions of the
+//! same names without `shader_` are their f64 instances, used where the computation is not a
+//! fragment program (the coverage texture's precomputation, tests).
+//!
 //! # Sign (Paper III §3.2.2, pseudo code lines 6–9)
 //!
 //! The paper adds the coverage when `p` is in the negative half space of `Q` (the side that
@@ -57,9 +66,11 @@
 //! [`sector_minus_triangle`] the area and [`sphere_edge_coverage_exact`] the signed coverage.
 //! Paper III §5.3 computes this in the shader, without a coverage texture.
 
+use crate::gpu::shader_float::ShaderFloat;
+use crate::gpu::shader_vec::{SVec2, SVec3, SVec4};
 use crate::light::lookup_tables::AreaShape;
 use crate::scene::{Light, LightShape};
-use glam::{DVec2, DVec3, DVec4};
+use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
 
 /// A rectangular (parallelogram) light in f64 with its affine frame (module doc,
@@ -110,8 +121,17 @@ impl RectLight {
 
     /// The light-frame coordinates `(s, t, h)` of the world point `x`.
     pub fn local(&self, x: DVec3) -> DVec3 {
-        let d = x - self.center;
-        DVec3::new(d.dot(self.dual_u), d.dot(self.dual_v), d.dot(self.normal))
+        self.shader_local::<f64>(x).to_f64()
+    }
+
+    /// [`RectLight::local`] in the shader precision `T` (module doc, "Shader precision").
+    pub fn shader_local<T: ShaderFloat>(&self, x: DVec3) -> SVec3<T> {
+        let d = SVec3::from_f64(x) - SVec3::from_f64(self.center);
+        SVec3::new(
+            d.dot(SVec3::from_f64(self.dual_u)),
+            d.dot(SVec3::from_f64(self.dual_v)),
+            d.dot(SVec3::from_f64(self.normal)),
+        )
     }
 
     /// The world point at light-frame coordinates `(s, t, h)`.
@@ -142,38 +162,58 @@ impl RectLight {
 /// positive when `det(e0 − c, e1 − c, p − c) > 0` (module doc, "Sign"). Zero when `p` lies in
 /// the light's plane or in the plane of the quad.
 pub fn edge_coverage_exact(light: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
-    let sign = quad_side(light.center, p, e0, e1);
-    if sign == 0.0 {
-        return 0.0;
+    shader_edge_coverage::<f64>(light, p, e0, e1)
+}
+
+/// [`edge_coverage_exact`] in the shader precision `T` (module doc, "Shader precision"): the
+/// fragment program of Paper III §3.2.2.
+pub fn shader_edge_coverage<T: ShaderFloat>(
+    light: &RectLight,
+    p: DVec3,
+    e0: DVec3,
+    e1: DVec3,
+) -> T {
+    let (zero, one) = (T::zero(), T::one());
+    let sign = shader_quad_side::<T>(light.center, p, e0, e1);
+    if sign == zero {
+        return zero;
     }
-    let Some(projection) = ProjectionFromPoint::new(light, p) else {
-        return 0.0;
+    let Some(projection) = ProjectionFromPoint::<T>::new(light, p) else {
+        return zero;
     };
     // The local coordinates of e_i are also the ray directions e_i − c (the frame is centered
     // at c), so the rays' ends at infinity are the same vectors with w = 0.
-    let l0 = light.local(e0);
-    let l1 = light.local(e1);
+    let l0 = light.shader_local::<T>(e0);
+    let l1 = light.shader_local::<T>(e1);
     let quad = [
-        l0.extend(1.0),
-        l1.extend(1.0),
-        l1.extend(0.0),
-        l0.extend(0.0),
+        l0.extend(one),
+        l1.extend(one),
+        l1.extend(zero),
+        l0.extend(zero),
     ];
     let in_slab = projection.clip_to_slab(&quad);
-    let projected: Vec<DVec3> = in_slab.iter().map(|x| projection.apply(*x)).collect();
+    let projected: Vec<SVec3<T>> = in_slab.iter().map(|x| projection.apply(*x)).collect();
     sign * clipped_area_fraction(&projected)
 }
 
 /// `+1`, `−1` or `0`: the sign of `det(e0 − c, e1 − c, p − c)` for the light center `c`
 /// (module doc, "Sign"), the side of the quad's plane `p` is on.
 pub fn quad_side(c: DVec3, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
+    shader_quad_side::<f64>(c, p, e0, e1)
+}
+
+/// [`quad_side`] in the shader precision `T` (module doc, "Shader precision").
+pub fn shader_quad_side<T: ShaderFloat>(c: DVec3, p: DVec3, e0: DVec3, e1: DVec3) -> T {
+    let c = SVec3::<T>::from_f64(c);
+    let (p, e0, e1) = (SVec3::from_f64(p), SVec3::from_f64(e0), SVec3::from_f64(e1));
     let d = (e0 - c).cross(e1 - c).dot(p - c);
-    if d > 0.0 {
-        1.0
-    } else if d < 0.0 {
-        -1.0
+    let zero = T::zero();
+    if d > zero {
+        T::one()
+    } else if d < zero {
+        -T::one()
     } else {
-        0.0
+        zero
     }
 }
 
@@ -188,8 +228,24 @@ pub fn projected_edge_in_light(
     e0: DVec3,
     e1: DVec3,
 ) -> Option<[DVec2; 2]> {
-    let projection = ProjectionFromPoint::new(light, p)?;
-    let seg = [light.local(e0).extend(1.0), light.local(e1).extend(1.0)];
+    shader_projected_edge_in_light::<f64>(light, p, e0, e1).map(|e| e.map(SVec2::to_f64))
+}
+
+/// [`projected_edge_in_light`] in the shader precision `T` (module doc, "Shader precision"):
+/// the texture coordinates Paper III §3.3's fragment program computes for the coverage
+/// texture.
+pub fn shader_projected_edge_in_light<T: ShaderFloat>(
+    light: &RectLight,
+    p: DVec3,
+    e0: DVec3,
+    e1: DVec3,
+) -> Option<[SVec2<T>; 2]> {
+    let (zero, one) = (T::zero(), T::one());
+    let projection = ProjectionFromPoint::<T>::new(light, p)?;
+    let seg = [
+        light.shader_local::<T>(e0).extend(one),
+        light.shader_local::<T>(e1).extend(one),
+    ];
     let mut a = seg[0];
     let mut b = seg[1];
     for plane in projection.slab_planes() {
@@ -197,10 +253,10 @@ pub fn projected_edge_in_light(
     }
     let mut a = projection.apply(a);
     let mut b = projection.apply(b);
-    for border in LIGHT_BORDERS {
+    for border in light_borders() {
         clip_segment(&mut a, &mut b, border)?;
     }
-    if a.z <= 0.0 || b.z <= 0.0 {
+    if a.z <= zero || b.z <= zero {
         return None;
     }
     Some([a.truncate() / a.z, b.truncate() / b.z])
@@ -226,11 +282,11 @@ pub fn projected_edge_near_clipped(
     e1: DVec3,
     near_fraction: f64,
 ) -> Option<[DVec2; 2]> {
-    let projection = ProjectionFromPoint::new(light, p)?;
-    let mut a = light.local(e0).extend(1.0);
-    let mut b = light.local(e1).extend(1.0);
+    let projection = ProjectionFromPoint::<f64>::new(light, p)?;
+    let mut a = light.shader_local::<f64>(e0).extend(1.0);
+    let mut b = light.shader_local::<f64>(e1).extend(1.0);
     let [far, _] = projection.slab_planes();
-    let near = DVec4::new(
+    let near = SVec4::new(
         0.0,
         0.0,
         -projection.flip,
@@ -243,7 +299,7 @@ pub fn projected_edge_near_clipped(
     if a.z <= 0.0 || b.z <= 0.0 {
         return None;
     }
-    let (a, b) = (a.truncate() / a.z, b.truncate() / b.z);
+    let (a, b) = ((a.truncate() / a.z).to_f64(), (b.truncate() / b.z).to_f64());
     (a.is_finite() && b.is_finite()).then_some([a, b])
 }
 
@@ -273,8 +329,11 @@ pub fn segment_region(a: DVec2, b: DVec2) -> Vec<DVec2> {
     if a.perp_dot(b).abs() <= THROUGH_CENTER_ROUNDING * a.length() * b.length() {
         return Vec::new();
     }
-    let quad = [a.extend(1.0), b.extend(1.0), b.extend(0.0), a.extend(0.0)];
-    clip_to_light(&quad)
+    let quad = [a.extend(1.0), b.extend(1.0), b.extend(0.0), a.extend(0.0)].map(SVec3::from_f64);
+    clip_to_light::<f64>(&quad)
+        .into_iter()
+        .map(SVec2::to_f64)
+        .collect()
 }
 
 /// `|a × b| / (|a| |b|)` at or below which a segment's line counts as passing through the light
@@ -283,12 +342,18 @@ const THROUGH_CENTER_ROUNDING: f64 = 16.0 * f64::EPSILON;
 
 /// Unsigned area of a simple polygon (shoelace formula).
 pub fn polygon_area(poly: &[DVec2]) -> f64 {
+    let poly: Vec<SVec2<f64>> = poly.iter().map(|v| SVec2::from_f64(*v)).collect();
+    shader_polygon_area(&poly)
+}
+
+/// [`polygon_area`] in the shader precision `T`.
+fn shader_polygon_area<T: ShaderFloat>(poly: &[SVec2<T>]) -> T {
     let n = poly.len();
-    let mut twice_area = 0.0;
+    let mut twice_area = T::zero();
     for i in 0..n {
-        twice_area += poly[i].perp_dot(poly[(i + 1) % n]);
+        twice_area = twice_area + poly[i].perp_dot(poly[(i + 1) % n]);
     }
-    (0.5 * twice_area).abs()
+    (T::from_f64(0.5) * twice_area).abs()
 }
 
 /// The part of a convex polygon inside the axis-aligned box `[lo, hi]` (Sutherland–Hodgman).
@@ -471,37 +536,38 @@ pub fn exact_sector_minus_triangle(a: DVec2, b: DVec2, shape: AreaShape) -> f64 
 
 /// The central projection from a receiver point onto the light plane in the light frame
 /// (module doc, "Representation"), with `h_p > 0` (the frame is flipped for points below the
-/// light plane).
-struct ProjectionFromPoint {
+/// light plane), in the shader precision `T`.
+struct ProjectionFromPoint<T> {
     /// `(p_s, p_t, h_p)` with `h_p > 0`.
-    p: DVec3,
+    p: SVec3<T>,
     /// `−1` when the `h` axis was flipped so that `h_p > 0`, else `1`.
-    flip: f64,
+    flip: T,
 }
 
-impl ProjectionFromPoint {
+impl<T: ShaderFloat> ProjectionFromPoint<T> {
     fn new(light: &RectLight, p: DVec3) -> Option<Self> {
-        let lp = light.local(p);
-        if lp.z == 0.0 || !lp.is_finite() {
+        let lp = light.shader_local::<T>(p);
+        if lp.z == T::zero() || !lp.is_finite() {
             return None;
         }
         let flip = lp.z.signum();
         Some(ProjectionFromPoint {
-            p: DVec3::new(lp.x, lp.y, lp.z * flip),
+            p: SVec3::new(lp.x, lp.y, lp.z * flip),
             flip,
         })
     }
 
     /// The slab planes `h ≥ 0` and `h_p·w − h ≥ 0` as functionals on `(s, t, h, w)` with `h`
     /// already in the caller's (unflipped) frame.
-    fn slab_planes(&self) -> [DVec4; 2] {
+    fn slab_planes(&self) -> [SVec4<T>; 2] {
+        let zero = T::zero();
         [
-            DVec4::new(0.0, 0.0, self.flip, 0.0),
-            DVec4::new(0.0, 0.0, -self.flip, self.p.z),
+            SVec4::new(zero, zero, self.flip, zero),
+            SVec4::new(zero, zero, -self.flip, self.p.z),
         ]
     }
 
-    fn clip_to_slab(&self, poly: &[DVec4]) -> Vec<DVec4> {
+    fn clip_to_slab(&self, poly: &[SVec4<T>]) -> Vec<SVec4<T>> {
         let mut out = poly.to_vec();
         for plane in self.slab_planes() {
             out = clip_polygon(&out, |x| plane.dot(x));
@@ -510,9 +576,9 @@ impl ProjectionFromPoint {
     }
 
     /// `(s, t, h, w) ↦ (S, T, W)`: homogeneous light-plane coordinates of the projection.
-    fn apply(&self, x: DVec4) -> DVec3 {
+    fn apply(&self, x: SVec4<T>) -> SVec3<T> {
         let h = x.z * self.flip;
-        DVec3::new(
+        SVec3::new(
             x.x * self.p.z - self.p.x * h,
             x.y * self.p.z - self.p.y * h,
             x.w * self.p.z - h,
@@ -522,53 +588,53 @@ impl ProjectionFromPoint {
 
 /// The four light borders `W − S ≥ 0`, `W + S ≥ 0`, `W − T ≥ 0`, `W + T ≥ 0` on homogeneous
 /// light-plane coordinates `(S, T, W)`.
-const LIGHT_BORDERS: [fn(DVec3) -> f64; 4] =
-    [|x| x.z - x.x, |x| x.z + x.x, |x| x.z - x.y, |x| x.z + x.y];
+fn light_borders<T: ShaderFloat>() -> [fn(SVec3<T>) -> T; 4] {
+    [|x| x.z - x.x, |x| x.z + x.x, |x| x.z - x.y, |x| x.z + x.y]
+}
 
 /// Clip a homogeneous polygon `(S, T, W)` to the light square and return its area / 4 (the
 /// square's area in light coordinates), unsigned, at most 1: the clipped polygon lies in the
 /// square, but where its `W` are tiny beside their rounding (a receiver 10⁻⁹ above the light's
 /// plane and 10 to the side of it) dividing by them can put vertices outside it (found by
 /// fuzzing: a coverage of −1.64).
-fn clipped_area_fraction(poly: &[DVec3]) -> f64 {
-    (polygon_area(&clip_to_light(poly)) / 4.0).min(1.0)
+fn clipped_area_fraction<T: ShaderFloat>(poly: &[SVec3<T>]) -> T {
+    (shader_polygon_area(&clip_to_light(poly)) / T::from_f64(4.0)).min(T::one())
 }
 
 /// Clip a homogeneous polygon `(S, T, W)` to the light square and dehomogenise it (vertices
 /// with `W = 0` left by the clip are the zero vector and are dropped).
-fn clip_to_light(poly: &[DVec3]) -> Vec<DVec2> {
+fn clip_to_light<T: ShaderFloat>(poly: &[SVec3<T>]) -> Vec<SVec2<T>> {
     let mut out = poly.to_vec();
-    for border in LIGHT_BORDERS {
+    for border in light_borders() {
         out = clip_polygon(&out, border);
         if out.is_empty() {
             return Vec::new();
         }
     }
     out.iter()
-        .filter(|x| x.z > 0.0)
+        .filter(|x| x.z > T::zero())
         .map(|x| x.truncate() / x.z)
         .collect()
 }
 
 /// One Sutherland–Hodgman step: keep the part of `poly` where `dist ≥ 0`.
-fn clip_polygon<V, F>(poly: &[V], dist: F) -> Vec<V>
+fn clip_polygon<V, T, F>(poly: &[V], dist: F) -> Vec<V>
 where
-    V: Copy
-        + std::ops::Sub<Output = V>
-        + std::ops::Add<Output = V>
-        + std::ops::Mul<f64, Output = V>,
-    F: Fn(V) -> f64,
+    V: Copy + std::ops::Sub<Output = V> + std::ops::Add<Output = V> + std::ops::Mul<T, Output = V>,
+    T: ShaderFloat,
+    F: Fn(V) -> T,
 {
+    let zero = T::zero();
     let n = poly.len();
     let mut out = Vec::with_capacity(n + 2);
     for i in 0..n {
         let a = poly[i];
         let b = poly[(i + 1) % n];
         let (da, db) = (dist(a), dist(b));
-        if da >= 0.0 {
+        if da >= zero {
             out.push(a);
         }
-        if (da >= 0.0) != (db >= 0.0) {
+        if (da >= zero) != (db >= zero) {
             out.push(a + (b - a) * (da / (da - db)));
         }
     }
@@ -576,16 +642,15 @@ where
 }
 
 /// Clip the segment `a b` to `dist ≥ 0` in place; `None` when nothing is left.
-fn clip_segment<V, F>(a: &mut V, b: &mut V, dist: F) -> Option<()>
+fn clip_segment<V, T, F>(a: &mut V, b: &mut V, dist: F) -> Option<()>
 where
-    V: Copy
-        + std::ops::Sub<Output = V>
-        + std::ops::Add<Output = V>
-        + std::ops::Mul<f64, Output = V>,
-    F: Fn(V) -> f64,
+    V: Copy + std::ops::Sub<Output = V> + std::ops::Add<Output = V> + std::ops::Mul<T, Output = V>,
+    T: ShaderFloat,
+    F: Fn(V) -> T,
 {
+    let zero = T::zero();
     let (da, db) = (dist(*a), dist(*b));
-    match (da >= 0.0, db >= 0.0) {
+    match (da >= zero, db >= zero) {
         (true, true) => Some(()),
         (false, false) => None,
         (true, false) => {

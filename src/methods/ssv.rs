@@ -13,7 +13,7 @@
 //!   paper's "negative half space"). The sum over the silhouette is Green's theorem: exact for
 //!   occluders without the single-silhouette or overlap artifacts (§5.3).
 //! * **Coverage** (`coverage`): `exact` clips the projected quad against the light
-//!   ([`edge_coverage_exact`], §3.2.2; for a sphere [`sphere_edge_coverage_exact`], below);
+//!   ([`edge_coverage_exact`](crate::light::coverage::edge_coverage_exact), §3.2.2; for a sphere [`sphere_edge_coverage_exact`], below);
 //!   `texture` looks the clipped projected edge up in the 4D coverage texture (§3.3) of
 //!   `texture-n` (8…64, default 32) with `filter` (`nearest` (default; the paper: "for normal
 //!   scenes, this filtering is not necessary"), `bilinear`, `quadrilinear`).
@@ -24,6 +24,14 @@
 //!   to n×n), the V-buffer RGB f32, and the visibility RGB. `coverage = texture` is required
 //!   and is the default for them; the 8-bit V-buffer is grey only ("only one component could be
 //!   used", §4.2) and is rejected for textured lights.
+//!
+//! * **Shader precision** (`[options.gpu] shader`, [`crate::gpu::shader_float`]): pass 2's
+//!   fragment program — the wedge's inside test (its four plane evaluations), the exact
+//!   coverage of a rectangle (the clipping and area arithmetic,
+//!   [`crate::light::coverage::shader_edge_coverage`]) and, with `coverage = texture`, the
+//!   texture coordinates (the clipped projected edge) and the sign applied to the fetched
+//!   value — runs in the chosen precision; the texture unit's addressing and filtering stay
+//!   as they are. The sphere's coverage is not converted yet and stays in f64.
 //!
 //! Choices where the paper is silent:
 //! * The receiver point of a pixel is the depth-buffer point ([`Frame::receivers`]), the same
@@ -67,13 +75,15 @@ use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::probe::PrimitiveKind;
 use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
 use crate::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
+use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::transform::ClipVertex;
 use crate::gpu::vbuffer::{
     add_probed, VBuffer8Tile, VBufferF16Tile, VBufferF32Tile, VBufferFormat, VBufferRgbTile,
     VBufferTile,
 };
 use crate::light::coverage::{
-    edge_coverage_exact, projected_edge_in_light, quad_side, sphere_edge_coverage_exact,
+    shader_edge_coverage, shader_projected_edge_in_light, shader_quad_side,
+    sphere_edge_coverage_exact,
 };
 use crate::light::coverage_texture::{
     coverage_texture, CoverageFilter, CoverageTexture, CoverageTextureKey, DEFAULT_N, MAX_N, MIN_N,
@@ -237,8 +247,9 @@ struct CoverageSource<'a> {
 }
 
 impl CoverageSource<'_> {
-    /// The signed per-channel coverage of edge `w` at `p` (module doc).
-    fn coverage(&self, w: &EdgeWedge, p: DVec3) -> [f32; 3] {
+    /// The signed per-channel coverage of edge `w` at `p` (module doc), computed in the shader
+    /// precision `T` (module doc, "Shader precision").
+    fn coverage<T: ShaderFloat>(&self, w: &EdgeWedge, p: DVec3) -> [f32; 3] {
         let light = match self.light {
             WedgeLight::Rect(light) => light,
             WedgeLight::Sphere { center, radius } => {
@@ -247,13 +258,15 @@ impl CoverageSource<'_> {
         };
         match (self.mode, &self.texture) {
             (CoverageMode::Texture { filter, .. }, Some(t)) => {
-                let Some([a, b]) = projected_edge_in_light(&light, p, w.e0, w.e1) else {
+                let Some([a, b]) = shader_projected_edge_in_light::<T>(&light, p, w.e0, w.e1)
+                else {
                     return [0.0; 3];
                 };
-                let s = quad_side(light.center, p, w.e0, w.e1);
-                t.lookup(a, b, filter).map(|v| (s * v) as f32)
+                let s = shader_quad_side::<T>(light.center, p, w.e0, w.e1);
+                t.lookup(a.to_f64(), b.to_f64(), filter)
+                    .map(|v| (s * T::from_f64(v)).to_f64() as f32)
             }
-            _ => [edge_coverage_exact(&light, p, w.e0, w.e1) as f32; 3],
+            _ => [shader_edge_coverage::<T>(&light, p, w.e0, w.e1).to_f64() as f32; 3],
         }
     }
 }
@@ -282,15 +295,15 @@ pub struct SsvRender {
 /// Render `ssv` with `settings` on `frame` (the light must be a rectangle or a sphere, with
 /// exact coverage for a sphere: [`read_settings`] checks both).
 pub fn render(frame: &Frame, settings: &SsvSettings) -> SsvRender {
-    match settings.vbuffer {
-        VBufferFormat::F32 => render_with::<VBufferF32Tile>(frame, settings),
-        VBufferFormat::F16 => render_with::<VBufferF16Tile>(frame, settings),
-        VBufferFormat::RgbF32 => render_with::<VBufferRgbTile>(frame, settings),
-        VBufferFormat::Split8 => render_with::<VBuffer8Tile>(frame, settings),
-    }
+    crate::with_shader_float!(frame.gpu.shader, T => match settings.vbuffer {
+        VBufferFormat::F32 => render_with::<VBufferF32Tile, T>(frame, settings),
+        VBufferFormat::F16 => render_with::<VBufferF16Tile, T>(frame, settings),
+        VBufferFormat::RgbF32 => render_with::<VBufferRgbTile, T>(frame, settings),
+        VBufferFormat::Split8 => render_with::<VBuffer8Tile, T>(frame, settings),
+    })
 }
 
-fn render_with<V: VBufferDump>(frame: &Frame, settings: &SsvSettings) -> SsvRender {
+fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSettings) -> SsvRender {
     let scene = frame.scene;
     let tiling = &frame.tiling;
     let light = WedgeLight::from_light(scene.light()).expect("ssv supports rects and spheres");
@@ -419,14 +432,18 @@ fn render_with<V: VBufferDump>(frame: &Frame, settings: &SsvSettings) -> SsvRend
                 return;
             };
             let p = rcv.point.as_dvec3();
-            if ew.wedge.as_ref().is_some_and(|w| !w.contains(p)) {
+            if ew
+                .wedge
+                .as_ref()
+                .is_some_and(|w| !w.shader_contains::<T>(p))
+            {
                 if let Some((tap, e)) = event {
                     tap.push(e.note("receiver outside the wedge: discarded"));
                 }
                 return;
             }
             c.fragments_shaded += 1;
-            let coverage = source.coverage(ew, p);
+            let coverage = source.coverage::<T>(ew, p);
             let event = event.map(|(tap, e)| (tap, e.value("coverage", coverage[0] as f64)));
             add_probed(vb, f.local, coverage, c, event);
         },
