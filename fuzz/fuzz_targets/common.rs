@@ -559,9 +559,14 @@ fn quad_plane_sine(c: DVec3, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
 /// `e` are `S = s_e·h_p − s_p·h_e` (T likewise) and `W = h_p − h_e` (its ray: `W = −h_e`; where
 /// the slab cuts the ray: `W = 0`), each computed with an error of ε times the size of its
 /// terms, and interpolates between them, which carries that error over to the smallest of
-/// them. The condition is the largest terms over the smallest such coordinate (|S, T| or |W|,
-/// or `h_p`, the slab's thickness). Infinite (or NaN) when `p` or an end is in the light's plane, an end
-/// is at `p`'s level or projects onto the light center.
+/// them. That is the largest terms over the smallest such coordinate (|S, T| or |W|, or `h_p`,
+/// the slab's thickness), times the [`end_on`] factor: where the slab cuts the edge at `p`'s
+/// level, the clipped point is the direction from `p` to the edge's point there, a difference
+/// of points at least `p`'s distance from the edge's line apart, whose direction the border
+/// clips then follow (found by fuzzing: a receiver on the edge, λ = 0, whose clipped point at
+/// its level was `p` itself to rounding, gave a projected point at t = −2). Infinite (or NaN)
+/// when `p` or an end is in the light's plane, an end is at `p`'s level or projects onto the
+/// light center, or `p` is on the edge's line.
 fn rect_condition(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
     let lp = l.local(p);
     let (mut terms, mut smallest) = (0.0f64, f64::INFINITY);
@@ -578,7 +583,15 @@ fn rect_condition(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
             .min(le.z.abs())
             .min(lp.z.abs());
     }
-    terms / smallest
+    terms / smallest * end_on(p, e0, e1).max(1.0)
+}
+
+/// 1 / the sine of the angle the edge `e0 e1` subtends at `p` (`|e0 − p|·|e1 − p| / |(e0 − p) ×
+/// (e1 − p)|`): how nearly `p` sees the edge end-on, its line running through `p`. Infinite
+/// (or NaN) when `p` is on the edge's line.
+fn end_on(p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
+    let (a, b) = (e0 - p, e1 - p);
+    a.length() * b.length() / a.cross(b).length()
 }
 
 /// How much the light space of [`clip_to_light_cone`] amplifies rounding for the edge `e0 e1`
@@ -588,14 +601,18 @@ fn rect_condition(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
 /// runs through the cone's apex and the cone's quadratic degenerates). Infinite when an end is
 /// at `p`'s level or `p` is on the edge's line.
 fn sphere_condition(center: DVec3, radius: f64, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
+    sphere_end_factor(center, radius, p, e0, e1).max(end_on(p, e0, e1))
+}
+
+/// The largest of [`sphere_condition`]'s per-end factors (at least 1): an end's offset from the
+/// center in radii over its height above `p`'s level as a fraction of the light's.
+fn sphere_end_factor(center: DVec3, radius: f64, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
     let w = center - p;
     let dist = w.length();
-    let (a, b) = (e0 - p, e1 - p);
-    let end_on = a.length() * b.length() / a.cross(b).length();
     [e0, e1]
         .iter()
         .map(|e| (1.0 + (*e - center).length() / radius) / ((*e - p).dot(w) / dist / dist).abs())
-        .fold(end_on, f64::max)
+        .fold(1.0, f64::max)
 }
 
 /// How much [`clip_to_light_cone`] amplifies rounding in its chord's ends: the product of
@@ -610,15 +627,7 @@ fn sphere_condition(center: DVec3, radius: f64, p: DVec3, e0: DVec3, e1: DVec3) 
 /// scene 2¹²⁶ times larger (radius 0.085 instead of 10⁻³⁹), as f64 scaling by a power of two
 /// is exact: rounding in the geometry, not subnormals.
 fn sphere_chord_condition(center: DVec3, radius: f64, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
-    let w = center - p;
-    let dist = w.length();
-    let (a, b) = (e0 - p, e1 - p);
-    let end_on = a.length() * b.length() / a.cross(b).length();
-    let ends = [e0, e1]
-        .iter()
-        .map(|e| (1.0 + (*e - center).length() / radius) / ((*e - p).dot(w) / dist / dist).abs())
-        .fold(1.0, f64::max);
-    end_on.max(1.0) * ends
+    end_on(p, e0, e1).max(1.0) * sphere_end_factor(center, radius, p, e0, e1)
 }
 
 /// [`rect_condition`] or [`sphere_condition`] for `light`.

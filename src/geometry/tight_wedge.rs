@@ -465,7 +465,26 @@ pub fn hull_halfspaces(center: DVec3, apex: [DVec3; 2], corners: [&[DVec3]; 2]) 
             }
         }
     }
-    out
+    // Two facets with opposite normals would hold both pyramids in a slab, which pyramids
+    // opening across it cannot fit: every ray then lies on the plane within the tolerance, on
+    // a side the facet test cannot tell, and both are left out (found by fuzzing: a rectangle
+    // 7·10¹³ long and 60 wide 1.8·10⁹ from the edge, whose corners' rays lie 6·10⁻¹³ of their
+    // length off one plane while the rays from its middle spread 2.4·10⁻⁸ rad across it, got a
+    // slab 0.25 thick between the apexes' levels, which clipping to a 10³⁸ box lost).
+    let opposed: Vec<bool> = out
+        .iter()
+        .map(|h| out.iter().any(|o| nearly_antiparallel(o, h)))
+        .collect();
+    out.into_iter()
+        .zip(opposed)
+        .filter_map(|(h, opposed)| (!opposed).then_some(h))
+        .collect()
+}
+
+/// Whether two half-spaces' outward normals are opposite within 10⁻⁹ rad, the largest
+/// tolerance of [`hull_halfspaces`]' facet test.
+fn nearly_antiparallel(a: &HalfSpace, b: &HalfSpace) -> bool {
+    a.normal.dot(b.normal) < 0.0 && a.normal.cross(b.normal).length() <= 1e-9
 }
 
 /// Whether two half-spaces' outward normals are within 1.4·10⁻⁶ rad (`n·n' > 1 − 10⁻¹²`). Two
@@ -1094,6 +1113,41 @@ mod tests {
             for edge_point in [a, b, (a + b) * 0.5] {
                 let p = edge_point + (edge_point - *light_point) * 400.0;
                 assert!(whole.contains(p, 1e-8 * size), "{p} outside {whole:?}");
+            }
+        }
+    }
+
+    /// A rectangle 7·10¹³ long and 60 wide whose middle passes 1.8·10⁹ from the edge (found
+    /// by fuzzing): its corners' rays lie within 6·10⁻¹³ of their length of one plane, within
+    /// the facet tolerance, so that plane was kept through one apex and, opposite, through the
+    /// other, a slab 0.25 thick, while the rays from the light's middle spread 2.4·10⁻⁸ rad
+    /// across it. Every point on a ray from a light point through the edge must be inside every
+    /// facet (up to the tolerance, 10⁻⁹ of its distance).
+    #[test]
+    fn long_thin_light_does_not_make_a_slab() {
+        let c = DVec3::new(-2.75, -14.5576171875, 274408144896.0);
+        let u = DVec3::new(1.4423828125, 21.3330078125, 21.3330078125);
+        let v = DVec3::new(-227532603392.0, 0.0, 35183845703680.0);
+        let corners = [c - u - v, c + u - v, c + u + v, c - u + v];
+        let (a, b) = (
+            DVec3::new(0.0, 0.0, -0.125),
+            DVec3::new(-14.5615234375, -0.25, 10.6884765625),
+        );
+        let planes = wedge_halfspaces(c, &corners, a, b);
+        // The light's points nearest the edge: its middle line where it crosses z = 0.
+        let t = -c.z / v.z;
+        for light_point in [c + v * t + u, c + v * t - u, c + v * t, c] {
+            for edge_point in [a, b, (a + b) * 0.5] {
+                for lambda in [1.0, 1e3] {
+                    let p = edge_point + (edge_point - light_point) * lambda;
+                    for h in &planes {
+                        assert!(
+                            h.distance(p) <= 1e-9 * (p - edge_point).length(),
+                            "{p} outside {h:?} by {}",
+                            h.distance(p)
+                        );
+                    }
+                }
             }
         }
     }
