@@ -15,6 +15,7 @@
 //! one target can be filled by several draws that each own some of its channels.
 
 use super::counters::Counters;
+use super::probe::Overflow;
 use half::f16;
 
 /// The storage format of a colour target (module doc).
@@ -66,6 +67,15 @@ impl ColorFormat {
                 let x = v as f32;
                 (x.to_bits(), !x.is_finite())
             }
+        }
+    }
+
+    /// What the overflow events a write counts are: a clamp for unorm8, a result that is not
+    /// finite for the float formats.
+    pub fn overflow(self) -> Overflow {
+        match self {
+            ColorFormat::Unorm8 => Overflow::Clamp,
+            _ => Overflow::NonFinite,
         }
     }
 
