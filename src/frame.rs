@@ -405,26 +405,36 @@ impl<'s> Frame<'s> {
         self.receivers_with(|_, x, y, prim| self.primary_hit(x, y, prim))
     }
 
+    /// The receiver of [`Frame::primary_ray_receivers`] of the pixel of row-major index `i`.
+    pub fn primary_ray_receiver(&self, i: usize) -> Option<Receiver> {
+        self.receiver_with(i, |_, x, y, prim| self.primary_hit(x, y, prim))
+    }
+
     fn receivers_with(
         &self,
         point: impl Fn(usize, u32, u32, u32) -> DVec3 + Sync,
     ) -> Vec<Option<Receiver>> {
-        let prims = self.prim_ids();
-        let w = self.scene.width;
-        (0..prims.len())
+        (0..self.pixel_count())
             .into_par_iter()
-            .map(|i| {
-                let prim = prims[i];
-                if prim == BACKGROUND {
-                    return None;
-                }
-                let (x, y) = (i as u32 % w, i as u32 / w);
-                Some(Receiver {
-                    point: point(i, x, y, prim).as_vec3(),
-                    normal: self.normal_of(prim),
-                })
-            })
+            .map(|i| self.receiver_with(i, &point))
             .collect()
+    }
+
+    fn receiver_with(
+        &self,
+        i: usize,
+        point: impl Fn(usize, u32, u32, u32) -> DVec3,
+    ) -> Option<Receiver> {
+        let prim = self.prim_ids()[i];
+        if prim == BACKGROUND {
+            return None;
+        }
+        let w = self.scene.width;
+        let (x, y) = (i as u32 % w, i as u32 / w);
+        Some(Receiver {
+            point: point(i, x, y, prim).as_vec3(),
+            normal: self.normal_of(prim),
+        })
     }
 
     fn primary_hit(&self, x: u32, y: u32, prim: u32) -> DVec3 {

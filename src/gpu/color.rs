@@ -16,6 +16,7 @@
 
 use super::buffers::{overflow_record, record_overflow};
 use super::counters::Counters;
+use super::probe::Overflow;
 use half::f16;
 
 /// The storage format of a colour target (module doc).
@@ -54,6 +55,15 @@ impl ColorFormat {
                 let x = v as f32;
                 (x.to_bits(), !x.is_finite())
             }
+        }
+    }
+
+    /// What the overflow events a write counts are: a clamp for unorm8, a result that is not
+    /// finite for the float formats.
+    pub fn overflow(self) -> Overflow {
+        match self {
+            ColorFormat::Unorm8 => Overflow::Clamp,
+            _ => Overflow::NonFinite,
         }
     }
 

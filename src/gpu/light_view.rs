@@ -52,7 +52,8 @@
 use super::buffers::{alloc_tiles, DepthTile};
 use super::counters::Counters;
 use super::depth::{DepthFormat, DepthState, PolygonOffset};
-use super::raster::{bin, draw, no_tile_culling, Fragment};
+use super::probe::{Overflow, PassProbe, PrimitiveKind, Raw};
+use super::raster::{bin, draw_probed, no_tile_culling, Fragment};
 use super::setup::{setup_all, CullMode};
 use super::texture::{nearest, sample_2d, Filter, Wrap};
 use super::tiling::Tiling;
@@ -281,6 +282,25 @@ impl LightView {
         )
     }
 
+    /// The texels (column, image row) [`LightView::sample`] reads at window coordinates (x, y)
+    /// with `filter`, in the order it reads them: what a probe of a map lookup watches
+    /// ([`super::probe`]).
+    pub fn texels_read(&self, x: f32, y: f32, filter: Filter) -> Vec<[u32; 2]> {
+        let read = std::cell::RefCell::new(Vec::new());
+        self.sample(x, y, filter, |t, l| {
+            read.borrow_mut().push(self.tiling.position(t, l));
+            0.0
+        });
+        let mut texels = read.into_inner();
+        let mut seen = Vec::new();
+        texels.retain(|t| {
+            let new = !seen.contains(t);
+            seen.push(*t);
+            new
+        });
+        texels
+    }
+
     /// The clip coordinates of the triangles of `scene` in this view, meshes in file order,
     /// triangles in order: of every mesh (the primitive ids of the scene pass), or with
     /// `casters_only` of the meshes that cast shadows (not the receiver-only ones).
@@ -331,21 +351,57 @@ impl LightView {
     /// cast none) from the light with polygon `offset` (module doc, "The shadow map"): the
     /// tile-major depth target and the pass counters.
     pub fn render_depth(&self, scene: &Scene, offset: PolygonOffset) -> (Vec<DepthTile>, Counters) {
+        self.render_depth_probed(scene, offset, None)
+    }
+
+    /// [`LightView::render_depth`] recording the clear and every fragment at the texels
+    /// `probe` watches ([`super::probe`]).
+    pub fn render_depth_probed(
+        &self,
+        scene: &Scene,
+        offset: PolygonOffset,
+        probe: Option<&PassProbe>,
+    ) -> (Vec<DepthTile>, Counters) {
         let prims = self.scene_triangles(scene, true);
         let (tris, mut counters) = setup_all(&prims, CullMode::Back, &self.tiling);
         let bins = bin(&self.tiling, &tris);
         let mut tiles = alloc_tiles(&self.tiling, |_, len| DepthTile::cleared(self.depth, len));
+        if let Some(p) = probe {
+            p.record_each(|tap| {
+                tap.event()
+                    .clear("shadow-map", Raw::Depth(self.depth.far()))
+            });
+        }
         let state = DepthState::LESS_WRITE;
         let format = self.depth;
-        counters += draw(
+        counters += draw_probed(
             &self.tiling,
             &mut tiles,
             &tris,
             &bins,
+            probe,
             no_tile_culling,
-            |_, tile, tri, f, c| {
+            |_, tile, tri, f, c, tap| {
                 let z = offset.apply(format, f.z, tri.max_depth_slope(), tri.z_range[1]);
-                tile.test_and_write(&state, &Fragment { z, ..f }, c);
+                let before = tile.values[f.local];
+                let pass = tile.test_and_write(&state, &Fragment { z, ..f }, c);
+                if let Some(tap) = tap {
+                    let e = tap.event().primitive(
+                        PrimitiveKind::SceneTriangle,
+                        tri.prim,
+                        "",
+                        Some(tri.front_facing),
+                    );
+                    let e = e.value("offset", z as f64 - f.z as f64).depth(
+                        format,
+                        state.func,
+                        format.quantize(z),
+                        before,
+                        pass,
+                    );
+                    let after = Raw::Depth(tile.values[f.local]);
+                    tap.push(e.write("shadow-map", Raw::Depth(before), after, Overflow::Clamp, 0));
+                }
             },
         );
         (tiles, counters)

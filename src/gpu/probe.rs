@@ -590,16 +590,27 @@ impl PassProbe<'_> {
             tap.push(event(tap));
         }
     }
+
+    /// Record one event at every watched sample (e.g. the clear of a map).
+    pub fn record_each(&self, event: impl Fn(Tap) -> ProbeEvent) {
+        for t in &self.targets {
+            let tap = Tap {
+                pass: self,
+                at: t.at,
+            };
+            tap.push(event(tap));
+        }
+    }
 }
 
 /// Check that every buffer's writes chain (module doc, "Buffers"): per buffer name and
 /// sample, the first event is a clear and every later event's `before` equals the previous
 /// `after` (a clear starts the chain again). Returns the first break as a message.
 pub fn check_chains(events: &[ProbeEvent]) -> Result<(), String> {
-    let mut last: Vec<((&str, [u32; 2]), (usize, &Raw))> = Vec::new();
+    let mut last: Vec<((&str, [u32; 2], bool), (usize, &Raw))> = Vec::new();
     for (k, e) in events.iter().enumerate() {
         let Some(b) = &e.buffer else { continue };
-        let key = (b.buffer.as_str(), e.at);
+        let key = (b.buffer.as_str(), e.at, e.texel);
         let slot = last.iter().position(|(kk, _)| *kk == key);
         match (&b.before, slot) {
             (None, Some(s)) => last[s].1 = (k, &b.after),

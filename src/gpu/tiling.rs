@@ -81,6 +81,16 @@ impl Tiling {
         ((y / self.tile) * self.tiles_x + x / self.tile) as usize
     }
 
+    /// The pixel (x, y) of sample `local` of tile `t` (the inverse of [`Tiling::tile_of`] and
+    /// [`Tiling::local`]).
+    pub fn position(&self, t: usize, local: usize) -> [u32; 2] {
+        let r = self.rect(t);
+        [
+            r.x0 + local as u32 % self.tile,
+            r.y0 + local as u32 / self.tile,
+        ]
+    }
+
     /// Index of pixel (x, y) inside its tile's storage.
     #[inline]
     pub fn local(&self, x: u32, y: u32) -> usize {

@@ -124,10 +124,13 @@ use crate::geometry::umbra_penumbra::{build_volumes, Disk, Extrusion, VolumeStat
 use crate::gpu::buffers::{alloc_tiles, DepthTile};
 use crate::gpu::color::{ColorFormat, ColorMask, RgbaTile};
 use crate::gpu::counters::Counters;
+use crate::gpu::depth::DepthFunc;
 use crate::gpu::depth::{DepthFormat, DepthState, PolygonOffset};
 use crate::gpu::light_view::LightView;
-use crate::gpu::raster::{bin, draw, no_tile_culling, Fragment};
+use crate::gpu::probe::{Overflow, PassProbe, PrimitiveKind, ProbeEvent, Raw, Tap};
+use crate::gpu::raster::{bin, draw_probed, no_tile_culling, Fragment};
 use crate::gpu::setup::{setup_all_barycentric, CullMode};
+use crate::gpu::texture::Filter;
 use crate::gpu::transform::ClipVertex;
 use crate::options::{option_names, option_table, OptionTable};
 use crate::plan::BufferPlan;
@@ -470,7 +473,17 @@ fn ray_distance(view: &LightView, x: u32, y: u32, (n, k): (DVec3, f64)) -> Optio
     (d.is_finite() && d > 0.0).then_some(d)
 }
 
-/// Run one D-buffer draw of `input` into `tiles` (module doc, pass 2).
+/// A D-buffer texel as stored, for probes ([`crate::gpu::probe`]).
+fn texel_raw(tile: &RgbaTile, i: usize) -> Raw {
+    let c = tile.values[i];
+    Raw::Channels(match tile.format {
+        ColorFormat::F16 => c.iter().map(|v| Raw::F16(*v as u16)).collect(),
+        _ => c.iter().map(|v| Raw::F32(*v)).collect(),
+    })
+}
+
+/// Run one D-buffer draw of `input` into `tiles` (module doc, pass 2), recording at the texel
+/// `probe` watches.
 fn draw_dbuffer(
     view: &LightView,
     range: f64,
@@ -478,6 +491,7 @@ fn draw_dbuffer(
     tiles: &mut [DTile],
     input: &DrawInput,
     kind: DrawKind,
+    probe: Option<&PassProbe>,
 ) -> Counters {
     let cull = match kind {
         DrawKind::Scene(_) => CullMode::Back,
@@ -486,13 +500,18 @@ fn draw_dbuffer(
     let (tris, mut counters) = setup_all_barycentric(&input.prims, cull, &view.tiling);
     let bins = bin(&view.tiling, &tris);
     let format = view.depth;
-    counters += draw(
+    counters += draw_probed(
         &view.tiling,
         tiles,
         &tris,
         &bins,
+        probe,
         no_tile_culling,
-        |_, tile, tri, f, c| {
+        |_, tile, tri, f, c, tap| {
+            let before = tap.map(|_| {
+                let (depth, texel) = (tile.depth.values[f.local], texel_raw(&tile.color, f.local));
+                (depth, texel, c.overflow_events)
+            });
             c.fragments_shaded += 1;
             let prim = tri.prim as usize;
             let v = input.values[prim];
@@ -531,15 +550,26 @@ fn draw_dbuffer(
                     };
                     let z_max = tri.z_range[1];
                     let z = offset.apply(format, f.z, m, z_max);
-                    if tile
-                        .depth
-                        .test_and_write(&DepthState::LESS_WRITE, &Fragment { z, ..f }, c)
-                    {
+                    let pass =
+                        tile.depth
+                            .test_and_write(&DepthState::LESS_WRITE, &Fragment { z, ..f }, c);
+                    if pass {
                         let r = d + range * offset.amount(format, m, z_max);
                         let mask = ColorMask([true, false, false, false]);
                         tile.color
                             .write_masked(f.local, [r, 0.0, 0.0, 0.0], mask, c);
                         tile.stats.r_writes += 1;
+                    }
+                    if let (Some(tap), Some(b)) = (tap, &before) {
+                        let e = tap.event().primitive(
+                            PrimitiveKind::SceneTriangle,
+                            tri.prim,
+                            "",
+                            Some(tri.front_facing),
+                        );
+                        let z = format.quantize(z);
+                        let e = e.depth(format, DepthFunc::Less, z, b.0, pass);
+                        record_dbuffer_write(tap, e.value("|cx|", d), tile, f.local, b, c);
                     }
                 }
                 DrawKind::Volume(mask) => {
@@ -549,7 +579,8 @@ fn draw_dbuffer(
                     } else {
                         tile.stats.penumbra_fragments += 1;
                     }
-                    if tile.depth.test_and_write(&DepthState::GREATER_WRITE, &f, c) {
+                    let pass = tile.depth.test_and_write(&DepthState::GREATER_WRITE, &f, c);
+                    if pass {
                         tile.color
                             .write_masked(f.local, [0.0, d, d, at(1)], mask, c);
                         if umbra {
@@ -559,11 +590,47 @@ fn draw_dbuffer(
                         }
                         tile.stats.a_writes += 1;
                     }
+                    if let (Some(tap), Some(b)) = (tap, &before) {
+                        let kind = if umbra {
+                            PrimitiveKind::UmbraVolume
+                        } else {
+                            PrimitiveKind::PenumbraVolume
+                        };
+                        let e = tap
+                            .event()
+                            .primitive(kind, tri.prim, "", Some(tri.front_facing));
+                        let z = format.quantize(f.z);
+                        let e = e.depth(format, DepthFunc::Greater, z, b.0, pass);
+                        let e = e.value("|cx|", d).value("|cx_s|", at(1));
+                        record_dbuffer_write(tap, e, tile, f.local, b, c);
+                    }
                 }
             }
         },
     );
     counters
+}
+
+/// Record a D-buffer fragment's writes (module doc, pass 2): the depth buffer, then the
+/// texel, from their values `before` (depth, texel, overflow count) to what `tile` holds now.
+fn record_dbuffer_write(
+    tap: Tap,
+    e: ProbeEvent,
+    tile: &DTile,
+    i: usize,
+    before: &(u32, Raw, u64),
+    c: &Counters,
+) {
+    let after = Raw::Depth(tile.depth.values[i]);
+    tap.push(e.write("depth", Raw::Depth(before.0), after, Overflow::Clamp, 0));
+    let e = tap.event().write(
+        "dbuffer",
+        before.1.clone(),
+        texel_raw(&tile.color, i),
+        tile.color.format.overflow(),
+        c.overflow_events - before.2,
+    );
+    tap.push(e.note("(R |cx_o|, G |cx_uv|, B |cx_pv|, A |cx_s|)"));
 }
 
 /// The D-buffer draw of the volume triangles `tris`: the vertex program of §3.2 with eq. 2;
@@ -626,13 +693,32 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
         .map_err(|(i, e)| InputError::at(&scene.source, frame.caster_object(i), e))?;
     let pass_volumes = PassStats::since("volumes", t, Counters::default());
 
-    // Pass 2: the D-buffer, three draws.
+    // Pass 2: the D-buffer, three draws; a probe watches the texel the screen pass reads for
+    // its pixel.
     let mut tiles = alloc_tiles(&view.tiling, |_, len| DTile {
         color: RgbaTile::cleared(s.storage, [range, 0.0, 0.0, 0.0], len)
             .recording(frame.dump_buffers),
         depth: DepthTile::cleared(view.depth, len),
         stats: DBufferStats::default(),
     });
+    let texel = frame.probe.as_ref().and_then(|p| {
+        let [x, y] = p.pixel();
+        let r = frame.primary_ray_receiver((y * scene.width + x) as usize)?;
+        let [wx, wy, _] = view.window(r.point)?;
+        Some((p, view.texels_read(wx, wy, Filter::Nearest)))
+    });
+    let map_probe = |name: &str| {
+        texel
+            .as_ref()
+            .map(|(p, t)| p.pass_at(name, &view.tiling, t, true))
+    };
+    if let Some(p) = map_probe("dbuffer-clear") {
+        p.record_each(|tap| tap.event().clear("dbuffer", texel_raw(&tiles[0].color, 0)));
+        p.record_each(|tap| {
+            tap.event()
+                .clear("depth", Raw::Depth(tiles[0].depth.values[0]))
+        });
+    }
     let t = Instant::now();
     let mut scene_input = DrawInput::default();
     for (m, _) in &meshes {
@@ -654,6 +740,7 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
         &mut tiles,
         &scene_input,
         DrawKind::Scene(s.offset),
+        map_probe("dbuffer-scene").as_ref(),
     );
     let pass_scene = PassStats::since("dbuffer-scene", t, c1);
     let mut not_finite = 0;
@@ -662,9 +749,24 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
         for tile in tiles.iter_mut() {
             tile.depth = DepthTile::cleared_to(view.depth, 0.0, tile.depth.values.len());
         }
+        let probe = map_probe(name);
+        if let Some(p) = &probe {
+            p.record_each(|tap| {
+                tap.event()
+                    .clear("depth", Raw::Depth(tiles[0].depth.values[0]))
+            });
+        }
         let input = volume_input(&view, range, &disk, tris, &mut not_finite);
         let kind = DrawKind::Volume(ColorMask(mask));
-        let counters = draw_dbuffer(&view, range, s.distances, &mut tiles, &input, kind);
+        let counters = draw_dbuffer(
+            &view,
+            range,
+            s.distances,
+            &mut tiles,
+            &input,
+            kind,
+            probe.as_ref(),
+        );
         PassStats::since(name, t, counters)
     };
     let pass_umbra = volume_pass("dbuffer-umbra", &volumes.umbra, [false, true, false, true]);
@@ -724,21 +826,58 @@ fn screen_pass(
     let receivers = frame.primary_ray_receivers();
     let width = frame.scene.width as usize;
     let texel_bytes = 4 * s.storage.bytes();
-    let (pixels, stats, counters) =
-        super::shade_receivers(&receivers, width, |_, r, st: &mut ScreenStats, cn| {
+    let probe = frame.probe_pass("screen");
+    let (pixels, stats, counters) = super::shade_receivers_probed(
+        &receivers,
+        width,
+        probe.as_ref(),
+        |_, r, st: &mut ScreenStats, cn, tap| {
+            let record = |v: f32, note: &str| {
+                if let Some(tap) = tap {
+                    tap.push(tap.event().resolve(&[v], false).note(note));
+                }
+            };
             let Some(r) = r else {
+                record(1.0, "background: lit");
                 return (1.0, None);
             };
             st.receivers += 1;
             cn.fragments_shaded += 1;
             let Some([x, y, _]) = view.window(r.point) else {
                 st.behind_light += 1;
+                record(1.0, "behind the light: lit");
                 return (1.0, None);
             };
             let (tile, local) = view.nearest_texel(x, y);
             cn.color_read_bytes += texel_bytes;
             let texel = dbuffer[tile].texel(local);
-            let shade = screen_program((r.point.as_dvec3() - c).length(), texel, s);
+            let d = (r.point.as_dvec3() - c).length();
+            let shade = screen_program(d, texel, s);
+            if let Some(tap) = tap {
+                let [tx, ty] = view.tiling.position(tile, local);
+                let e = ["R", "G", "B", "A"]
+                    .iter()
+                    .zip(texel)
+                    .fold(tap.event(), |e, (n, v)| e.value(n, v as f64))
+                    .value("|cx|", d)
+                    .value("texel x", tx as f64)
+                    .value("texel y", ty as f64);
+                let e = match shade.t {
+                    Some(t) => e.value("t", t),
+                    None => e,
+                };
+                let clamped = shade.t.is_some_and(|t| !(0.0..=1.0).contains(&t));
+                let note = format!(
+                    "{:?}{}",
+                    shade.region,
+                    if shade.degenerate {
+                        ", degenerate: t = ½"
+                    } else {
+                        ""
+                    }
+                );
+                tap.push(e.resolve(&[shade.v as f32], clamped).note(note));
+            }
             match shade.region {
                 Region::Umbra => {
                     st.umbra += 1;
@@ -751,7 +890,8 @@ fn screen_pass(
             st.degenerate_t += shade.degenerate as u64;
             st.t_out_of_range += shade.clamped() as u64;
             (shade.v as f32, Some(shade))
-        });
+        },
+    );
     let (values, shades) = pixels.into_iter().unzip();
     (Visibility::Gray(values), shades, stats, counters)
 }

@@ -35,6 +35,7 @@ use crate::gpu::color::ColorFormat;
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::DepthFormat;
 use crate::gpu::light_view::{LightView, MAX_LIGHT_VIEW_HALF_ANGLE_DEG};
+use crate::gpu::probe::{PassProbe, Tap};
 use crate::gpu::texture::Filter;
 use crate::gpu::tiling::Tiling;
 use crate::options::{option_names, option_table, KeyDoc, OptionTable, OptionType};
@@ -350,6 +351,24 @@ where
     T: Send,
     S: Default + std::ops::AddAssign + Send,
 {
+    shade_receivers_probed(receivers, width, None, |i, r, st, c, _| {
+        program(i, r, st, c)
+    })
+}
+
+/// [`shade_receivers`] with a probe ([`crate::gpu::probe`]): `program` gets a [`Tap`] for the
+/// pixel `probe` watches and `None` for every other one (the row is compared once per row).
+pub fn shade_receivers_probed<T, S>(
+    receivers: &[Option<crate::frame::Receiver>],
+    width: usize,
+    probe: Option<&PassProbe>,
+    program: impl Fn(usize, Option<&crate::frame::Receiver>, &mut S, &mut Counters, Option<Tap>) -> T
+        + Sync,
+) -> (Vec<T>, S, Counters)
+where
+    T: Send,
+    S: Default + std::ops::AddAssign + Send,
+{
     use rayon::prelude::*;
     let rows: Vec<(Vec<T>, S, Counters)> = receivers
         .par_chunks(width)
@@ -357,10 +376,14 @@ where
         .map(|(row, pixels)| {
             let mut st = S::default();
             let mut c = Counters::default();
+            let watched = probe.filter(|p| p.watches_row(row as u32));
             let out = pixels
                 .iter()
                 .enumerate()
-                .map(|(k, r)| program(row * width + k, r.as_ref(), &mut st, &mut c))
+                .map(|(k, r)| {
+                    let tap = watched.and_then(|p| p.tap_at(k as u32, row as u32));
+                    program(row * width + k, r.as_ref(), &mut st, &mut c, tap)
+                })
                 .collect();
             (out, st, c)
         })

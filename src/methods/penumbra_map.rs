@@ -102,13 +102,16 @@ use super::dump::{
 use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
 use crate::frame::Frame;
-use crate::geometry::penumbra_cones::{cones_and_sheets, silhouettes, ConeLight, PenumbraGeometry};
+use crate::geometry::penumbra_cones::{
+    cones_and_sheets, silhouettes, ConeLight, ConeOrSheet, PenumbraGeometry,
+};
 use crate::gpu::buffers::{alloc_tiles, DepthTile};
 use crate::gpu::color::{ColorFormat, ColorTile};
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFormat, DepthState, PolygonOffset};
 use crate::gpu::light_view::LightView;
-use crate::gpu::raster::{bin, draw, no_tile_culling, Fragment};
+use crate::gpu::probe::{Overflow, PassProbe, PrimitiveKind, ProbeEvent, Raw};
+use crate::gpu::raster::{bin, draw_probed, no_tile_culling, Fragment};
 use crate::gpu::setup::{setup_all_barycentric, CullMode};
 use crate::gpu::texture::Filter;
 use crate::options::{option_names, option_table, OptionTable};
@@ -332,13 +335,27 @@ pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRende
     };
     let view = super::fit_light_view(frame, "penumbra-map", s.map_size, s.depth, "penumbra maps")?;
 
+    // A probe watches the texels the screen pass reads for its pixel.
+    let texels = frame.probe.as_ref().and_then(|p| {
+        let [x, y] = p.pixel();
+        let r = frame.primary_ray_receiver((y * scene.width + x) as usize)?;
+        let [wx, wy, _] = view.window(r.point)?;
+        Some((p, view.texels_read(wx, wy, s.filter)))
+    });
+    let map_probe = |name: &str| {
+        texels
+            .as_ref()
+            .map(|(p, t)| p.pass_at(name, &view.tiling, t, true))
+    };
+
     // Pass 1: the shadow map.
     let t = Instant::now();
     let render_offset = match s.bias_stage {
         BiasStage::Render => s.offset,
         BiasStage::Lookup => PolygonOffset::NONE,
     };
-    let (shadow_map, c1) = view.render_depth(scene, render_offset);
+    let probe = map_probe("shadow-map");
+    let (shadow_map, c1) = view.render_depth_probed(scene, render_offset, probe.as_ref());
     let pass1 = PassStats::since("shadow-map", t, c1);
 
     // The silhouette from the light center (CPU; the paper's 30 %).
@@ -357,8 +374,15 @@ pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRende
         &cone_light(&view, radius),
         s.cone_segments,
     );
-    let (color, program, c2) =
-        render_penumbra_map(&view, &shadow_map, &geometry, s, frame.dump_buffers);
+    let probe = map_probe("penumbra-map");
+    let (color, program, c2) = render_penumbra_map_probed(
+        &view,
+        &shadow_map,
+        &geometry,
+        s,
+        frame.dump_buffers,
+        probe.as_ref(),
+    );
     let pass2 = PassStats::since("penumbra-map", t, c2);
 
     // Pass 3: the screen.
@@ -439,6 +463,19 @@ pub fn render_penumbra_map(
     s: &PenumbraMapSettings,
     record: bool,
 ) -> (Vec<ColorTile>, ProgramStats, Counters) {
+    render_penumbra_map_probed(view, shadow_map, geometry, s, record, None)
+}
+
+/// [`render_penumbra_map`] recording the clears and every fragment at the texels `probe`
+/// watches ([`crate::gpu::probe`]).
+pub fn render_penumbra_map_probed(
+    view: &LightView,
+    shadow_map: &[DepthTile],
+    geometry: &PenumbraGeometry,
+    s: &PenumbraMapSettings,
+    record: bool,
+    probe: Option<&PassProbe>,
+) -> (Vec<ColorTile>, ProgramStats, Counters) {
     let prims: Vec<_> = geometry
         .triangles
         .iter()
@@ -453,13 +490,22 @@ pub fn render_penumbra_map(
     });
     let less = DepthState::LESS_WRITE;
     let format = view.depth;
-    counters += draw(
+    if let Some(p) = probe {
+        let cleared = &tiles[0];
+        p.record_each(|tap| tap.event().clear("colour", color_raw(&cleared.color, 0)));
+        p.record_each(|tap| {
+            tap.event()
+                .clear("depth", Raw::Depth(cleared.depth.values[0]))
+        });
+    }
+    counters += draw_probed(
         &view.tiling,
         &mut tiles,
         &tris,
         &bins,
+        probe,
         no_tile_culling,
-        |t, tile, tri, f, c| {
+        |t, tile, tri, f, c, tap| {
             let PenumbraTile {
                 color,
                 depth,
@@ -468,33 +514,79 @@ pub fn render_penumbra_map(
             c.fragments_shaded += 1;
             st.fragments += 1;
             let z_p = shadow_map[t].read(f.local, c);
+            let triangle = &geometry.triangles[tri.prim as usize];
             let z_v = tri
-                .interpolate(f.x, f.y, geometry.triangles[tri.prim as usize].z_v)
+                .interpolate(f.x, f.y, triangle.z_v)
                 .expect("penumbra triangles are set up with barycentrics");
+            let event = tap.map(|tap| {
+                let kind = match triangle.kind {
+                    ConeOrSheet::Cone => PrimitiveKind::Cone,
+                    ConeOrSheet::Sheet => PrimitiveKind::Sheet,
+                };
+                let e = tap
+                    .event()
+                    .primitive(kind, tri.prim, "", Some(tri.front_facing))
+                    .value("Z_F", f.z as f64)
+                    .value("Z_P", format.to_window(z_p))
+                    .value("Z_v", z_v);
+                (tap, e)
+            });
             let i = match penumbra_intensity(f.z, format.to_window(z_p), z_v, &view.proj) {
                 Ok(i) => i,
-                Err(Discard::BehindSurface) => {
-                    st.discarded_behind_surface += 1;
-                    return;
-                }
-                Err(Discard::SurfaceNotBeyondSilhouette) => {
-                    st.discarded_surface_not_beyond_silhouette += 1;
-                    return;
-                }
-                Err(Discard::InFrontOfSilhouette) => {
-                    st.discarded_in_front_of_silhouette += 1;
+                Err(why) => {
+                    match why {
+                        Discard::BehindSurface => st.discarded_behind_surface += 1,
+                        Discard::SurfaceNotBeyondSilhouette => {
+                            st.discarded_surface_not_beyond_silhouette += 1
+                        }
+                        Discard::InFrontOfSilhouette => st.discarded_in_front_of_silhouette += 1,
+                    }
+                    if let Some((tap, e)) = event {
+                        tap.push(e.note(format!("discarded: {why:?}")));
+                    }
                     return;
                 }
             };
             if !(0.0..=1.0).contains(&i) {
                 st.intensity_out_of_range += 1;
             }
+            let event = event.map(|(tap, e)| (tap, e.value("I", i)));
             let i = s.falloff.apply(i);
             // (9)–(10): colour and depth, LESS: the darkest wins.
             let out = Fragment { z: i as f32, ..f };
-            if depth.test_and_write(&less, &out, c) {
+            let (depth_before, colour_before) = (depth.values[f.local], color_raw(color, f.local));
+            let overflows = c.overflow_events;
+            let written = depth.test_and_write(&less, &out, c);
+            if written {
                 color.write(f.local, i, c);
                 st.written += 1;
+            }
+            if let Some((tap, e)) = event {
+                let z = format.quantize(out.z);
+                let e = e
+                    .value("I'", i)
+                    .depth(format, less.func, z, depth_before, written);
+                let depth_after = Raw::Depth(depth.values[f.local]);
+                let e = e.write(
+                    "depth",
+                    Raw::Depth(depth_before),
+                    depth_after,
+                    Overflow::Clamp,
+                    0,
+                );
+                tap.push(e.note("(10): I' as depth, LESS: the darkest wins"));
+                let e = tap.event().write(
+                    "colour",
+                    colour_before,
+                    color_raw(color, f.local),
+                    s.storage.overflow(),
+                    c.overflow_events - overflows,
+                );
+                tap.push(e.note(if written {
+                    "(9): I' written"
+                } else {
+                    "not written"
+                }));
             }
         },
     );
@@ -527,15 +619,27 @@ fn screen_pass(
         Filter::Nearest => 1,
         Filter::Bilinear => 4,
     };
-    let (values, stats, counters) =
-        super::shade_receivers(&receivers, width, |i, r, st: &mut ScreenStats, c| {
+    let probe = frame.probe_pass("screen");
+    let (values, stats, counters) = super::shade_receivers_probed(
+        &receivers,
+        width,
+        probe.as_ref(),
+        |i, r, st: &mut ScreenStats, c, tap| {
+            let record = |e: Option<ProbeEvent>, v: f32, clamped: bool, why: &str| {
+                if let (Some(tap), Some(e)) = (tap, e) {
+                    tap.push(e.resolve(&[v], clamped).note(why));
+                }
+            };
+            let event = tap.map(|tap| tap.event());
             let Some(r) = r else {
+                record(event, 1.0, false, "background: lit");
                 return 1.0;
             };
             st.receivers += 1;
             c.fragments_shaded += 1;
             let Some([x, y, z]) = view.window(r.point) else {
                 st.behind_light += 1;
+                record(event, 1.0, false, "behind the light: lit");
                 return 1.0;
             };
             c.depth_read_bytes += depth_bytes;
@@ -543,8 +647,20 @@ fn screen_pass(
                 Some(&(m, z_max)) => (z as f64 - s.offset.amount(view.depth, m, z_max)) as f32,
                 None => z,
             };
+            let event = event.map(|e| {
+                let (t, l) = view.nearest_texel(x, y);
+                let e = e
+                    .value("x", x as f64)
+                    .value("y", y as f64)
+                    .value("z", z as f64);
+                e.value(
+                    "shadow-map depth",
+                    view.depth.to_window(shadow_map[t].values[l]),
+                )
+            });
             if !view.lit(shadow_map, [x, y, z]) {
                 st.umbra += 1;
+                record(event, 0.0, false, "behind the shadow map's surface: umbra");
                 return 0.0;
             }
             c.color_read_bytes += taps * s.storage.bytes();
@@ -553,9 +669,28 @@ fn screen_pass(
                 st.out_of_range += 1;
             }
             st.penumbra += (v < 1.0) as u64;
-            v.clamp(0.0, 1.0) as f32
-        });
+            let vis = v.clamp(0.0, 1.0) as f32;
+            let event = event.map(|e| e.value("penumbra map", v));
+            record(
+                event,
+                vis,
+                vis as f64 != v,
+                "lit by the shadow map: the penumbra map's value",
+            );
+            vis
+        },
+    );
     (Visibility::Gray(values), stats, counters)
+}
+
+/// A colour sample as stored, for probes ([`crate::gpu::probe`]).
+fn color_raw(tile: &ColorTile, i: usize) -> Raw {
+    let stored = tile.values[i];
+    match tile.format {
+        ColorFormat::Unorm8 => Raw::U8(stored as u8),
+        ColorFormat::F16 => Raw::F16(stored as u16),
+        ColorFormat::F32 => Raw::F32(stored),
+    }
 }
 
 /// Run `penumbra-map` on a rendered frame (one light: [`super::run`] averages several).
