@@ -59,7 +59,7 @@ pub trait VBufferStorage: Sync {
     fn raw(&self, px: &Self::Pixel) -> Raw;
     /// The pixel a probe recorded as `raw` ([`VBufferStorage::raw`]'s inverse); `None` for a
     /// value of another format.
-    fn from_raw(&self, raw: &Raw) -> Option<Self::Pixel>;
+    fn decode_raw(&self, raw: &Raw) -> Option<Self::Pixel>;
 }
 
 /// The paper's packed 8-bit storage (module doc).
@@ -208,7 +208,7 @@ impl VBufferStorage for Packed8 {
         Raw::Channels(px.iter().map(|w| Raw::Word(*w)).collect())
     }
 
-    fn from_raw(&self, raw: &Raw) -> Option<Self::Pixel> {
+    fn decode_raw(&self, raw: &Raw) -> Option<Self::Pixel> {
         let Raw::Channels(words) = raw else {
             return None;
         };
@@ -301,7 +301,7 @@ impl VBufferStorage for UnpackedF32 {
         )
     }
 
-    fn from_raw(&self, raw: &Raw) -> Option<Self::Pixel> {
+    fn decode_raw(&self, raw: &Raw) -> Option<Self::Pixel> {
         let Raw::Channels(values) = raw else {
             return None;
         };
@@ -415,11 +415,11 @@ mod tests {
             centroid: true,
         };
         let (px, _) = packed.store(&parts, &mut e);
-        assert_eq!(packed.from_raw(&packed.raw(&px)), Some(px));
+        assert_eq!(packed.decode_raw(&packed.raw(&px)), Some(px));
         let unpacked = UnpackedF32 { centroid: true };
         let (px, _) = unpacked.store(&parts, &mut e);
-        assert_eq!(unpacked.from_raw(&unpacked.raw(&px)), Some(px));
-        assert_eq!(unpacked.from_raw(&packed.raw(&packed.cleared())), None);
+        assert_eq!(unpacked.decode_raw(&unpacked.raw(&px)), Some(px));
+        assert_eq!(unpacked.decode_raw(&packed.raw(&packed.cleared())), None);
     }
 
     #[test]
