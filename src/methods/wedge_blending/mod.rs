@@ -411,7 +411,7 @@ pub fn blend_steps(events: &[ProbeEvent], s: &Settings) -> Vec<BlendStep> {
 }
 
 fn decode_steps<S: VBufferStorage>(events: &[ProbeEvent], storage: &S) -> Vec<BlendStep> {
-    let load = |raw: &Raw| storage.from_raw(raw).map(|px| storage.load(&px));
+    let load = |raw: &Raw| storage.pixel_of_raw(raw).map(|px| storage.load(&px));
     let mut silhouette = None;
     let mut steps = Vec::new();
     for e in events.iter().filter(|e| e.pass == PASS_NAMES[3]) {

@@ -55,7 +55,7 @@ pub trait VBufferStorage: Sync {
     fn raw(&self, px: &Self::Pixel) -> Raw;
     /// The pixel a probe recorded as `raw` ([`VBufferStorage::raw`]'s inverse); `None` for a
     /// value of another format.
-    fn from_raw(&self, raw: &Raw) -> Option<Self::Pixel>;
+    fn pixel_of_raw(&self, raw: &Raw) -> Option<Self::Pixel>;
 }
 
 /// The paper's packed 8-bit storage (module doc).
@@ -171,7 +171,7 @@ impl VBufferStorage for Packed8 {
         Raw::Channels(px.iter().map(|w| Raw::Word(*w)).collect())
     }
 
-    fn from_raw(&self, raw: &Raw) -> Option<Self::Pixel> {
+    fn pixel_of_raw(&self, raw: &Raw) -> Option<Self::Pixel> {
         let Raw::Channels(words) = raw else {
             return None;
         };
@@ -244,7 +244,7 @@ impl VBufferStorage for UnpackedF32 {
         )
     }
 
-    fn from_raw(&self, raw: &Raw) -> Option<Self::Pixel> {
+    fn pixel_of_raw(&self, raw: &Raw) -> Option<Self::Pixel> {
         let Raw::Channels(values) = raw else {
             return None;
         };
@@ -358,11 +358,11 @@ mod tests {
             centroid: true,
         };
         let (px, _) = packed.store(&parts, &mut e);
-        assert_eq!(packed.from_raw(&packed.raw(&px)), Some(px));
+        assert_eq!(packed.pixel_of_raw(&packed.raw(&px)), Some(px));
         let unpacked = UnpackedF32 { centroid: true };
         let (px, _) = unpacked.store(&parts, &mut e);
-        assert_eq!(unpacked.from_raw(&unpacked.raw(&px)), Some(px));
-        assert_eq!(unpacked.from_raw(&packed.raw(&packed.cleared())), None);
+        assert_eq!(unpacked.pixel_of_raw(&unpacked.raw(&px)), Some(px));
+        assert_eq!(unpacked.pixel_of_raw(&packed.raw(&packed.cleared())), None);
     }
 
     #[test]
