@@ -297,9 +297,7 @@ impl WedgeSet {
         self.extra_wedges += other.extra_wedges;
         self.open_wedges += other.open_wedges;
     }
-}
 
-impl WedgeSet {
     /// The light (the set appended, in order) of wedge `wi`; `None` for a set built at once.
     pub fn light_of_wedge(&self, wi: usize) -> Option<u32> {
         self.appended(0, wi)

@@ -607,9 +607,9 @@ impl PassProbe<'_> {
 /// sample, the first event is a clear and every later event's `before` equals the previous
 /// `after` (a clear starts the chain again). Returns the first break as a message.
 pub fn check_chains(events: &[ProbeEvent]) -> Result<(), String> {
-    // (buffer, sample, texel?) → (index of its last event, its value after that event).
-    type Chain<'a> = ((&'a str, [u32; 2], bool), (usize, &'a Raw));
-    let mut last: Vec<Chain> = Vec::new();
+    // Per buffer (name, sample, whether a texel): the last event that left a value, and it.
+    type Buffer<'a> = (&'a str, [u32; 2], bool);
+    let mut last: Vec<(Buffer, (usize, &Raw))> = Vec::new();
     for (k, e) in events.iter().enumerate() {
         let Some(b) = &e.buffer else { continue };
         let key = (b.buffer.as_str(), e.at, e.texel);

@@ -184,14 +184,10 @@ where
                 if skip_tile(t, storage, tri, &mut c) {
                     continue;
                 }
-                let (visited, n) = match watched {
-                    None => rasterize_in_tile(tiling, tri, &rect, |f| {
-                        fragment(t, storage, tri, f, &mut c, None)
-                    }),
-                    Some(p) => rasterize_in_tile(tiling, tri, &rect, |f| {
-                        fragment(t, storage, tri, f, &mut c, p.tap(t, f.local))
-                    }),
-                };
+                let (visited, n) = rasterize_in_tile(tiling, tri, &rect, |f| {
+                    let tap = watched.and_then(|p| p.tap(t, f.local));
+                    fragment(t, storage, tri, f, &mut c, tap)
+                });
                 c.tiles_visited += visited as u64;
                 c.fragments_rasterized += n;
             }

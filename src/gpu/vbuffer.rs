@@ -93,31 +93,26 @@ pub trait VBufferTile: Send {
     fn raw(&self, i: usize) -> Raw;
 }
 
-/// [`VBufferTile::add`] that, given the watched fragment's tap and its event so far, records
-/// the write of the V-buffer there, before and after, with its overflow events
-/// ([`super::probe`]).
+/// [`VBufferTile::add`] that, for the watched fragment's `tap`, records `event` with the write
+/// of the V-buffer there, before and after, and its overflow events ([`super::probe`]).
 #[inline]
 pub fn add_probed<V: VBufferTile>(
     vb: &mut V,
     i: usize,
     delta: [f32; 3],
     c: &mut Counters,
-    probe: Option<(Tap, ProbeEvent)>,
+    tap: Option<Tap>,
+    event: impl FnOnce(Tap) -> ProbeEvent,
 ) {
-    let Some((tap, e)) = probe else {
+    let Some(tap) = tap else {
         return vb.add(i, delta, c);
     };
     let (before, overflows) = (vb.raw(i), c.overflow_events);
     vb.add(i, delta, c);
     let kind = V::FORMAT.overflow();
     let after = vb.raw(i);
-    tap.push(e.write(
-        "vbuffer",
-        before,
-        after,
-        kind,
-        c.overflow_events - overflows,
-    ));
+    let overflows = c.overflow_events - overflows;
+    tap.push(event(tap).write("vbuffer", before, after, kind, overflows));
 }
 
 /// One f32 per pixel (module doc).

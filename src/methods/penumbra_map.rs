@@ -110,7 +110,7 @@ use crate::gpu::color::{ColorFormat, ColorTile};
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFormat, DepthState, PolygonOffset};
 use crate::gpu::light_view::LightView;
-use crate::gpu::probe::{Overflow, PassProbe, PrimitiveKind, ProbeEvent, Raw};
+use crate::gpu::probe::{Overflow, PassProbe, PrimitiveKind, ProbeEvent, Raw, Tap};
 use crate::gpu::raster::{bin, draw_probed, no_tile_culling, Fragment};
 use crate::gpu::setup::{setup_all_barycentric, CullMode};
 use crate::gpu::texture::Filter;
@@ -518,19 +518,18 @@ pub fn render_penumbra_map_probed(
             let z_v = tri
                 .interpolate(f.x, f.y, triangle.z_v)
                 .expect("penumbra triangles are set up with barycentrics");
-            let event = tap.map(|tap| {
+            // The watched fragment's event, built only there.
+            let event = |tap: Tap| {
                 let kind = match triangle.kind {
                     ConeOrSheet::Cone => PrimitiveKind::Cone,
                     ConeOrSheet::Sheet => PrimitiveKind::Sheet,
                 };
-                let e = tap
-                    .event()
+                tap.event()
                     .primitive(kind, tri.prim, "", Some(tri.front_facing))
                     .value("Z_F", f.z as f64)
                     .value("Z_P", format.to_window(z_p))
-                    .value("Z_v", z_v);
-                (tap, e)
-            });
+                    .value("Z_v", z_v)
+            };
             let i = match penumbra_intensity(f.z, format.to_window(z_p), z_v, &view.proj) {
                 Ok(i) => i,
                 Err(why) => {
@@ -541,8 +540,8 @@ pub fn render_penumbra_map_probed(
                         }
                         Discard::InFrontOfSilhouette => st.discarded_in_front_of_silhouette += 1,
                     }
-                    if let Some((tap, e)) = event {
-                        tap.push(e.note(format!("discarded: {why:?}")));
+                    if let Some(tap) = tap {
+                        tap.push(event(tap).note(format!("discarded: {why:?}")));
                     }
                     return;
                 }
@@ -550,22 +549,30 @@ pub fn render_penumbra_map_probed(
             if !(0.0..=1.0).contains(&i) {
                 st.intensity_out_of_range += 1;
             }
-            let event = event.map(|(tap, e)| (tap, e.value("I", i)));
-            let i = s.falloff.apply(i);
+            let falloff = s.falloff.apply(i);
             // (9)–(10): colour and depth, LESS: the darkest wins.
-            let out = Fragment { z: i as f32, ..f };
-            let (depth_before, colour_before) = (depth.values[f.local], color_raw(color, f.local));
-            let overflows = c.overflow_events;
+            let out = Fragment {
+                z: falloff as f32,
+                ..f
+            };
+            let before = tap.map(|_| {
+                let colour = color_raw(color, f.local);
+                (depth.values[f.local], colour, c.overflow_events)
+            });
             let written = depth.test_and_write(&less, &out, c);
             if written {
-                color.write(f.local, i, c);
+                color.write(f.local, falloff, c);
                 st.written += 1;
             }
-            if let Some((tap, e)) = event {
+            if let (Some(tap), Some((depth_before, colour_before, overflows))) = (tap, before) {
                 let z = format.quantize(out.z);
-                let e = e
-                    .value("I'", i)
-                    .depth(format, less.func, z, depth_before, written);
+                let e = event(tap).value("I", i).value("I'", falloff).depth(
+                    format,
+                    less.func,
+                    z,
+                    depth_before,
+                    written,
+                );
                 let depth_after = Raw::Depth(depth.values[f.local]);
                 let e = e.write(
                     "depth",

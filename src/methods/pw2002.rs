@@ -44,7 +44,7 @@ use crate::geometry::penumbra_wedge::{
 use crate::gpu::buffers::alloc_tiles;
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::li_buffer::{li_clamped, li_visibility, LiFormat, LiOverflow, LiTile, LI_CLEAR};
-use crate::gpu::probe::{PrimitiveKind, ProbeEvent, Raw};
+use crate::gpu::probe::{PrimitiveKind, ProbeEvent, Raw, Tap};
 use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
 use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::options::{option_names, option_table, OptionTable, Switch};
@@ -311,21 +311,19 @@ pub fn render_li(
         |t, tile, tri, f, c, tap| {
             let depth = &frame.tiles[t].depth;
             let (pass, z) = depth.test(&depth_state, &f, c);
-            let event = tap.map(|tap| {
+            // The watched fragment's event, built only there.
+            let event = |tap: Tap| {
                 let wt = &tris[tri.prim as usize];
                 let e = tap.event();
                 let e = match (wt.wedge, wt.kind) {
                     (Some(wi), Some(kind)) => wedge_primitive(e, set, wi, kind, tri),
                     _ => e,
                 };
-                (
-                    tap,
-                    depth.record_test(e, depth_state.func, f.local, z, pass),
-                )
-            });
+                depth.record_test(e, depth_state.func, f.local, z, pass)
+            };
             if !pass {
-                if let Some((tap, e)) = event {
-                    tap.push(e.note("depth test failed: not a visible fragment"));
+                if let Some(tap) = tap {
+                    tap.push(event(tap).note("depth test failed: not a visible fragment"));
                 }
                 return;
             }
@@ -356,24 +354,24 @@ pub fn render_li(
             let p = frame
                 .proj
                 .unproject(f.x, f.y, frame.gpu.depth.to_window(stored));
-            let v_i = if stored != far && w.contains(p) {
+            let inside = stored != far && w.contains(p);
+            let v_i = if inside {
                 li_amount(light_intensity(w, p, s.smooth), s.lights)
             } else {
                 w.exit(eye, dir).map_or(0, |(k, t)| boundary(k, t))
             };
             let delta = v_i - v_f;
             let added = (delta != 0).then(|| tile.add(f.local, delta, c));
-            if let Some((tap, e)) = event {
-                let e = e
+            if let Some(tap) = tap {
+                let e = event(tap)
                     .value("v_f", v_f as f64)
                     .value("v_i", v_i as f64)
-                    .value("delta", delta as f64);
-                let inside = stored != far && w.contains(p);
-                let e = e.note(if inside {
-                    "p inside the wedge: v_i at p"
-                } else {
-                    "p outside the wedge: v_i at the exit point"
-                });
+                    .value("delta", delta as f64)
+                    .note(if inside {
+                        "p inside the wedge: v_i at p"
+                    } else {
+                        "p outside the wedge: v_i at the exit point"
+                    });
                 tap.push(match added {
                     Some(a) => tile.record_add(e, a),
                     None => e.read("li", Raw::Int(tile.values[f.local])),

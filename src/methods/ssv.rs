@@ -72,7 +72,7 @@ use crate::geometry::silhouette::{light_facing, possible_silhouettes};
 use crate::geometry::ssv_wedge::{SsvWedge, WedgeLight};
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
-use crate::gpu::probe::PrimitiveKind;
+use crate::gpu::probe::{PrimitiveKind, Tap};
 use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
 use crate::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
 use crate::gpu::shader_float::ShaderFloat;
@@ -414,22 +414,23 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSett
             frame.tiles[t].depth.read(f.local, c);
             let k = owner[tri.prim as usize];
             let ew = &edges[k as usize];
-            let event = tap.map(|tap| {
+            // The watched fragment's event, built only there.
+            let event = |tap: Tap| {
                 let (kind, how) = match ew.wedge {
                     Some(_) => (PrimitiveKind::Wedge, "face"),
                     None => (PrimitiveKind::FullScreen, "full-screen"),
                 };
                 let detail = format!("of silhouette edge {k}, {how} triangle {}", tri.prim);
-                let e = tap
-                    .event()
-                    .primitive(kind, k, detail, Some(tri.front_facing));
-                (tap, e)
-            });
-            let Some(rcv) = source.receivers[(f.y * source.width + f.x) as usize] else {
-                if let Some((tap, e)) = event {
-                    tap.push(e.note("background: no receiver"));
+                tap.event()
+                    .primitive(kind, k, detail, Some(tri.front_facing))
+            };
+            let stop = |why: &str| {
+                if let Some(tap) = tap {
+                    tap.push(event(tap).note(why));
                 }
-                return;
+            };
+            let Some(rcv) = source.receivers[(f.y * source.width + f.x) as usize] else {
+                return stop("background: no receiver");
             };
             let p = rcv.point.as_dvec3();
             if ew
@@ -437,15 +438,13 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSett
                 .as_ref()
                 .is_some_and(|w| !w.shader_contains::<T>(p))
             {
-                if let Some((tap, e)) = event {
-                    tap.push(e.note("receiver outside the wedge: discarded"));
-                }
-                return;
+                return stop("receiver outside the wedge: discarded");
             }
             c.fragments_shaded += 1;
             let coverage = source.coverage::<T>(ew, p);
-            let event = event.map(|(tap, e)| (tap, e.value("coverage", coverage[0] as f64)));
-            add_probed(vb, f.local, coverage, c, event);
+            add_probed(vb, f.local, coverage, c, tap, |tap| {
+                event(tap).value("coverage", coverage[0] as f64)
+            });
         },
     );
 
@@ -582,28 +581,33 @@ fn hard_quads_pass<V: VBufferTile>(frame: &Frame, test: ShadowTest, vbuf: &mut [
         |t, vb, tri, f, c, tap| {
             let (pass, z) = frame.tiles[t].depth.test(&depth, &f, c);
             c.depth_passed += pass as u64;
-            let event = tap.zip(parts.as_ref()).map(|(tap, parts)| {
-                let (kind, detail) = parts[tri.prim as usize].describe();
-                let e = tap
-                    .event()
-                    .primitive(kind, tri.prim, detail, Some(tri.front_facing));
-                let e = frame.tiles[t]
+            // The watched fragment's event, built only there.
+            let event = |tap: Tap| {
+                let e = tap.event();
+                let e = match &parts {
+                    Some(parts) => {
+                        let (kind, detail) = parts[tri.prim as usize].describe();
+                        e.primitive(kind, tri.prim, detail, Some(tri.front_facing))
+                    }
+                    None => e,
+                };
+                frame.tiles[t]
                     .depth
-                    .record_test(e, depth.func, f.local, z, pass);
-                (tap, e)
-            });
+                    .record_test(e, depth.func, f.local, z, pass)
+            };
             let delta = match (test, pass, tri.front_facing) {
                 (ShadowTest::ZPass, true, true) | (ShadowTest::ZFail, false, false) => -1.0,
                 (ShadowTest::ZPass, true, false) | (ShadowTest::ZFail, false, true) => 1.0,
                 _ => {
-                    if let Some((tap, e)) = event {
-                        tap.push(e.read("vbuffer", vb.raw(f.local)).note("no count"));
+                    if let Some(tap) = tap {
+                        tap.push(event(tap).read("vbuffer", vb.raw(f.local)).note("no count"));
                     }
                     return;
                 }
             };
-            let event = event.map(|(tap, e)| (tap, e.value("delta", delta as f64)));
-            add_probed(vb, f.local, [delta; 3], c, event);
+            add_probed(vb, f.local, [delta; 3], c, tap, |tap| {
+                event(tap).value("delta", delta as f64)
+            });
         },
     );
     counters

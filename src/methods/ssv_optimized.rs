@@ -92,7 +92,7 @@ use crate::geometry::tight_wedge::{
 use crate::gpu::buffers::{alloc_tiles, StencilTile};
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
-use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw, Tap};
+use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw};
 use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
 use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::split_blend::{SplitFormat, SplitTarget, SplitVTile};
@@ -682,41 +682,44 @@ fn render_group(
                     }
                     let job = &jobs[h as usize];
                     let tested = matches!(roles[tri.prim as usize], Role::ShadeTested(_));
-                    let event = tap.map(|tap| (tap, primitive(tap.event(), tri)));
-                    // Each early return records why the fragment stopped there.
-                    let stop = |e: Option<(Tap, ProbeEvent)>, why: &str| {
-                        if let Some((tap, e)) = e {
-                            tap.push(e.note(why));
+                    // The watched fragment's event, built only there: what it saw up to
+                    // where it stopped.
+                    let record = |build: &dyn Fn(ProbeEvent) -> ProbeEvent| {
+                        if let Some(tap) = tap {
+                            tap.push(build(primitive(tap.event(), tri)));
                         }
                     };
-                    let event = if tested {
-                        event
-                    } else {
+                    let stored = (!tested).then(|| {
                         cnt.stencil_read_bytes += 1;
-                        let stored = st.stencil.values[f.local];
-                        let event = event.map(|(tap, e)| {
-                            let e = e.value("reference", job.reference as f64);
-                            (tap, e.read("stencil", Raw::U8(stored)))
-                        });
-                        if stored != job.reference {
-                            return stop(event, "stencil ≠ reference: not in this half");
-                        }
-                        event
-                    };
-                    let (pass, z) = frame.tiles[t].depth.test(&gequal, &f, cnt);
-                    let event = event.map(|(tap, e)| {
-                        let depth = &frame.tiles[t].depth;
-                        (tap, depth.record_test(e, gequal.func, f.local, z, pass))
+                        st.stencil.values[f.local]
                     });
+                    let seen_stencil = |e: ProbeEvent| match stored {
+                        Some(v) => e
+                            .value("reference", job.reference as f64)
+                            .value("stencil", v as f64),
+                        None => e,
+                    };
+                    if stored.is_some_and(|v| v != job.reference) {
+                        return record(&|e| {
+                            seen_stencil(e).note("stencil ≠ reference: not in this half")
+                        });
+                    }
+                    let (pass, z) = frame.tiles[t].depth.test(&gequal, &f, cnt);
+                    let seen_depth = |e: ProbeEvent| {
+                        let depth = &frame.tiles[t].depth;
+                        depth.record_test(seen_stencil(e), gequal.func, f.local, z, pass)
+                    };
                     if !pass {
-                        return stop(event, "receiver behind the back face");
+                        return record(&|e| seen_depth(e).note("receiver behind the back face"));
                     }
                     cnt.depth_passed += 1;
                     let Some(p) = receivers[t][f.local] else {
-                        return stop(event, "background");
+                        return record(&|e| seen_depth(e).note("background"));
                     };
                     if tested && !job.shape.contains(p, 0.0) {
-                        return stop(event, "receiver outside the half (shader test)");
+                        return record(&|e| {
+                            seen_depth(e).note("receiver outside the half (shader test)")
+                        });
                     }
                     cnt.fragments_shaded += 1;
                     let target = job
@@ -725,12 +728,12 @@ fn render_group(
                     let cov = light.coverage(p, job.edge[0], job.edge[1], s.coverage);
                     let split = table.lookup(cov);
                     let blend = st.v.blend(target, f.local, split, cnt);
-                    if let Some((tap, e)) = event {
-                        let e = e
+                    record(&|e| {
+                        let e = seen_depth(e)
                             .value("coverage", cov)
                             .value("split value", format.reconstruct(split) as f64);
-                        tap.push(blend.record(e));
-                    }
+                        blend.record(e)
+                    });
                 }
             },
         );

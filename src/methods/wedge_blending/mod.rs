@@ -119,7 +119,7 @@ use crate::gpu::buffers::{alloc_tiles, overflow_record, record_overflow, Stencil
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::pack4ub::{FloatTarget, StoreEvents};
-use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw, Tap};
+use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw};
 use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
 use crate::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
 use crate::gpu::tiling::Tiling;
@@ -872,40 +872,44 @@ fn render_with<S: VBufferStorage>(
                 let role = roles[tri.prim as usize];
                 let job = &jobs[role.job as usize];
                 let depth = &frame.tiles[t].depth;
-                let event = tap.map(|tap| {
-                    let half = if job.inner { "inner" } else { "outer" };
-                    let detail = format!("{half} half of edge {} of silhouette {si}", job.edge);
-                    let kind = if job.full_screen {
-                        PrimitiveKind::FullScreen
-                    } else {
-                        PrimitiveKind::HalfWedge
-                    };
-                    let e = tap
-                        .event()
-                        .primitive(kind, role.job, detail, Some(tri.front_facing));
-                    (tap, e)
-                });
-                // Each rejection records why the fragment stopped there.
-                let stop = |e: Option<(Tap, ProbeEvent)>, why: &str| {
-                    if let Some((tap, e)) = e {
-                        tap.push(e.note(why));
+                // The watched fragment's event, built only there: what it saw up to where it
+                // stopped.
+                let record = |build: &dyn Fn(ProbeEvent) -> ProbeEvent| {
+                    if let Some(tap) = tap {
+                        let half = if job.inner { "inner" } else { "outer" };
+                        let detail = format!("{half} half of edge {} of silhouette {si}", job.edge);
+                        let kind = if job.full_screen {
+                            PrimitiveKind::FullScreen
+                        } else {
+                            PrimitiveKind::HalfWedge
+                        };
+                        let e =
+                            tap.event()
+                                .primitive(kind, role.job, detail, Some(tri.front_facing));
+                        tap.push(build(e));
                     }
                 };
-                let (stored, event) = if !role.depth_tested {
-                    (depth.read(f.local, cnt), event)
+                let (stored, test) = if !role.depth_tested {
+                    (depth.read(f.local, cnt), None)
                 } else {
                     let (pass, z) = depth.test(&less, &f, cnt);
-                    let event = event
-                        .map(|(tap, e)| (tap, depth.record_test(e, less.func, f.local, z, pass)));
                     if !pass {
                         tile.counters.rejected_depth += 1;
-                        return stop(event, "depth test failed: the receiver is in front");
+                        return record(&|e| {
+                            depth
+                                .record_test(e, less.func, f.local, z, pass)
+                                .note("depth test failed: the receiver is in front")
+                        });
                     }
                     cnt.depth_passed += 1;
-                    (depth.values[f.local], event)
+                    (depth.values[f.local], Some(z))
+                };
+                let seen = |e: ProbeEvent| match test {
+                    Some(z) => depth.record_test(e, less.func, f.local, z, true),
+                    None => e,
                 };
                 let Some(rcv) = receivers[(f.y * tiling.width + f.x) as usize] else {
-                    return stop(event, "background");
+                    return record(&|e| seen(e).note("background"));
                 };
                 let z_w = frame.gpu.depth.to_window(stored);
                 if job
@@ -914,31 +918,24 @@ fn render_with<S: VBufferStorage>(
                     .any(|pl| pl.footprint_outside(f.x, f.y, z_w))
                 {
                     tile.counters.rejected_outside_planes += 1;
-                    return stop(event, "outside a bounding plane (Fig. 7)");
+                    return record(&|e| seen(e).note("outside a bounding plane (Fig. 7)"));
                 }
                 let [a, b] = sil.edges[job.edge];
                 let (side, p) = quads[job.edge].side(f.x, f.y, stored, rcv.point.as_dvec3(), frame);
                 if side == 0.0 || (side > 0.0) != job.inner {
                     tile.counters.rejected_quad_side += 1;
-                    return stop(event, "the other side of the hard quad (Fig. 8)");
+                    return record(&|e| seen(e).note("the other side of the hard quad (Fig. 8)"));
                 }
                 cnt.fragments_shaded += 1;
                 tile.dirty = true;
                 let regions = edge_in_parts(&light, p, a, b);
                 if regions.iter().all(Option::is_none) {
                     tile.counters.missed_light += 1;
-                    return stop(event, "the edge reaches no part of the light");
+                    return record(&|e| seen(e).note("the edge reaches no part of the light"));
                 }
                 cnt.color_read_bytes += sil_bytes;
                 let before = tile.silhouette[f.local];
                 let mut parts = storage.load(&before);
-                let event = event.map(|(tap, e)| {
-                    let areas = regions
-                        .iter()
-                        .enumerate()
-                        .filter_map(|(k, r)| r.as_ref().map(|r| (format!("area{k}"), r.area)));
-                    (tap, areas.fold(e, |e, (name, a)| e.value(&name, a)))
-                });
                 for (part, region) in parts.iter_mut().zip(&regions) {
                     let Some(r) = region else { continue };
                     tile.counters.part_updates += 1;
@@ -952,7 +949,12 @@ fn render_with<S: VBufferStorage>(
                 tile.silhouette[f.local] = px;
                 tile.counters.packing_clamps += clamps;
                 cnt.color_write_bytes += sil_bytes;
-                if let Some((tap, e)) = event {
+                record(&|e| {
+                    let areas = regions
+                        .iter()
+                        .enumerate()
+                        .filter_map(|(k, r)| Some((k, r.as_ref()?)));
+                    let e = areas.fold(seen(e), |e, (k, r)| e.value(&format!("area{k}"), r.area));
                     let e = e.write(
                         "silhouette-vbuffer",
                         storage.raw(&before),
@@ -960,12 +962,12 @@ fn render_with<S: VBufferStorage>(
                         Overflow::Clamp,
                         clamps,
                     );
-                    tap.push(e.note(if job.inner {
+                    e.note(if job.inner {
                         "inner: the regions' areas subtracted, max X/Y raised"
                     } else {
                         "outer: the regions' areas added, rectangles grown"
-                    }));
-                }
+                    })
+                });
             },
         );
         passes[2].0 += c2;
