@@ -252,7 +252,7 @@ pub fn projected_edge_near_clipped(
 /// the quad `a, b, b∞, a∞` clipped to the square, area / 4 (Paper III §3.3: the function
 /// `f(x1, y1, x2, y2)` the coverage texture stores). For a clipped projected edge from
 /// [`projected_edge_in_light`] this equals the magnitude of [`edge_coverage_exact`] whenever the
-/// edge lies entirely between `p` and the light plane. At most 1 ([`square_fraction`]: found
+/// edge lies entirely between `p` and the light plane. At most 1 (rounding clamped: found
 /// by fuzzing, a segment whose end was 2·10⁻¹⁴ from the center, so that its ray's direction at
 /// infinity was as short, gave 1.7·10¹³).
 pub fn segment_coverage(a: DVec2, b: DVec2) -> f64 {
