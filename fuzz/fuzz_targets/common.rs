@@ -616,12 +616,28 @@ fn sphere_condition(center: DVec3, radius: f64, p: DVec3, e0: DVec3, e1: DVec3) 
 /// The largest of [`sphere_condition`]'s per-end factors (at least 1): an end's offset from the
 /// center in radii over its height above `p`'s level as a fraction of the light's.
 fn sphere_end_factor(center: DVec3, radius: f64, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
-    let w = center - p;
-    let dist = w.length();
     [e0, e1]
         .iter()
-        .map(|e| (1.0 + (*e - center).length() / radius) / ((*e - p).dot(w) / dist / dist).abs())
+        .map(|e| (1.0 + (*e - center).length() / radius) / height_fraction(center, p, *e).abs())
         .fold(1.0, f64::max)
+}
+
+/// The height of `e` above `p` toward the light center, as a fraction of the center's (0 at
+/// `p`'s level, 1 in the facing disk's plane): the light space's z of [`clip_to_light_cone`].
+fn height_fraction(center: DVec3, p: DVec3, e: DVec3) -> f64 {
+    let w = center - p;
+    let dist = w.length();
+    (e - p).dot(w) / dist / dist
+}
+
+/// 1 / the smallest height fraction at which [`clip_to_light_cone`]'s chord can end next to the
+/// cone's apex `p`: an edge end's ([`height_fraction`]), or the edge's line passing `p`, within
+/// about 1 / [`end_on`] of it. At least 1.
+fn apex_factor(center: DVec3, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
+    [e0, e1]
+        .iter()
+        .map(|e| 1.0 / height_fraction(center, p, *e).abs())
+        .fold(end_on(p, e0, e1).max(1.0), f64::max)
 }
 
 /// How much [`clip_to_light_cone`] amplifies rounding in its chord's ends: the product of
@@ -936,12 +952,13 @@ fn rect_coverage(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) {
 /// with `p` off the quad's plane, negated (to rounding) when the edge is reversed;
 /// [`clip_to_light_cone`]'s chord lies in the unit disk (to the square root of the rounding of
 /// [`sphere_chord_condition`]: its ends are roots of a quadratic, double where the edge's line
-/// touches the cone; plus the rounding of [`end_on`]²: where the edge's line passes a distance
-/// δ from `p`, the cone's apex, it crosses the cone within about δ of the apex, at roots δ
-/// apart whose error ε/δ the projection divides by their height, about δ again: ε/δ², and
-/// 1/δ is the end-on factor; measured 2·ε·end_on² for end-on factors 8·10²…8·10⁶, found by
-/// fuzzing: a receiver 3·10⁻⁸ from the line of an edge 1.7·10³⁸ long, chord end 1.006 from
-/// the center, the coverage right to 10⁻⁶).
+/// touches the cone; plus the rounding of [`apex_factor`]²: a chord end at a height fraction δ
+/// above `p`, the cone's apex, is a root of the cone's quadratic, whose coefficients are of the
+/// light's size (the clip's parameter starts near the center) while the cone there is δ wide:
+/// off by ε/δ, which the projection divides by the height, δ again: ε/δ²; measured 2·ε·end_on²
+/// where the edge's line passes p (end-on factors 8·10²…8·10⁶). Found by fuzzing: a receiver
+/// 3·10⁻⁸ from the line of an edge 1.7·10³⁸ long, chord end 1.006 from the center, the coverage
+/// right to 10⁻⁶; an edge end 1.5·10⁻⁸ of the light's distance above `p`, chord end 1.015).
 fn sphere_coverage(center: DVec3, radius: f64, p: DVec3, e0: DVec3, e1: DVec3) {
     let at = || format!("p {p}, edge {e0} {e1}, sphere {center} r {radius}");
     let c = sphere_edge_coverage_exact(center, radius, p, e0, e1);
@@ -967,7 +984,7 @@ fn sphere_coverage(center: DVec3, radius: f64, p: DVec3, e0: DVec3, e1: DVec3) {
     );
     if let Some([a, b]) = clip_to_light_cone(center, radius, p, e0, e1) {
         let chord = rounding(sphere_chord_condition(center, radius, p, e0, e1));
-        let apex = rounding(end_on(p, e0, e1) * end_on(p, e0, e1));
+        let apex = rounding(apex_factor(center, p, e0, e1) * apex_factor(center, p, e0, e1));
         for q in [a, b] {
             assert!(
                 q.is_finite() && q.length() <= 1.0 + UNIT_SLACK + chord + chord.sqrt() + apex,
