@@ -559,18 +559,20 @@ fn quad_plane_sine(c: DVec3, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
 /// `e` are `S = s_e·h_p − s_p·h_e` (T likewise) and `W = h_p − h_e` (its ray: `W = −h_e`; where
 /// the slab cuts the ray: `W = 0`), each computed with an error of ε times the size of its
 /// terms, and interpolates between them, which carries that error over to the smallest of
-/// them, among them the point where the edge crosses the light's plane: `(s₀·h_p, t₀·h_p, h_p)`,
-/// whose quad side runs from the light center through `(s₀, t₀)` (found by fuzzing: an edge
-/// crossing the plane 10⁻¹⁴ of the light's size from its center got coverage −0.3755 one way
-/// and 0.3746 the other). That is the largest terms over the smallest such coordinate (|S, T|
-/// or |W|, or `h_p`, the slab's thickness), times the [`end_on`] factor: where the slab cuts the edge at `p`'s
-/// level, the clipped point is the direction from `p` to the edge's point there, a difference
-/// of points at least `p`'s distance from the edge's line apart, whose direction the border
-/// clips then follow (found by fuzzing: a receiver on the edge, λ = 0, whose clipped point at
-/// its level was `p` itself to rounding, gave a projected point at t = −2). Infinite (or NaN)
-/// when `p` or an end is in the light's plane, an end is at `p`'s level or projects onto the
-/// light center, the edge crosses the light's plane at its center, or `p` is on the edge's
-/// line.
+/// them. That is the largest terms over the smallest such coordinate (|S, T| or |W|, or `h_p`,
+/// the slab's thickness), among them the two points where the slab cuts the edge:
+/// - where it crosses the light's plane, `(s₀·h_p, t₀·h_p, h_p)`, whose quad side runs from the
+///   light center through `(s₀, t₀)` (found by fuzzing: an edge crossing the plane 10⁻¹⁴ of the
+///   light's size from its center got coverage −0.3755 one way and 0.3746 the other);
+/// - where it crosses `p`'s level, `(h_p·(s_x − s_p), h_p·(t_x − t_p), 0)`, the direction from
+///   `p` to the edge's point `x` there, which the border clips follow: a difference of light
+///   coordinates of the size of `p`'s (found by fuzzing: a receiver on the edge, λ = 0, whose
+///   `x` was `p` itself to rounding, gave a projected point at t = −2; a receiver 0.8 from `x`
+///   and 5.5·10⁵ from the center of a light as large, its border 1.4·10⁻¹⁰ off).
+///
+/// Infinite (or NaN) when `p` or an end is in the light's plane, an end is at `p`'s level or
+/// projects onto the light center, or the edge crosses the light's plane at its center or
+/// `p`'s level at `p`.
 fn rect_condition(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
     let lp = l.local(p);
     let (mut terms, mut smallest) = (0.0f64, f64::INFINITY);
@@ -588,11 +590,15 @@ fn rect_condition(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
             .min(lp.z.abs());
     }
     let (l0, l1) = (l.local(e0), l.local(e1));
-    if l0.z * l1.z < 0.0 {
-        let crossing = l0.lerp(l1, l0.z / (l0.z - l1.z));
-        smallest = smallest.min(crossing.x.abs().max(crossing.y.abs()) * lp.z.abs());
+    // The edge's points at the light's plane (height 0) and at p's level, relative to the
+    // center and to p.
+    for (level, from) in [(0.0, DVec3::ZERO), (lp.z, lp)] {
+        if (l0.z - level) * (l1.z - level) < 0.0 {
+            let x = l0.lerp(l1, (level - l0.z) / (l1.z - l0.z)) - from;
+            smallest = smallest.min(x.x.abs().max(x.y.abs()) * lp.z.abs());
+        }
     }
-    terms / smallest * end_on(p, e0, e1).max(1.0)
+    terms / smallest
 }
 
 /// 1 / the sine of the angle the edge `e0 e1` subtends at `p` (`|e0 − p|·|e1 − p| / |(e0 − p) ×
