@@ -39,3 +39,11 @@ pub const MAX_THREADS: usize = 1024;
 /// spans about two f32 steps (2⁻²⁴ relative) of the distance it is seen at; narrower views
 /// put several pixels into one representable coordinate and the methods stop agreeing.
 pub const MIN_VFOV_DEG: f64 = 0.1;
+/// Smallest width of a rectangular light relative to its length: its narrower height
+/// `|u × v| / max(|u|, |v|)` over `max(|u|, |v|)` (the sine of the angle between `u` and `v`
+/// times the shorter side over the longer). f32 keeps 2⁻²⁴ ≈ 6·10⁻⁸ of a coordinate, so the
+/// corners `c ± u ± v` of a thinner light round onto a segment, and the coverage code's light
+/// frame mixes the two sides' scales (found by fuzzing: a light 10³⁴ long and 60 wide got
+/// coverage −0.036 for an edge one way and 0 the other). 10⁻⁶ is 16 times that rounding, the
+/// bound the check for parallel sides already used.
+pub const MIN_RECT_LIGHT_WIDTH: f64 = 1e-6;

@@ -560,13 +560,19 @@ fn quad_plane_sine(c: DVec3, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
 /// the slab cuts the ray: `W = 0`), each computed with an error of ε times the size of its
 /// terms, and interpolates between them, which carries that error over to the smallest of
 /// them. That is the largest terms over the smallest such coordinate (|S, T| or |W|, or `h_p`,
-/// the slab's thickness), times the [`end_on`] factor: where the slab cuts the edge at `p`'s
-/// level, the clipped point is the direction from `p` to the edge's point there, a difference
-/// of points at least `p`'s distance from the edge's line apart, whose direction the border
-/// clips then follow (found by fuzzing: a receiver on the edge, λ = 0, whose clipped point at
-/// its level was `p` itself to rounding, gave a projected point at t = −2). Infinite (or NaN)
-/// when `p` or an end is in the light's plane, an end is at `p`'s level or projects onto the
-/// light center, or `p` is on the edge's line.
+/// the slab's thickness), among them the two points where the slab cuts the edge:
+/// - where it crosses the light's plane, `(s₀·h_p, t₀·h_p, h_p)`, whose quad side runs from the
+///   light center through `(s₀, t₀)` (found by fuzzing: an edge crossing the plane 10⁻¹⁴ of the
+///   light's size from its center got coverage −0.3755 one way and 0.3746 the other);
+/// - where it crosses `p`'s level, `(h_p·(s_x − s_p), h_p·(t_x − t_p), 0)`, the direction from
+///   `p` to the edge's point `x` there, which the border clips follow: a difference of light
+///   coordinates of the size of `p`'s (found by fuzzing: a receiver on the edge, λ = 0, whose
+///   `x` was `p` itself to rounding, gave a projected point at t = −2; a receiver 0.8 from `x`
+///   and 5.5·10⁵ from the center of a light as large, its border 1.4·10⁻¹⁰ off).
+///
+/// Infinite (or NaN) when `p` or an end is in the light's plane, an end is at `p`'s level or
+/// projects onto the light center, or the edge crosses the light's plane at its center or
+/// `p`'s level at `p`.
 fn rect_condition(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
     let lp = l.local(p);
     let (mut terms, mut smallest) = (0.0f64, f64::INFINITY);
@@ -583,7 +589,16 @@ fn rect_condition(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
             .min(le.z.abs())
             .min(lp.z.abs());
     }
-    terms / smallest * end_on(p, e0, e1).max(1.0)
+    let (l0, l1) = (l.local(e0), l.local(e1));
+    // The edge's points at the light's plane (height 0) and at p's level, relative to the
+    // center and to p.
+    for (level, from) in [(0.0, DVec3::ZERO), (lp.z, lp)] {
+        if (l0.z - level) * (l1.z - level) < 0.0 {
+            let x = l0.lerp(l1, (level - l0.z) / (l1.z - l0.z)) - from;
+            smallest = smallest.min(x.x.abs().max(x.y.abs()) * lp.z.abs());
+        }
+    }
+    terms / smallest
 }
 
 /// 1 / the sine of the angle the edge `e0 e1` subtends at `p` (`|e0 − p|·|e1 − p| / |(e0 − p) ×
@@ -607,12 +622,28 @@ fn sphere_condition(center: DVec3, radius: f64, p: DVec3, e0: DVec3, e1: DVec3) 
 /// The largest of [`sphere_condition`]'s per-end factors (at least 1): an end's offset from the
 /// center in radii over its height above `p`'s level as a fraction of the light's.
 fn sphere_end_factor(center: DVec3, radius: f64, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
-    let w = center - p;
-    let dist = w.length();
     [e0, e1]
         .iter()
-        .map(|e| (1.0 + (*e - center).length() / radius) / ((*e - p).dot(w) / dist / dist).abs())
+        .map(|e| (1.0 + (*e - center).length() / radius) / height_fraction(center, p, *e).abs())
         .fold(1.0, f64::max)
+}
+
+/// The height of `e` above `p` toward the light center, as a fraction of the center's (0 at
+/// `p`'s level, 1 in the facing disk's plane): the light space's z of [`clip_to_light_cone`].
+fn height_fraction(center: DVec3, p: DVec3, e: DVec3) -> f64 {
+    let w = center - p;
+    let dist = w.length();
+    (e - p).dot(w) / dist / dist
+}
+
+/// 1 / the smallest height fraction at which [`clip_to_light_cone`]'s chord can end next to the
+/// cone's apex `p`: an edge end's ([`height_fraction`]), or the edge's line passing `p`, within
+/// about 1 / [`end_on`] of it. At least 1.
+fn apex_factor(center: DVec3, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
+    [e0, e1]
+        .iter()
+        .map(|e| 1.0 / height_fraction(center, p, *e).abs())
+        .fold(end_on(p, e0, e1).max(1.0), f64::max)
 }
 
 /// How much [`clip_to_light_cone`] amplifies rounding in its chord's ends: the product of
@@ -927,7 +958,13 @@ fn rect_coverage(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) {
 /// with `p` off the quad's plane, negated (to rounding) when the edge is reversed;
 /// [`clip_to_light_cone`]'s chord lies in the unit disk (to the square root of the rounding of
 /// [`sphere_chord_condition`]: its ends are roots of a quadratic, double where the edge's line
-/// touches the cone).
+/// touches the cone; plus the rounding of [`apex_factor`]²: a chord end at a height fraction δ
+/// above `p`, the cone's apex, is a root of the cone's quadratic, whose coefficients are of the
+/// light's size (the clip's parameter starts near the center) while the cone there is δ wide:
+/// off by ε/δ, which the projection divides by the height, δ again: ε/δ²; measured 2·ε·end_on²
+/// where the edge's line passes p (end-on factors 8·10²…8·10⁶). Found by fuzzing: a receiver
+/// 3·10⁻⁸ from the line of an edge 1.7·10³⁸ long, chord end 1.006 from the center, the coverage
+/// right to 10⁻⁶; an edge end 1.5·10⁻⁸ of the light's distance above `p`, chord end 1.015).
 fn sphere_coverage(center: DVec3, radius: f64, p: DVec3, e0: DVec3, e1: DVec3) {
     let at = || format!("p {p}, edge {e0} {e1}, sphere {center} r {radius}");
     let c = sphere_edge_coverage_exact(center, radius, p, e0, e1);
@@ -953,9 +990,10 @@ fn sphere_coverage(center: DVec3, radius: f64, p: DVec3, e0: DVec3, e1: DVec3) {
     );
     if let Some([a, b]) = clip_to_light_cone(center, radius, p, e0, e1) {
         let chord = rounding(sphere_chord_condition(center, radius, p, e0, e1));
+        let apex = rounding(apex_factor(center, p, e0, e1) * apex_factor(center, p, e0, e1));
         for q in [a, b] {
             assert!(
-                q.is_finite() && q.length() <= 1.0 + UNIT_SLACK + chord + chord.sqrt(),
+                q.is_finite() && q.length() <= 1.0 + UNIT_SLACK + chord + chord.sqrt() + apex,
                 "chord point {q} outside the disk: {}",
                 at()
             );

@@ -308,9 +308,15 @@ pub fn projected_edge_near_clipped(
 /// the quad `a, b, b∞, a∞` clipped to the square, area / 4 (Paper III §3.3: the function
 /// `f(x1, y1, x2, y2)` the coverage texture stores). For a clipped projected edge from
 /// [`projected_edge_in_light`] this equals the magnitude of [`edge_coverage_exact`] whenever the
-/// edge lies entirely between `p` and the light plane.
+/// edge lies entirely between `p` and the light plane. At most 1 (rounding clamped: found
+/// by fuzzing, a segment whose end was 2·10⁻¹⁴ from the center, so that its ray's direction at
+/// infinity was as short, gave 1.7·10¹³).
 pub fn segment_coverage(a: DVec2, b: DVec2) -> f64 {
-    polygon_area(&segment_region(a, b)) / 4.0
+    let region: Vec<SVec2<f64>> = segment_region(a, b)
+        .iter()
+        .map(|v| SVec2::from_f64(*v))
+        .collect();
+    square_fraction(&region)
 }
 
 /// The region whose area [`segment_coverage`] measures, as a convex polygon in light
@@ -592,13 +598,19 @@ fn light_borders<T: ShaderFloat>() -> [fn(SVec3<T>) -> T; 4] {
     [|x| x.z - x.x, |x| x.z + x.x, |x| x.z - x.y, |x| x.z + x.y]
 }
 
-/// Clip a homogeneous polygon `(S, T, W)` to the light square and return its area / 4 (the
-/// square's area in light coordinates), unsigned, at most 1: the clipped polygon lies in the
-/// square, but where its `W` are tiny beside their rounding (a receiver 10⁻⁹ above the light's
-/// plane and 10 to the side of it) dividing by them can put vertices outside it (found by
-/// fuzzing: a coverage of −1.64).
+/// Clip a homogeneous polygon `(S, T, W)` to the light square and return the fraction of the
+/// square it covers ([`square_fraction`]).
 fn clipped_area_fraction<T: ShaderFloat>(poly: &[SVec3<T>]) -> T {
-    (shader_polygon_area(&clip_to_light(poly)) / T::from_f64(4.0)).min(T::one())
+    square_fraction(&clip_to_light(poly))
+}
+
+/// The area of a polygon clipped to the light square over the square's (4 in light
+/// coordinates), unsigned, at most 1: the polygon lies in the square, but where its vertices'
+/// `W` were tiny beside their rounding (a receiver 10⁻⁹ above the light's plane and 10 to the
+/// side of it) dividing by them can put vertices outside it (found by fuzzing: a coverage of
+/// −1.64).
+fn square_fraction<T: ShaderFloat>(clipped: &[SVec2<T>]) -> T {
+    (shader_polygon_area(clipped) / T::from_f64(4.0)).min(T::one())
 }
 
 /// Clip a homogeneous polygon `(S, T, W)` to the light square and dehomogenise it (vertices
@@ -731,6 +743,20 @@ mod tests {
                     "edge {e0} {e1}: {c} vs {expected}"
                 );
             }
+        }
+    }
+
+    /// A projected edge whose line runs through the light's center to rounding, one end
+    /// 2·10⁻¹⁴ from it (found by fuzzing: a receiver on the edge, so in the quad's plane): the
+    /// ray through that end has a direction as short, and clipping the region beyond the
+    /// segment gave 1.7·10¹³ of the light. Whatever the region, it is part of the light.
+    #[test]
+    fn segment_through_the_center_covers_at_most_the_light() {
+        let a = DVec2::new(-1.4153545364093077e-17, -1.0);
+        let b = DVec2::new(-1.415354536409308e-17, 2.1595223208207936e-14);
+        for (a, b) in [(a, b), (b, a)] {
+            let f = segment_coverage(a, b);
+            assert!((0.0..=1.0).contains(&f), "{f}");
         }
     }
 

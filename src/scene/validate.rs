@@ -5,7 +5,8 @@
 //! Checked: image size in `1..=MAX_IMAGE_SIZE`; every number finite (camera, light, every
 //! vertex, colours); camera with `vfov_deg` from [`MIN_VFOV_DEG`] up to (not including) 180, `eye ≠ target`, `up` not parallel to
 //! the view direction, `near > 0` if given; 1 to [`MAX_LIGHTS`] lights, each of positive size (radius > 0; `u`, `v`
-//! non-zero and not parallel; disk normal non-zero; a non-empty texture of `width·height`
+//! non-zero, not parallel, the light at least [`MIN_RECT_LIGHT_WIDTH`] of its length wide;
+//! disk normal non-zero; a non-empty texture of `width·height`
 //! texels in `[0, 1]`, emitting in every channel); at least one mesh, each a closed, consistently wound two-manifold
 //! ([`crate::geometry::adjacency::build`], the message names the offending edge) that is not
 //! inside out (signed volume not negative; flat two-sided meshes have volume 0); every light
@@ -16,7 +17,7 @@
 use super::{Camera, Light, LightShape, Mesh, Scene};
 use crate::error::InputError;
 use crate::geometry::adjacency;
-use crate::limits::{MAX_IMAGE_SIZE, MAX_LIGHTS, MIN_VFOV_DEG};
+use crate::limits::{MAX_IMAGE_SIZE, MAX_LIGHTS, MIN_RECT_LIGHT_WIDTH, MIN_VFOV_DEG};
 use glam::{DVec3, Vec3};
 
 /// Checks every invariant a [`Scene`] promises (see the module docs); the first violation is
@@ -346,6 +347,21 @@ pub fn validate_light(l: &Light) -> Result<(), (&'static str, String)> {
                     "{} is parallel to light.u {} (zero-area light)",
                     v3(v),
                     v3(u)
+                ),
+            ));
+        }
+        let long = ud.length().max(vd.length());
+        let wide = ud.cross(vd).length() / long;
+        if wide < MIN_RECT_LIGHT_WIDTH * long {
+            return Err((
+                "light.v",
+                format!(
+                    "{} and light.u {} make a light {:e} wide and {:e} long: thinner than \
+                     {MIN_RECT_LIGHT_WIDTH:e} of its length, its corners are not apart in f32",
+                    v3(v),
+                    v3(u),
+                    2.0 * wide,
+                    2.0 * long
                 ),
             ));
         }
@@ -719,6 +735,22 @@ mod tests {
             v: Vec3::X * -2.0,
         };
         assert!(msg(&s).contains("light.v") && msg(&s).contains("parallel"));
+        // A light 2·10⁷ long and 2 wide: thinner than 10⁻⁶ of its length (MIN_RECT_LIGHT_WIDTH);
+        // 2·10⁵ long is accepted.
+        s.lights[0].shape = LightShape::Rect {
+            u: Vec3::X * 1e7,
+            v: Vec3::Z,
+        };
+        assert_eq!(
+            msg(&s),
+            "test-scene: light.v: (0, 0, 1) and light.u (10000000, 0, 0) make a light 2e0 wide \
+             and 2e7 long: thinner than 1e-6 of its length, its corners are not apart in f32"
+        );
+        s.lights[0].shape = LightShape::Rect {
+            u: Vec3::X * 1e5,
+            v: Vec3::Z,
+        };
+        assert!(validate_light(&s.lights[0]).is_ok());
         s.lights[0].shape = LightShape::Disk {
             radius: 1.0,
             normal: Vec3::ZERO,
