@@ -104,6 +104,19 @@ enum ExperimentCmd {
         #[arg(long, default_value_t = penumbra::experiment::accuracy_time::TIMING_RUNS)]
         runs: usize,
     },
+    /// Issue 11: error added by each shader precision and buffer format, overflow of each
+    /// buffer format over stacks of N = 1…512 quads, the papers' precision claims checked
+    /// (default scenes cube-of-spheres and cube-of-spheres-sphere).
+    Precision {
+        /// Scene files or built-in names.
+        scenes: Vec<String>,
+        /// Output directory.
+        #[arg(long, default_value = penumbra::experiment::precision::DEFAULT_OUT)]
+        out: PathBuf,
+        /// Image side of the shader-precision and storage-format renders.
+        #[arg(long, default_value_t = penumbra::experiment::precision::DEFAULT_SIZE)]
+        size: u32,
+    },
     /// Join the outputs of accuracy-time shards into what an unsharded run writes.
     Merge {
         /// The shards' output directories.
@@ -383,7 +396,7 @@ fn load_scene(arg: &str) -> Result<Scene, InputError> {
 }
 
 fn experiment(cmd: ExperimentCmd) -> Result<(), Box<dyn std::error::Error>> {
-    use penumbra::experiment::{accuracy_time, sized, tile_size, wedge_blending};
+    use penumbra::experiment::{accuracy_time, precision, sized, tile_size, wedge_blending};
     let size_range = |size: u32| {
         if (16..=2048).contains(&size) {
             Ok(size)
@@ -465,6 +478,27 @@ fn experiment(cmd: ExperimentCmd) -> Result<(), Box<dyn std::error::Error>> {
             accuracy_time::write(&sweep, &out)?;
             print!("{}", accuracy_time::summary(&sweep));
             print_accuracy_outputs(&sweep, &out);
+        }
+        ExperimentCmd::Precision { scenes, out, size } => {
+            let names: Vec<String> = if scenes.is_empty() {
+                precision::SCENES.iter().map(|s| s.to_string()).collect()
+            } else {
+                scenes
+            };
+            let loaded = names
+                .iter()
+                .map(|n| load_scene(n))
+                .collect::<Result<Vec<_>, _>>()?;
+            let (study, maps) = precision::study(&loaded, size_range(size)?)?;
+            precision::write(&study, &maps, &out)?;
+            print!("{}", precision::summary(&study));
+            println!(
+                "outputs: {0}/{1}, {0}/{2}, {0}/{3}, {0}/precision.json, CSV files and maps/",
+                out.display(),
+                precision::SUMMARY_FILE,
+                precision::SHADER_PNG,
+                precision::OVERFLOW_PNG
+            );
         }
         ExperimentCmd::Merge { dirs, out } => {
             let shards = dirs

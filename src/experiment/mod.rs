@@ -4,6 +4,7 @@
 pub mod accuracy_time;
 pub mod panels;
 pub mod plotting;
+pub mod precision;
 pub mod tile_size;
 pub mod wedge_blending;
 

@@ -1,15 +1,16 @@
 //! The experiments' results that lie next to the page: an accuracy–time sweep
-//! ([`crate::experiment::accuracy_time`]: `accuracy-time.json` and the scenes' Pareto plots)
-//! and a tile-size sweep ([`crate::experiment::tile_size`]: its plot and CSV). Each is looked
+//! ([`crate::experiment::accuracy_time`]: `accuracy-time.json` and the scenes' Pareto plots),
+//! a tile-size sweep ([`crate::experiment::tile_size`]: its plot and CSV) and the precision
+//! experiment ([`crate::experiment::precision`]: its two plots and summary). Each is looked
 //! for in the report's directory itself and where its command writes by default relative to
-//! the default output directory (`experiment/accuracy-time/` and `experiment/`, so that the
+//! the default output directory (`experiment/accuracy-time/`, `experiment/` and `experiment/precision/`, so that the
 //! default run's `out/index.html` finds `out/experiment/…`). The page shows a scene's Pareto
-//! plot and Pareto-optimal configurations in the scene's section, the tile-size plot once at
-//! the end (its scene is named in the plot).
+//! plot and Pareto-optimal configurations in the scene's section, the tile-size plot and the
+//! precision plots once at the end.
 
 use super::html::{url, Html};
 use crate::experiment::accuracy_time::{self, fmt_g, pareto_rows, plot_files, Sweep};
-use crate::experiment::tile_size;
+use crate::experiment::{precision, tile_size};
 use std::path::{Path, PathBuf};
 
 /// The folders, relative to the report's directory, where an experiment writing by default
@@ -32,6 +33,8 @@ pub struct Found {
     accuracy: Option<(PathBuf, Sweep)>,
     /// The tile-size experiment's folder relative to the report's directory.
     pub tile_size: Option<PathBuf>,
+    /// The precision experiment's folder relative to the report's directory.
+    pub precision: Option<PathBuf>,
     /// Results found but unreadable, one sentence each (shown at the top of the page).
     pub problems: Vec<String>,
 }
@@ -43,6 +46,7 @@ impl Found {
             root: dir.to_path_buf(),
             accuracy: None,
             tile_size: None,
+            precision: None,
             problems: Vec::new(),
         };
         for rel in candidates(accuracy_time::DEFAULT_OUT) {
@@ -58,6 +62,9 @@ impl Found {
         found.tile_size = candidates(crate::experiment::DEFAULT_OUT)
             .into_iter()
             .find(|rel| dir.join(rel).join(tile_size::SVG_FILE).is_file());
+        found.precision = candidates(precision::DEFAULT_OUT)
+            .into_iter()
+            .find(|rel| dir.join(rel).join(precision::SUMMARY_FILE).is_file());
         found
     }
 
@@ -155,6 +162,42 @@ impl Found {
                 ("alt", "memory accesses per tile size, one line per variant"),
             ],
         );
+        h.close();
+    }
+
+    /// The precision section (issue 11), if its results were found: the two plots and a
+    /// link to the summary with the papers' claims.
+    pub fn precision(&self, h: &mut Html) {
+        let Some(rel) = &self.precision else {
+            return;
+        };
+        h.open("section", &[("id", "precision")]);
+        h.element(
+            "h2",
+            &[],
+            "Precision: shader arithmetic, buffer formats and overflow",
+        );
+        h.open("p", &[]);
+        h.text("From the precision experiment: ");
+        let summary = rel.join(precision::SUMMARY_FILE);
+        h.element("a", &[("href", &url(&summary))], precision::SUMMARY_FILE);
+        h.text(" has every table and the papers' claims checked.");
+        h.close();
+        for (file, alt) in [
+            (
+                precision::SHADER_PNG,
+                "mean error against f64 per shader precision, one line per method and scene",
+            ),
+            (
+                precision::OVERFLOW_PNG,
+                "corrupted pixels per stack size, one line per buffer format",
+            ),
+        ] {
+            let at = rel.join(file);
+            if self.root.join(&at).is_file() {
+                h.void("img", &[("src", &url(&at)), ("alt", alt)]);
+            }
+        }
         h.close();
     }
 }

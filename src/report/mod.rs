@@ -125,6 +125,11 @@ pub fn page(dir: &Path, scenes: &[SceneRuns]) -> String {
         h.element("a", &[("href", "#tile-size")], "tile-size experiment");
         h.close();
     }
+    if found.precision.is_some() {
+        h.open("li", &[]);
+        h.element("a", &[("href", "#precision")], "precision experiment");
+        h.close();
+    }
     h.close();
     for note in &found.problems {
         h.element("p", &[("class", "notes")], note);
@@ -139,6 +144,7 @@ pub fn page(dir: &Path, scenes: &[SceneRuns]) -> String {
         h.close();
     }
     found.tile_size(&mut h);
+    found.precision(&mut h);
     h.close().close();
     h.finish()
 }

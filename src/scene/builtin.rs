@@ -252,8 +252,18 @@ const STRESS_QUADS: u32 = 300;
 /// stencil holds, so wrap and saturate differ), and the band 0.8 < |x| or |z| < 1.0 is inside
 /// fewer, from 299 down to 1, because the higher quads cast larger shadows.
 fn overlap_stress() -> Scene {
+    overlap_stack(STRESS_QUADS, LightShape::Point)
+}
+
+/// `overlap-stress` generalized (issue 11's overflow study): `n` two-sided quads (1.2×1.2)
+/// stacked 0.002 apart from y = 1 over the floor, under a light of `shape` centered at
+/// y = 4. Floor points below the stack's middle are inside all `n` shadow volumes and, under
+/// an area light, all `n` umbrae (a rectangle or sphere up to 0.5 across keeps the common
+/// umbra at least |x|, |z| < 0.4 for `n` ≤ 512); the rim between the smallest and the largest
+/// shadow is inside fewer volumes and many overlapping penumbrae.
+pub fn overlap_stack(n: u32, shape: LightShape) -> Scene {
     let mut meshes = vec![floor([-3.0, 3.0], [-3.0, 3.0])];
-    for i in 0..STRESS_QUADS {
+    for i in 0..n {
         let y = (1.0 + 0.002 * f64::from(i)) as f32;
         let q = [
             Vec3::new(-0.6, y, 0.6),
@@ -267,7 +277,7 @@ fn overlap_stress() -> Scene {
         camera([0.0, 2.0, 3.5], [0.0, 0.3, -0.3], 45.0),
         Light {
             center: Vec3::new(0.0, 4.0, 0.0),
-            shape: LightShape::Point,
+            shape,
         },
         meshes,
     )
