@@ -259,7 +259,19 @@ pub fn shader_projected_edge_in_light<T: ShaderFloat>(
     if a.z <= zero || b.z <= zero {
         return None;
     }
-    Some([a.truncate() / a.z, b.truncate() / b.z])
+    Some([in_light_square(a), in_light_square(b)])
+}
+
+/// The light coordinates `(S/W, T/W)` of a homogeneous point clipped to the light square,
+/// clamped to `[−1, 1]²`. The point lies in the square, but where its `W` is at the rounding
+/// of the coordinates it was interpolated from, dividing puts it anywhere (found by fuzzing: a
+/// receiver 6·10⁻⁹ from an edge lying at its own level, so that the whole projected edge is at
+/// infinity and its clipped ends have `W` ≈ 2·10⁻¹⁶, gave s = −1.118); the clamp removes only
+/// that rounding, and keeps texture coordinates in the texture.
+fn in_light_square<T: ShaderFloat>(x: SVec3<T>) -> SVec2<T> {
+    let one = T::one();
+    let q = x.truncate() / x.z;
+    SVec2::new(q.x.clamp(-one, one), q.y.clamp(-one, one))
 }
 
 /// The edge `e0 e1` projected from `p` onto the light plane, in light coordinates `(s, t)`,
@@ -757,6 +769,32 @@ mod tests {
         for (a, b) in [(a, b), (b, a)] {
             let f = segment_coverage(a, b);
             assert!((0.0..=1.0).contains(&f), "{f}");
+        }
+    }
+
+    /// A receiver 6·10⁻⁹ from an edge that lies at its own level to 3·10⁻⁸ (found by fuzzing,
+    /// `fuzz/regressions/coverage/rect-receiver-6e-9-from-edge-at-its-level-projected-at-infinity.bin`):
+    /// the projected edge is at infinity, its clipped ends had W ≈ 2·10⁻¹⁶ and divided to
+    /// s = −1.118. Every projected point lies in the light square.
+    #[test]
+    fn edge_at_the_receivers_level_projects_into_the_square() {
+        let l = RectLight::new(
+            DVec3::new(0.0, 3.0, 0.0),
+            DVec3::new(0.5, 0.0, 0.0),
+            DVec3::new(0.0, 0.0, 0.5),
+        );
+        let p = DVec3::new(
+            -0.8117647057946991,
+            -5.807754967142554e-9,
+            0.040808823529411765,
+        );
+        let e0 = DVec3::new(-1.0, 5.868143310234427e-39, 0.0);
+        let e1 = DVec3::new(4.656612873077393e-10, -3.085369826294482e-8, 0.216796875);
+        for (a, b) in [(e0, e1), (e1, e0)] {
+            let [q0, q1] = projected_edge_in_light(&l, p, a, b).expect("the edge projects");
+            for q in [q0, q1] {
+                assert!(q.abs().max_element() <= 1.0, "{q}");
+            }
         }
     }
 
