@@ -485,6 +485,14 @@ fn loop_wedges(lp: &[DVec3], o: &WedgeOptions, set: &mut WedgeSet) {
                 let n = slerp(e.n, next.n, j as f64 / (k + 1) as f64, e.dir);
                 let v = e.b;
                 let dir = n.cross(v - c).normalize_or_zero();
+                // An interpolated normal along the light ray through v gives no edge
+                // direction, and its wedge no front and back planes: left out, as the
+                // loop's own edges with a zero direction or normal are (found by fuzzing: a
+                // half turn at a vertex 2·10²⁴ away, whose incoming edge, the direction the
+                // turn takes, runs along the ray to rounding; NaN planes before).
+                if dir == DVec3::ZERO {
+                    continue;
+                }
                 edges.push(LoopEdge {
                     a: v,
                     b: v,
@@ -492,8 +500,8 @@ fn loop_wedges(lp: &[DVec3], o: &WedgeOptions, set: &mut WedgeSet) {
                     n,
                     extra: true,
                 });
+                set.extra_wedges += 1;
             }
-            set.extra_wedges += k;
         }
     }
     let k = edges.len();
