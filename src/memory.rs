@@ -35,7 +35,11 @@ pub const DUMP_BYTES_PER_PIXEL: u64 = 48;
 pub fn method_bytes_per_pixel(method: &str) -> u64 {
     match method {
         "raycast" | "hard-sv" => 72,
-        "nsample" | "pw2002" => 88,
+        "pw2002" => 88,
+        // Up to `nsample::MAX_CONCURRENT_SAMPLES` stencil passes at once, each with its own
+        // stencil and scratch: 92 bytes per pixel on one thread, 185 on eight (n = 16,
+        // `cube-of-spheres`, 512² and 1024²).
+        "nsample" => 208,
         "pw-restructured" | "ssv-optimized" => 96,
         "ssv" => 160,
         // wedge-blending, sized for packing = f32 (two RGBA32F targets per vBuffer; 8bit

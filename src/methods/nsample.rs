@@ -38,6 +38,10 @@ use std::time::Instant;
 /// Default sample count (Paper III §5.1).
 pub const DEFAULT_SAMPLES: u32 = 1024;
 
+/// Most stencil passes rendered at once (one per thread, at most this many): each holds its
+/// own stencil buffer until the batch is accumulated (1 byte per pixel, `memory`'s estimate).
+pub const MAX_CONCURRENT_SAMPLES: usize = 8;
+
 /// The point a sphere light's sampling disk faces: the center of the mesh bounds.
 pub fn sphere_disk_target(scene: &Scene) -> Vec3 {
     let mut lo = Vec3::splat(f32::MAX);
@@ -105,60 +109,82 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     frame.probe_record("accumulate", |tap, _| {
         tap.event().clear("accumulator", f64_bits(&[0.0; 3]))
     });
-    for (k, s) in samples.iter().enumerate() {
-        let _scope = frame
+    // The N stencil passes are independent: a batch of them runs at once (each is itself
+    // parallel over tiles), then the batch is accumulated in sample order, so the f64 sums and
+    // every output bit are those of one pass after another, for any thread count. A probe
+    // records events in the order the passes apply them: one sample at a time then.
+    let batch = if frame.probe.is_some() {
+        1
+    } else {
+        rayon::current_num_threads().clamp(1, MAX_CONCURRENT_SAMPLES)
+    };
+    let scoped = |k: usize| {
+        frame
             .probe
             .as_ref()
-            .map(|p| p.enter(|sc| sc.sample = Some(k as u32)));
-        let (stencil, c) = stencil_shadow(frame, s.position, &settings);
-        counters += c;
-        if frame.dump_buffers {
-            let sample = row_major(tiling, &stencil, |t| &t.overflows);
-            overflows.iter_mut().zip(sample).for_each(|(a, b)| *a += b);
-        }
-        let w = s.weight.map(f64::from);
-        let add = |px: &mut [f64; 3], v: u8| {
-            if v == 0 {
-                for ch in 0..3 {
-                    px[ch] += w[ch];
-                }
-            }
-        };
-        let probe = frame.probe_pass("accumulate");
-        acc.par_iter_mut()
-            .zip(&stencil)
+            .map(|p| p.enter(move |sc| sc.sample = Some(k as u32)))
+    };
+    for (b, chunk) in samples.chunks(batch).enumerate() {
+        let rendered: Vec<_> = chunk
+            .par_iter()
             .enumerate()
-            .for_each(
-                |(t, (a, st))| match probe.as_ref().filter(|p| p.watches_tile(t)) {
-                    None => a.iter_mut().zip(&st.values).for_each(|(px, v)| add(px, *v)),
-                    Some(p) => {
-                        for (i, (px, v)) in a.iter_mut().zip(&st.values).enumerate() {
-                            let before = *px;
-                            add(px, *v);
-                            if let Some(tap) = p.tap(t, i) {
-                                let e = tap
-                                    .event()
-                                    .primitive(PrimitiveKind::LightSample, k as u32, "", None)
-                                    .value("lit", (*v == 0) as u8 as f64)
-                                    .value("weight", w[0]);
-                                tap.push(e.read("stencil", Raw::U8(*v)));
-                                let e = tap.event().write(
-                                    "accumulator",
-                                    f64_bits(&before),
-                                    f64_bits(px),
-                                    Overflow::NonFinite,
-                                    0,
-                                );
-                                tap.push(e.note(if *v == 0 {
-                                    "stencil 0: the sample lights the pixel"
-                                } else {
-                                    "stencil ≠ 0: in the sample's shadow"
-                                }));
+            .map(|(j, s)| {
+                let _scope = scoped(b * batch + j);
+                stencil_shadow(frame, s.position, &settings)
+            })
+            .collect();
+        for (j, (s, (stencil, c))) in chunk.iter().zip(rendered).enumerate() {
+            let k = b * batch + j;
+            let _scope = scoped(k);
+            counters += c;
+            if frame.dump_buffers {
+                let sample = row_major(tiling, &stencil, |t| &t.overflows);
+                overflows.iter_mut().zip(sample).for_each(|(a, b)| *a += b);
+            }
+            let w = s.weight.map(f64::from);
+            let add = |px: &mut [f64; 3], v: u8| {
+                if v == 0 {
+                    for ch in 0..3 {
+                        px[ch] += w[ch];
+                    }
+                }
+            };
+            let probe = frame.probe_pass("accumulate");
+            acc.par_iter_mut()
+                .zip(&stencil)
+                .enumerate()
+                .for_each(
+                    |(t, (a, st))| match probe.as_ref().filter(|p| p.watches_tile(t)) {
+                        None => a.iter_mut().zip(&st.values).for_each(|(px, v)| add(px, *v)),
+                        Some(p) => {
+                            for (i, (px, v)) in a.iter_mut().zip(&st.values).enumerate() {
+                                let before = *px;
+                                add(px, *v);
+                                if let Some(tap) = p.tap(t, i) {
+                                    let e = tap
+                                        .event()
+                                        .primitive(PrimitiveKind::LightSample, k as u32, "", None)
+                                        .value("lit", (*v == 0) as u8 as f64)
+                                        .value("weight", w[0]);
+                                    tap.push(e.read("stencil", Raw::U8(*v)));
+                                    let e = tap.event().write(
+                                        "accumulator",
+                                        f64_bits(&before),
+                                        f64_bits(px),
+                                        Overflow::NonFinite,
+                                        0,
+                                    );
+                                    tap.push(e.note(if *v == 0 {
+                                        "stencil 0: the sample lights the pixel"
+                                    } else {
+                                        "stencil ≠ 0: in the sample's shadow"
+                                    }));
+                                }
                             }
                         }
-                    }
-                },
-            );
+                    },
+                );
+        }
     }
     let pass_name = match settings.test {
         ShadowTest::ZPass => "sample-shadow-volume-zpass",
