@@ -538,22 +538,9 @@ fn silhouettes(frame: &Frame, c: Vec3) -> Result<Vec<Vec<[DVec3; 2]>>, InputErro
 type GroupResult = (Vec<f32>, Counters, Vec<bool>, Vec<BufferDump>);
 
 /// Render one group (pass 1 quads + the wedges of `edges`) for light piece `light` into a
-/// fresh split V-buffer ([`GroupResult`]), the shaders in the frame's shader precision.
-fn render_group(
-    frame: &Frame,
-    light: &LightModel,
-    quads: Vec<[ClipVertex; 3]>,
-    edges: &[[DVec3; 2]],
-    s: &Settings,
-    receivers: &[Vec<Option<DVec3>>],
-) -> GroupResult {
-    crate::with_shader_float!(frame.gpu.shader, T => {
-        render_group_with::<T>(frame, light, quads, edges, s, receivers)
-    })
-}
-
-/// [`render_group`] with the shaders in the precision `T` (module doc, "Shader precision").
-fn render_group_with<T: ShaderFloat>(
+/// fresh split V-buffer ([`GroupResult`]), the shaders in the precision `T` (module doc,
+/// "Shader precision").
+fn render_group<T: ShaderFloat>(
     frame: &Frame,
     light: &LightModel,
     quads: Vec<[ClipVertex; 3]>,
@@ -940,8 +927,9 @@ fn receiver_tiles(frame: &Frame, position: PositionBuffer) -> Vec<Vec<Option<DVe
 }
 
 /// The visibility of one light piece (row-major, clamped) with the settings' overlap mode, the
-/// counters, per pixel whether a clamp changed a value, and the buffer dumps of its groups.
-fn piece_visibility(
+/// counters, per pixel whether a clamp changed a value, and the buffer dumps of its groups;
+/// the shaders in the precision `T`.
+fn piece_visibility<T: ShaderFloat>(
     frame: &Frame,
     light: &LightModel,
     s: &Settings,
@@ -958,7 +946,7 @@ fn piece_visibility(
         };
         let quads = shadow_volume_triangles(&meshes, c, &frame.proj, capping);
         let edges: Vec<[DVec3; 2]> = loops.into_iter().flatten().collect();
-        return Ok(render_group(frame, light, quads, &edges, s, receivers));
+        return Ok(render_group::<T>(frame, light, quads, &edges, s, receivers));
     }
     // §5.1: per loop, coverage c_l = 1 − V_l, combined c = max + ½·min, folded in loop order.
     let mut covered = vec![0.0f32; frame.pixel_count()];
@@ -977,7 +965,7 @@ fn piece_visibility(
             .probe
             .as_ref()
             .map(|p| p.enter(|sc| sc.group = Some(k as u32)));
-        let (v, cnt, cl, group_dumps) = render_group(frame, light, quads, l, s, receivers);
+        let (v, cnt, cl, group_dumps) = render_group::<T>(frame, light, quads, l, s, receivers);
         drop(scope);
         dumps.extend(group_dumps.into_iter().map(|mut d| {
             d.name = format!("{}-loop{k}", d.name);
@@ -1044,7 +1032,10 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             .as_ref()
             .filter(|_| pieces.len() > 1)
             .map(|p| p.enter(|sc| sc.piece = Some(k as u32)));
-        let (v, c, cl, piece_dumps) = piece_visibility(frame, piece, &s, &receivers)?;
+        // The shader precision is chosen once per piece's pass.
+        let (v, c, cl, piece_dumps) = crate::with_shader_float!(frame.gpu.shader, T => {
+            piece_visibility::<T>(frame, piece, &s, &receivers)
+        })?;
         drop(scope);
         frame.probe_record("pieces", |tap, i| {
             tap.event()
