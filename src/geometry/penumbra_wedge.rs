@@ -53,10 +53,23 @@
 //! directions, interpolated with the distances to the side planes along the edge direction;
 //! optionally the smoothstep s' = 3s² − 2s³. [`li_amount`] is the one place 255·s is rounded,
 //! shared by `pw2002` and `pw-restructured` so that both produce the same LI values.
+//!
+//! # Shader precision
+//! What the fragment programs of Paper I §4 and Paper II §3 compute per pixel — a plane's value
+//! ([`Plane::shader_eval`], [`Plane::shader_distance_along`]), the inside test
+//! ([`Wedge::shader_contains`]), the exit point of the eye ray ([`Wedge::shader_exit`]),
+//! equations 1–3 ([`shader_light_intensity`]) and the scaling of s to an LI amount
+//! ([`shader_li_amount`]) — is generic over the fragment program's scalar
+//! ([`crate::gpu::shader_float::ShaderFloat`], `[options.gpu] shader`): the wedge's planes and
+//! directions are uniforms rounded to it, the point an input rounded to it, every operation
+//! rounded. The functions without `shader_` are their f64 instances; the construction above is
+//! CPU work (Paper I §4.1) and stays f64.
 
 use super::adjacency::Adjacency;
 use super::loops::silhouette_loops;
 use super::silhouette::{light_facing, possible_silhouettes};
+use crate::gpu::shader_float::ShaderFloat;
+use crate::gpu::shader_vec::SVec3;
 use crate::gpu::transform::{ClipVertex, Projection};
 use crate::scene::{Mesh, Scene};
 use glam::{DMat3, DVec3, DVec4};
@@ -106,7 +119,14 @@ impl Plane {
     /// Signed distance of `p` (positive outside).
     #[inline]
     pub fn eval(&self, p: DVec3) -> f64 {
-        self.n.dot(p) + self.d
+        self.shader_eval(SVec3::<f64>::from_f64(p))
+    }
+
+    /// [`Plane::eval`] by a fragment program in the shader precision `T` (module doc, "Shader
+    /// precision"): the plane rounded to `T`, every operation rounded.
+    #[inline]
+    pub fn shader_eval<T: ShaderFloat>(&self, p: SVec3<T>) -> T {
+        SVec3::from_f64(self.n).dot(p) + T::from_f64(self.d)
     }
 
     /// Distance from `p` to the plane along the line through `p` with direction `dir` (either
@@ -114,7 +134,19 @@ impl Plane {
     /// finite distance.
     #[inline]
     pub fn distance_along(&self, p: DVec3, dir: DVec3) -> f64 {
-        (self.eval(p) / self.n.dot(dir).abs().max(1e-12)).abs()
+        self.shader_distance_along(SVec3::<f64>::from_f64(p), SVec3::from_f64(dir))
+    }
+
+    /// [`Plane::distance_along`] in the shader precision `T`. The floor 10⁻¹² of `|n·dir|`
+    /// is a constant rounded to `T` (0 in fp16, where a parallel line then gives an infinite
+    /// or NaN distance, as it would on the GPU).
+    #[inline]
+    pub fn shader_distance_along<T: ShaderFloat>(&self, p: SVec3<T>, dir: SVec3<T>) -> T {
+        let den = SVec3::from_f64(self.n)
+            .dot(dir)
+            .abs()
+            .max(T::from_f64(1e-12));
+        (self.shader_eval(p) / den).abs()
     }
 
     fn flipped(self) -> Self {
@@ -205,7 +237,14 @@ impl Wedge {
     /// Whether `p` lies inside (or on) all five planes.
     #[inline]
     pub fn contains(&self, p: DVec3) -> bool {
-        self.planes.iter().all(|pl| pl.eval(p) <= 0.0)
+        self.shader_contains(SVec3::<f64>::from_f64(p))
+    }
+
+    /// [`Wedge::contains`] by a fragment program in the shader precision `T` (module doc,
+    /// "Shader precision").
+    #[inline]
+    pub fn shader_contains<T: ShaderFloat>(&self, p: SVec3<T>) -> bool {
+        self.planes.iter().all(|pl| pl.shader_eval(p) <= T::zero())
     }
 
     /// The plane through which the ray `origin + t·dir` leaves the wedge, and the ray
@@ -213,11 +252,21 @@ impl Wedge {
     /// reaches first (Paper I §6: "the exit point is found by computing the intersection of the
     /// ray with all back facing planes, and picking the closest").
     pub fn exit(&self, origin: DVec3, dir: DVec3) -> Option<(FaceKind, f64)> {
-        let mut best: Option<(FaceKind, f64)> = None;
+        self.shader_exit(SVec3::<f64>::from_f64(origin), SVec3::from_f64(dir))
+    }
+
+    /// [`Wedge::exit`] by a fragment program in the shader precision `T` (module doc, "Shader
+    /// precision").
+    pub fn shader_exit<T: ShaderFloat>(
+        &self,
+        origin: SVec3<T>,
+        dir: SVec3<T>,
+    ) -> Option<(FaceKind, T)> {
+        let mut best: Option<(FaceKind, T)> = None;
         for (pl, kind) in self.planes.iter().zip(FACE_ORDER) {
-            let den = pl.n.dot(dir);
-            if den > 0.0 {
-                let t = -pl.eval(origin) / den;
+            let den = SVec3::from_f64(pl.n).dot(dir);
+            if den > T::zero() {
+                let t = -pl.shader_eval(origin) / den;
                 if best.is_none_or(|(_, bt)| t < bt) {
                     best = Some((kind, t));
                 }
@@ -827,32 +876,41 @@ pub fn build_wedges(meshes: &[(&Mesh, &Adjacency)], o: &WedgeOptions) -> Result<
 /// Paper I §4.2, equations 1–3: the light intensity s ∈ [0, 1] at a point `p` inside wedge `w`
 /// (1 on the front plane, 0 on the back plane), optionally smoothed to 3s² − 2s³.
 pub fn light_intensity(w: &Wedge, p: DVec3, smooth: bool) -> f64 {
+    shader_light_intensity(w, SVec3::<f64>::from_f64(p), smooth)
+}
+
+/// [`light_intensity`] by a fragment program in the shader precision `T` (module doc, "Shader
+/// precision"): the wedge's planes and ray directions rounded to `T`, every operation rounded.
+pub fn shader_light_intensity<T: ShaderFloat>(w: &Wedge, p: SVec3<T>, smooth: bool) -> T {
+    let (zero, one, half) = (T::zero(), T::one(), T::from_f64(0.5));
     let [front, back, left, right, _] = &w.planes;
     let side = |d: DVec3| {
-        let tf = front.distance_along(p, d);
-        let tb = back.distance_along(p, d);
-        if tf + tb > 0.0 {
+        let d = SVec3::from_f64(d);
+        let tf = front.shader_distance_along(p, d);
+        let tb = back.shader_distance_along(p, d);
+        if tf + tb > zero {
             tb / (tf + tb)
         } else {
-            0.5
+            half
         }
     };
     let sl = side(w.left_dir);
     let sr = side(w.right_dir);
-    let tl = left.distance_along(p, w.dir);
-    let tr = right.distance_along(p, w.dir);
-    let s = if tl + tr > 0.0 {
+    let dir = SVec3::from_f64(w.dir);
+    let tl = left.shader_distance_along(p, dir);
+    let tr = right.shader_distance_along(p, dir);
+    let s = if tl + tr > zero {
         (tr * sl + tl * sr) / (tr + tl)
     } else {
-        0.5 * (sl + sr)
+        half * (sl + sr)
     };
     let s = if s.is_finite() {
-        s.clamp(0.0, 1.0)
+        s.clamp(zero, one)
     } else {
-        0.0
+        zero
     };
     if smooth {
-        s * s * (3.0 - 2.0 * s)
+        s * s * (T::from_f64(3.0) - T::from_f64(2.0) * s)
     } else {
         s
     }
@@ -864,7 +922,16 @@ pub fn light_intensity(w: &Wedge, p: DVec3, smooth: bool) -> f64 {
 /// sums independent of how contributions are grouped into passes (Paper I §7 for 255/n).
 #[inline]
 pub fn li_amount(s: f64, lights: u32) -> i32 {
-    (s * 255.0 / lights.max(1) as f64 + 0.5).floor() as i32
+    shader_li_amount(s, lights)
+}
+
+/// [`li_amount`] with the scaling `255/n · s + 0.5` computed by the fragment program in the
+/// shader precision `T` (module doc, "Shader precision"); the floor is the conversion to the
+/// LI buffer's integers (exact).
+#[inline]
+pub fn shader_li_amount<T: ShaderFloat>(s: T, lights: u32) -> i32 {
+    let scaled = s * T::from_f64(255.0) / T::from_f64(lights.max(1) as f64) + T::from_f64(0.5);
+    scaled.floor().to_f64() as i32
 }
 
 /// A triangle of wedge geometry to submit, with what it is.

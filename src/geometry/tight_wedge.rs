@@ -66,6 +66,8 @@
 //! as before.
 
 use super::ssv_wedge::{SsvWedge, WedgeLight};
+use crate::gpu::shader_float::ShaderFloat;
+use crate::gpu::shader_vec::SVec3;
 use glam::DVec3;
 use std::cmp::Ordering;
 
@@ -215,6 +217,15 @@ impl ConvexPolyhedron {
     /// face that counts is flat (a sliver part of a split, found by fuzzing) and contains
     /// nothing.
     pub fn contains(&self, x: DVec3, eps: f64) -> bool {
+        self.shader_contains::<f64>(x, eps)
+    }
+
+    /// [`ConvexPolyhedron::contains`] evaluated by a fragment program in the shader precision
+    /// `T` (`[options.gpu] shader`, [`crate::gpu::shader_float`]): which faces count, their
+    /// normals, points and tolerances are uniforms computed in f64; `x`, rounded to `T`, is
+    /// tested against each plane with every operation rounded.
+    pub fn shader_contains<T: ShaderFloat>(&self, x: DVec3, eps: f64) -> bool {
+        let x = SVec3::<T>::from_f64(x);
         let Some(origin) = self.vertices().next().copied() else {
             return false;
         };
@@ -234,7 +245,8 @@ impl ConvexPolyhedron {
                 continue;
             }
             // A NaN distance is unordered, so it counts as outside.
-            let inside = n.dot(x - f[0]).partial_cmp(&(eps * n.length()));
+            let distance = SVec3::from_f64(n).dot(x - SVec3::from_f64(f[0]));
+            let inside = distance.partial_cmp(&T::from_f64(eps * n.length()));
             if !matches!(
                 inside,
                 Some(std::cmp::Ordering::Less | std::cmp::Ordering::Equal)

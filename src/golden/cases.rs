@@ -330,6 +330,22 @@ pub const VARIANTS: &[GoldenCase] = &[
     // Shader precision (issue 11): ssv's fragment program in ATI R300 fp24 and in fp16.
     GoldenCase::variant("cube-of-spheres", "ssv", "shader-fp24", &[]).gpu(&[("shader", "fp24")]),
     GoldenCase::variant("cube-of-spheres", "ssv", "shader-fp16", &[]).gpu(&[("shader", "fp16")]),
+    // pw2002's (Paper I, a sphere light) and ssv-optimized's (Paper IV) fragment programs in
+    // fp24 and fp16, and ssv-optimized's 16-bit float position buffer (Paper IV §4.2).
+    GoldenCase::variant("cube-of-spheres-sphere", "pw2002", "shader-fp24", &[])
+        .gpu(&[("shader", "fp24")]),
+    GoldenCase::variant("cube-of-spheres-sphere", "pw2002", "shader-fp16", &[])
+        .gpu(&[("shader", "fp16")]),
+    GoldenCase::variant("cube-of-spheres", "ssv-optimized", "shader-fp24", &[])
+        .gpu(&[("shader", "fp24")]),
+    GoldenCase::variant("cube-of-spheres", "ssv-optimized", "shader-fp16", &[])
+        .gpu(&[("shader", "fp16")]),
+    GoldenCase::variant(
+        "cube-of-spheres",
+        "ssv-optimized",
+        "position-f16",
+        &[("position", "f16")],
+    ),
     GoldenCase::variant("cube-of-spheres", "wedge-blending", "tile32", &[])
         .gpu(&[("tile-size", "32")]),
     // wedge-blending (Forest et al. 2006): packing, knobs, float targets, order.

@@ -214,6 +214,23 @@ pub trait ShaderFloat:
         Self::from_f64(libm::acos(self.to_f64()))
     }
 
+    /// `tan` (`libm`), rounded.
+    fn tan(self) -> Self {
+        Self::from_f64(libm::tan(self.to_f64()))
+    }
+
+    /// The nearest integer, halves away from zero (f64 `round`; exact).
+    fn round(self) -> Self {
+        Self::from_f64(self.to_f64().round())
+    }
+
+    /// The least non-negative remainder of `self` by `rhs` (f64 `rem_euclid`): the remainder
+    /// `self mod rhs` is exact in every format, and the one addition of `|rhs|` to a negative
+    /// remainder is rounded once (module doc: double rounding is innocuous for `+`).
+    fn rem_euclid(self, rhs: Self) -> Self {
+        Self::from_f64(self.to_f64().rem_euclid(rhs.to_f64()))
+    }
+
     /// Absolute value (exact).
     fn abs(self) -> Self {
         Self::from_f64(self.to_f64().abs())

@@ -32,9 +32,12 @@
 //! # Shader precision
 //!
 //! The per-fragment computations ([`shader_edge_coverage`], [`shader_quad_side`],
-//! [`shader_projected_edge_in_light`]) are generic over the fragment program's scalar
-//! ([`ShaderFloat`], `[options.gpu] shader`): the light frame, the edge and the receiver are
-//! rounded to it on input and every operation after that is rounded. The f64 functions of the
+//! [`shader_projected_edge_in_light`], and for spheres [`shader_sphere_edge_coverage`],
+//! [`shader_clip_to_light_cone`], [`shader_sector_minus_triangle`],
+//! [`shader_exact_sector_minus_triangle`]) are generic over the fragment program's scalar
+//! ([`ShaderFloat`], `[options.gpu] shader`): the light frame (or the sphere's center and
+//! radius), the edge and the receiver are rounded to it on input and every operation after
+//! that is rounded. The f64 functions of the
 //! same names without `shader_` are their f64 instances, used where the computation is not a
 //! fragment program (the coverage texture's precomputation, tests).
 //!
@@ -394,13 +397,26 @@ pub fn sphere_edge_coverage_exact(
     e0: DVec3,
     e1: DVec3,
 ) -> f64 {
-    let sign = quad_side(center, p, e0, e1);
-    if sign == 0.0 {
-        return 0.0;
+    shader_sphere_edge_coverage::<f64>(center, radius, p, e0, e1)
+}
+
+/// [`sphere_edge_coverage_exact`] in the shader precision `T` (module doc, "Shader
+/// precision"): the fragment program of Paper III §5.3 and Paper IV §4.2.1's spherical shader
+/// with exact arithmetic (its `atan2` and sector area rounded to `T`).
+pub fn shader_sphere_edge_coverage<T: ShaderFloat>(
+    center: DVec3,
+    radius: f64,
+    p: DVec3,
+    e0: DVec3,
+    e1: DVec3,
+) -> T {
+    let sign = shader_quad_side::<T>(center, p, e0, e1);
+    if sign == T::zero() {
+        return T::zero();
     }
-    match clip_to_light_cone(center, radius, p, e0, e1) {
-        Some([a, b]) => sign * exact_sector_minus_triangle(a, b, AreaShape::Disk),
-        None => 0.0,
+    match shader_clip_to_light_cone::<T>(center, radius, p, e0, e1) {
+        Some([a, b]) => sign * shader_exact_sector_minus_triangle(a, b, AreaShape::Disk),
+        None => T::zero(),
     }
 }
 
@@ -419,7 +435,22 @@ pub fn clip_to_light_cone(
     e0: DVec3,
     e1: DVec3,
 ) -> Option<[DVec2; 2]> {
-    let w = center - p;
+    shader_clip_to_light_cone::<f64>(center, radius, p, e0, e1).map(|c| c.map(SVec2::to_f64))
+}
+
+/// [`clip_to_light_cone`] in the shader precision `T` (module doc, "Shader precision"): the
+/// light center, radius, receiver and edge rounded to `T` on input, every operation rounded.
+pub fn shader_clip_to_light_cone<T: ShaderFloat>(
+    center: DVec3,
+    radius: f64,
+    p: DVec3,
+    e0: DVec3,
+    e1: DVec3,
+) -> Option<[SVec2<T>; 2]> {
+    let (zero, one) = (T::zero(), T::one());
+    let center = SVec3::<T>::from_f64(center);
+    let radius = T::from_f64(radius);
+    let w = center - SVec3::from_f64(p);
     let dist = w.length();
     if dist <= radius || !dist.is_finite() {
         return None;
@@ -436,8 +467,8 @@ pub fn clip_to_light_cone(
     // none of it), and z rounds to 1 on both sides of the disk's plane (a receiver 4·10³⁷ away
     // saw an edge end behind the light as in front of it).
     let to_light = |e: DVec3| {
-        let d = e - center;
-        DVec3::new(d.dot(x) / radius, d.dot(y) / radius, d.dot(z) / dist)
+        let d = SVec3::from_f64(e) - center;
+        SVec3::new(d.dot(x) / radius, d.dot(y) / radius, d.dot(z) / dist)
     };
     // The edge is parametrized as o + s·d, s ∈ [lo, hi], from o, its point nearest the light
     // center (found by fuzzing). A point q0 + d·t carries an error of ε·(|q0| + |d·t|) and
@@ -449,25 +480,25 @@ pub fn clip_to_light_cone(
     // end's distance, and the quadratic in s has coefficients |o|² and |d|², whose roots are
     // as accurate as the chord's own coordinates.
     let (q0, q1) = (to_light(e0), to_light(e1));
-    let from_e1 = q1.length_squared() < q0.length_squared();
+    let from_e1 = q1.dot(q1) < q0.dot(q0);
     let (near, d) = if from_e1 {
         (q1, q0 - q1)
     } else {
         (q0, q1 - q0)
     };
     // NaN for coincident ends: then o is that point (and lo ≤ hi keeps both candidates).
-    let foot = -near.dot(d) / d.length_squared();
-    let foot = if foot.is_nan() {
-        0.0
+    let foot = -near.dot(d) / d.dot(d);
+    let foot = if foot.to_f64().is_nan() {
+        zero
     } else {
-        foot.clamp(0.0, 1.0)
+        foot.clamp(zero, one)
     };
     let o = near + d * foot;
-    let (lo, hi) = (-foot, 1.0 - foot);
-    let zo = 1.0 + o.z;
-    let g = |s: f64| {
+    let (lo, hi) = (-foot, one - foot);
+    let zo = one + o.z;
+    let g = |s: T| {
         let q = o + d * s;
-        let zq = 1.0 + q.z;
+        let zq = one + q.z;
         q.x * q.x + q.y * q.y - zq * zq
     };
     // Breakpoints: roots of g (the cone) and of z = 0 and z = 1 (u = −1, u = 0) in (lo, hi).
@@ -476,44 +507,44 @@ pub fn clip_to_light_cone(
     let qc = o.x * o.x + o.y * o.y - zo * zo;
     // At most 6 candidates (lo, hi, two cone roots, z = 0, z = 1): a fixed array, since this
     // runs per fragment. NaN candidates fail the range test and are left out.
-    let mut buf = [0.0f64; 6];
+    let mut buf = [zero; 6];
     let mut len = 0;
-    let mut push = |s: f64| {
-        if (lo..=hi).contains(&s) {
+    let mut push = |s: T| {
+        if lo <= s && s <= hi {
             buf[len] = s;
             len += 1;
         }
     };
     push(lo);
     push(hi);
-    if qa.abs() > 1e-300 {
+    if qa.abs() > T::from_f64(1e-300) {
         let disc = qb * qb - qa * qc;
-        if disc >= 0.0 {
+        if disc >= zero {
             let s = disc.sqrt();
             let r = -(qb + qb.signum() * s);
-            if r != 0.0 {
+            if r != zero {
                 push(r / qa);
                 push(qc / r);
             } else {
                 // qb = 0 and a double root: at s = 0 (the line touches the cone at o).
-                push(0.0);
+                push(zero);
             }
         }
-    } else if qb != 0.0 {
-        push(-qc / (2.0 * qb));
+    } else if qb != zero {
+        push(-qc / (T::from_f64(2.0) * qb));
     }
-    if d.z != 0.0 {
+    if d.z != zero {
         push(-zo / d.z);
         push(-o.z / d.z);
     }
     let ss = &mut buf[..len];
     ss.sort_by(|a, b| a.partial_cmp(b).unwrap());
-    let mut span: Option<(f64, f64)> = None;
+    let mut span: Option<(T, T)> = None;
     for k in 0..ss.len() - 1 {
         let (s0, s1) = (ss[k], ss[k + 1]);
-        let m = 0.5 * (s0 + s1);
+        let m = T::from_f64(0.5) * (s0 + s1);
         let um = (o + d * m).z;
-        if s1 > s0 && g(m) <= 0.0 && um > -1.0 && um <= 0.0 {
+        if s1 > s0 && g(m) <= zero && um > -one && um <= zero {
             span = Some(match span {
                 None => (s0, s1),
                 Some((first, _)) => (first, s1),
@@ -521,10 +552,10 @@ pub fn clip_to_light_cone(
         }
     }
     let (s0, s1) = span?;
-    let project = |s: f64| {
+    let project = |s: T| {
         let q = o + d * s;
-        let zq = 1.0 + q.z;
-        DVec2::new(q.x / zq, q.y / zq)
+        let zq = one + q.z;
+        SVec2::new(q.x / zq, q.y / zq)
     };
     // The chord keeps the edge's direction.
     let (a, b) = (project(s0), project(s1));
@@ -537,19 +568,39 @@ pub fn clip_to_light_cone(
 /// (along the minor arc), the fraction beyond the chord `a b`: `sector` minus the triangle
 /// (origin, a, b) over the light's area, clamped to [0, 1]. `a` and `b` lie in the light.
 pub fn sector_minus_triangle(a: DVec2, b: DVec2, shape: AreaShape, sector: f64) -> f64 {
-    let total = match shape {
+    shader_sector_minus_triangle(SVec2::from_f64(a), SVec2::from_f64(b), shape, sector)
+}
+
+/// [`sector_minus_triangle`] in the shader precision `T` (module doc, "Shader precision").
+pub fn shader_sector_minus_triangle<T: ShaderFloat>(
+    a: SVec2<T>,
+    b: SVec2<T>,
+    shape: AreaShape,
+    sector: T,
+) -> T {
+    let total = T::from_f64(match shape {
         AreaShape::Square => 4.0,
         AreaShape::Disk => PI,
-    };
-    let triangle = 0.5 * a.perp_dot(b).abs() / total;
-    (sector - triangle).clamp(0.0, 1.0)
+    });
+    let triangle = T::from_f64(0.5) * a.perp_dot(b).abs() / total;
+    (sector - triangle).clamp(T::zero(), T::one())
 }
 
 /// [`sector_minus_triangle`] with the exact sector: f64 `atan2` of the two points and
 /// [`AreaShape::sector_fraction`].
 pub fn exact_sector_minus_triangle(a: DVec2, b: DVec2, shape: AreaShape) -> f64 {
-    let sector = shape.sector_fraction(libm::atan2(a.y, a.x), libm::atan2(b.y, b.x));
-    sector_minus_triangle(a, b, shape, sector)
+    shader_exact_sector_minus_triangle(SVec2::from_f64(a), SVec2::from_f64(b), shape)
+}
+
+/// [`exact_sector_minus_triangle`] in the shader precision `T` (module doc, "Shader
+/// precision"): `atan2` and [`AreaShape::shader_sector_fraction`] rounded to `T`.
+pub fn shader_exact_sector_minus_triangle<T: ShaderFloat>(
+    a: SVec2<T>,
+    b: SVec2<T>,
+    shape: AreaShape,
+) -> T {
+    let sector = shape.shader_sector_fraction(a.y.atan2(a.x), b.y.atan2(b.x));
+    shader_sector_minus_triangle(a, b, shape, sector)
 }
 
 /// The central projection from a receiver point onto the light plane in the light frame

@@ -34,6 +34,7 @@
 //!   texel centers); entry i holds `round(i / 1023 · full)` split over R, G, B, A, so 0 and 1 are
 //!   exact.
 
+use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::split_blend::SplitFormat;
 use crate::gpu::texture::{sample_2d, Wrap};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
@@ -97,9 +98,9 @@ fn angle_of(u: f64) -> f64 {
     -PI + u * TAU
 }
 
-/// The texture coordinate of angle θ: `(θ + π) / 2π`.
-fn coord_of(theta: f64) -> f64 {
-    (theta + PI) / TAU
+/// The texture coordinate of angle θ: `(θ + π) / 2π`, in the shader precision `T`.
+fn coord_of<T: ShaderFloat>(theta: T) -> T {
+    (theta + T::from_f64(PI)) / T::from_f64(TAU)
 }
 
 /// The six faces of a cube map, in OpenGL order.
@@ -213,29 +214,38 @@ pub enum AreaShape {
 
 impl AreaShape {
     /// Cumulative area fraction of the shape between angle 0 and θ (counter-clockwise,
-    /// continuous and increasing over all reals, +1 per turn).
-    fn cumulative(self, theta: f64) -> f64 {
+    /// continuous and increasing over all reals, +1 per turn), in the shader precision `T`.
+    fn cumulative<T: ShaderFloat>(self, theta: T) -> T {
+        let quarter = T::from_f64(FRAC_PI_2);
         match self {
             // Within the octants around axis k·π/2 the boundary is the side at distance 1:
             // the area from that axis to θ is tan(θ − kπ/2)/2; each quarter turn holds 1 of 4.
             AreaShape::Square => {
-                let k = (theta / FRAC_PI_2).round();
-                (k + libm::tan(theta - k * FRAC_PI_2) * 0.5) / 4.0
+                let k = (theta / quarter).round();
+                (k + (theta - k * quarter).tan() * T::from_f64(0.5)) / T::from_f64(4.0)
             }
-            AreaShape::Disk => theta / TAU,
+            AreaShape::Disk => theta / T::from_f64(TAU),
         }
     }
 
     /// Exact area fraction of the shape inside the sector between the rays from the center at
     /// θ0 and θ1, along the minor arc (Paper IV Fig. 5b, Fig. 6b). At most 1/2.
     pub fn sector_fraction(self, theta0: f64, theta1: f64) -> f64 {
-        let d = (theta1 - theta0).rem_euclid(TAU);
-        let (a, b) = if d <= PI {
+        self.shader_sector_fraction(theta0, theta1)
+    }
+
+    /// [`AreaShape::sector_fraction`] in the shader precision `T`
+    /// ([`crate::gpu::shader_float`]): the spherical shader of Paper IV §4.2.1 with exact
+    /// arithmetic instead of its area table.
+    pub fn shader_sector_fraction<T: ShaderFloat>(self, theta0: T, theta1: T) -> T {
+        let (pi, tau) = (T::from_f64(PI), T::from_f64(TAU));
+        let d = (theta1 - theta0).rem_euclid(tau);
+        let (a, b) = if d <= pi {
             (theta0, theta0 + d)
         } else {
-            (theta1, theta1 + (TAU - d))
+            (theta1, theta1 + (tau - d))
         };
-        (self.cumulative(b) - self.cumulative(a)).clamp(0.0, 0.5)
+        (self.cumulative(b) - self.cumulative(a)).clamp(T::zero(), T::from_f64(0.5))
     }
 
     /// Bits per texel of this shape's table (§6: 8-bit for the rectangle, 16 for the sphere).
@@ -291,9 +301,20 @@ impl AreaTable {
 
     /// The tabulated sector fraction between θ0 and θ1.
     pub fn sector_fraction(&self, theta0: f64, theta1: f64, filter: TableFilter) -> f64 {
-        0.5 * self
-            .texture
-            .sample(coord_of(theta0), coord_of(theta1), filter)
+        self.shader_sector_fraction(theta0, theta1, filter)
+    }
+
+    /// [`AreaTable::sector_fraction`] by a fragment program in the shader precision `T`
+    /// ([`crate::gpu::shader_float`]): the texture coordinates and the scaling of the fetched
+    /// value are computed in `T`; the texture unit's addressing and filtering are its own.
+    pub fn shader_sector_fraction<T: ShaderFloat>(
+        &self,
+        theta0: T,
+        theta1: T,
+        filter: TableFilter,
+    ) -> T {
+        let (s, t) = (coord_of(theta0).to_f64(), coord_of(theta1).to_f64());
+        T::from_f64(0.5) * T::from_f64(self.texture.sample(s, t, filter))
     }
 }
 
@@ -324,13 +345,31 @@ impl SplitTable {
 
     /// The entry index of coverage `c` (clamped to [0, 1]; NaN maps to 0).
     pub fn index(c: f64) -> usize {
-        let c = if c.is_nan() { 0.0 } else { c.clamp(0.0, 1.0) };
-        (c * (SPLIT_TABLE_SIZE - 1) as f64).round() as usize
+        Self::shader_index(c)
+    }
+
+    /// [`SplitTable::index`] by a fragment program in the shader precision `T`
+    /// ([`crate::gpu::shader_float`]): the scaling of `c` to the texel centers is computed in
+    /// `T`, the nearest texel is the texture unit's.
+    pub fn shader_index<T: ShaderFloat>(c: T) -> usize {
+        let c = if c.to_f64().is_nan() {
+            T::zero()
+        } else {
+            c.clamp(T::zero(), T::one())
+        };
+        (c * T::from_f64((SPLIT_TABLE_SIZE - 1) as f64))
+            .to_f64()
+            .round() as usize
     }
 
     /// The split value of coverage `c`.
     pub fn lookup(&self, c: f64) -> [u8; 4] {
-        self.entries[Self::index(c)]
+        self.shader_lookup(c)
+    }
+
+    /// [`SplitTable::lookup`] in the shader precision `T` ([`SplitTable::shader_index`]).
+    pub fn shader_lookup<T: ShaderFloat>(&self, c: T) -> [u8; 4] {
+        self.entries[Self::shader_index(c)]
     }
 }
 

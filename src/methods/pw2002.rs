@@ -29,6 +29,16 @@
 //! The eye is assumed to be outside every shadow (Paper I §8); `pw-restructured` handles the
 //! other case.
 //!
+//! * **Shader precision** (`[options.gpu] shader`, [`crate::gpu::shader_float`]): the fragment
+//!   program of Paper I §4 `rasterizeWedge` — the entry point's plane evaluation, the inside
+//!   test, the exit point, equations 1–3 at p_f and p_i and the scaling `255/n·s + 0.5` of the
+//!   LI amounts ([`crate::geometry::penumbra_wedge`], "Shader precision") — runs in the chosen
+//!   precision, with the point `p` and the eye ray's direction as inputs rounded to it; the
+//!   floor to an integer and the LI buffer's integer arithmetic are exact. The wedges' construction
+//!   (§4.1) is geometry built on the CPU and submitted as vertices, and stays f64, as does the
+//!   un-projection of the pixel (the depth-buffer point, made by the rasterizer's
+//!   interpolation before the program reads it).
+//!
 //! Buffer dump (`--dump-buffers`, [`super::dump`]): `li`, the LI buffer before the resolve, with
 //! its wraps or saturations per pixel and the pixels the resolve clamps ([`li_dump`]).
 
@@ -38,8 +48,8 @@ use super::Falloff;
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, BACKGROUND};
 use crate::geometry::penumbra_wedge::{
-    build_wedges, far_distance, li_amount, light_intensity, wedge_radius, wedge_triangles,
-    FaceKind, WedgeOptions, WedgeSet,
+    build_wedges, far_distance, li_amount, shader_li_amount, shader_light_intensity, wedge_radius,
+    wedge_triangles, FaceKind, WedgeOptions, WedgeSet,
 };
 use crate::gpu::buffers::alloc_tiles;
 use crate::gpu::depth::{DepthFunc, DepthState};
@@ -47,6 +57,8 @@ use crate::gpu::li_buffer::{li_clamped, li_visibility, LiFormat, LiOverflow, LiT
 use crate::gpu::probe::{PrimitiveKind, ProbeEvent, Raw, Tap};
 use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
 use crate::gpu::setup::{CullMode, RasterTriangle};
+use crate::gpu::shader_float::ShaderFloat;
+use crate::gpu::shader_vec::SVec3;
 use crate::options::{option_names, option_table, OptionTable, Switch};
 use crate::plan::{eye_in_shadow, representative_light_points, BufferPlan, MethodPlan};
 use crate::scene::{LightShape, Scene};
@@ -276,8 +288,19 @@ pub fn li_dump(
     ))
 }
 
-/// The LI buffer of `pw2002` (tile-major) and its counters.
+/// The LI buffer of `pw2002` (tile-major) and its counters, the fragment program in the
+/// frame's shader precision.
 pub fn render_li(
+    frame: &Frame,
+    set: &WedgeSet,
+    s: &WedgeSettings,
+) -> (Vec<LiTile>, crate::gpu::counters::Counters) {
+    crate::with_shader_float!(frame.gpu.shader, T => render_li_with::<T>(frame, set, s))
+}
+
+/// [`render_li`] with the fragment program in the precision `T` (module doc, "Shader
+/// precision").
+fn render_li_with<T: ShaderFloat>(
     frame: &Frame,
     set: &WedgeSet,
     s: &WedgeSettings,
@@ -299,6 +322,7 @@ pub fn render_li(
         write: false,
     };
     let eye = frame.scene.camera.eye;
+    let eye_uniform = SVec3::<T>::from_f64(eye);
     let full = li_amount(1.0, s.lights);
     let far = frame.gpu.depth.far();
     counters += draw_probed(
@@ -334,31 +358,38 @@ pub fn render_li(
                 return;
             };
             let w = &set.wedges[wi as usize];
-            let dir = frame.proj.unproject(f.x, f.y, 0.5) - eye;
+            // The eye ray: the eye a uniform, its direction an interpolated input.
+            let dir = SVec3::<T>::from_f64(frame.proj.unproject(f.x, f.y, 0.5) - eye);
+            let eye = eye_uniform;
             // The value at a wedge boundary point: 255 on the front plane and 0 on the back plane
             // (equation 1 with t_f = 0 or t_b = 0, the identity §5 uses); on a side plane §5
             // (`cancel`) uses 0, the §4 pseudocode (`compute`) evaluates s at the point itself.
             // Evaluating the front and back planes numerically instead fails for wedges
             // thinner than the arithmetic (a light of radius 1e-6 or less): t_f + t_b vanishes
             // and s is noise or the 0/0 fallback, so the umbra step is lost or doubled.
-            let boundary = |k: FaceKind, t: f64| match (k, s.side_planes) {
+            let boundary = |k: FaceKind, t: T| match (k, s.side_planes) {
                 (FaceKind::Front, _) => full,
                 (FaceKind::Back, _) | (_, SidePlanes::Cancel) => 0,
                 (_, SidePlanes::Compute) => {
-                    li_amount(light_intensity(w, eye + dir * t, s.smooth), s.lights)
+                    shader_li_amount(shader_light_intensity(w, eye + dir * t, s.smooth), s.lights)
                 }
             };
             let entry = w.plane(kind);
-            let v_f = boundary(kind, -entry.eval(eye) / entry.n.dot(dir));
+            let v_f = boundary(
+                kind,
+                -entry.shader_eval(eye) / SVec3::from_f64(entry.n).dot(dir),
+            );
             let stored = depth.values[f.local];
-            let p = frame
-                .proj
-                .unproject(f.x, f.y, frame.gpu.depth.to_window(stored));
-            let inside = stored != far && w.contains(p);
+            let p = SVec3::<T>::from_f64(frame.proj.unproject(
+                f.x,
+                f.y,
+                frame.gpu.depth.to_window(stored),
+            ));
+            let inside = stored != far && w.shader_contains(p);
             let v_i = if inside {
-                li_amount(light_intensity(w, p, s.smooth), s.lights)
+                shader_li_amount(shader_light_intensity(w, p, s.smooth), s.lights)
             } else {
-                w.exit(eye, dir).map_or(0, |(k, t)| boundary(k, t))
+                w.shader_exit(eye, dir).map_or(0, |(k, t)| boundary(k, t))
             };
             let delta = v_i - v_f;
             let added = (delta != 0).then(|| tile.add(f.local, delta, c));

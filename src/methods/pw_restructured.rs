@@ -60,6 +60,16 @@
 //! * z-pass or z-fail: `mode = auto` picks z-fail when [`crate::plan::eye_in_shadow`] finds the
 //!   near plane in the shadow of a point of the light.
 //!
+//! * **Shader precision** (`[options.gpu] shader`, [`crate::gpu::shader_float`]): the penumbra
+//!   fragment program — the inside test and equations 1–3 of Paper I §4.2 at the depth-buffer
+//!   point and the scaling of s to an LI amount ([`crate::geometry::penumbra_wedge`], "Shader
+//!   precision") — runs in the chosen precision; the umbra's ±255/n are integer constants, the
+//!   LI buffer's and stencil's arithmetic is integer (exact). The tile culling of §4 is the
+//!   rasterizer's hierarchical-Z test before any fragment program runs, and stays f64, as do the
+//!   wedges and caps (CPU geometry submitted as vertices, Paper II §3). With `li = 16` the
+//!   integer amounts hide most of fp32's rounding: on `cube-of-spheres-sphere` at 256² fp32
+//!   gives the f64 image bit for bit, fp24 changes 55 pixels and fp16 1822.
+//!
 //! Buffer dump (`--dump-buffers`): `li`, as `pw2002`'s
 //! ([`super::pw2002::li_dump`]).
 //!
@@ -75,8 +85,8 @@ use super::pw2002::{
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame};
 use crate::geometry::penumbra_wedge::{
-    cap_triangles, li_amount, light_intensity, screen_wedge, wedge_triangles, FaceKind,
-    ScreenWedge, WedgeSet, WedgeTriangle,
+    cap_triangles, li_amount, screen_wedge, shader_li_amount, shader_light_intensity,
+    wedge_triangles, FaceKind, ScreenWedge, WedgeSet, WedgeTriangle,
 };
 use crate::gpu::buffers::{alloc_tiles, StencilTile};
 use crate::gpu::counters::Counters;
@@ -85,6 +95,8 @@ use crate::gpu::li_buffer::{LiTile, LI_CLEAR};
 use crate::gpu::probe::{PassProbe, PrimitiveKind, ProbeEvent, Raw};
 use crate::gpu::raster::{bin, draw_probed, Fragment};
 use crate::gpu::setup::{CullMode, RasterTriangle};
+use crate::gpu::shader_float::ShaderFloat;
+use crate::gpu::shader_vec::SVec3;
 use crate::gpu::stencil::{StencilFace, StencilOp, StencilState};
 use crate::options::{option_names, option_table, OptionTable, OptionType};
 use crate::plan::{representative_light_points, BufferPlan, CountMode, MethodPlan};
@@ -326,8 +338,16 @@ impl Ctx<'_> {
         }
     }
 
-    /// The penumbra amount of fragment `f` of `tri` given the stored depth and the depth test.
-    fn penumbra_amount(&self, tri: &RasterTriangle, f: &Fragment, stored: u32, pass: bool) -> i32 {
+    /// The penumbra amount of fragment `f` of `tri` given the stored depth and the depth test,
+    /// computed by the fragment program in the shader precision `T` (module doc, "Shader
+    /// precision").
+    fn penumbra_amount<T: ShaderFloat>(
+        &self,
+        tri: &RasterTriangle,
+        f: &Fragment,
+        stored: u32,
+        pass: bool,
+    ) -> i32 {
         let behind_face = match self.s.test {
             WedgeTest::ZPass => pass,
             WedgeTest::ZFail => !pass,
@@ -340,10 +360,10 @@ impl Ctx<'_> {
             return 0;
         };
         let w = &self.set.wedges[wi as usize];
-        let p = self.frame.proj.unproject(f.x, f.y, fmt.to_window(stored));
-        if w.contains(p) {
-            li_amount(
-                light_intensity(w, p, self.s.wedge.smooth),
+        let p = SVec3::<T>::from_f64(self.frame.proj.unproject(f.x, f.y, fmt.to_window(stored)));
+        if w.shader_contains(p) {
+            shader_li_amount(
+                shader_light_intensity(w, p, self.s.wedge.smooth),
                 self.s.wedge.lights,
             )
         } else {
@@ -360,8 +380,8 @@ struct RTile {
 }
 
 /// One draw over `rt` (filtered raster triangles) adding umbra and/or penumbra contributions
-/// directly into the LI buffer.
-fn li_pass(
+/// directly into the LI buffer, the fragment program in the shader precision `T`.
+fn li_pass<T: ShaderFloat>(
     ctx: &Ctx,
     tiles: &mut [RTile],
     rt: &[RasterTriangle],
@@ -421,7 +441,7 @@ fn li_pass(
             let mut penumbra_delta = None;
             if !p_culled {
                 c.fragments_shaded += 1;
-                let amount = ctx.penumbra_amount(tri, &f, stored, pass);
+                let amount = ctx.penumbra_amount::<T>(tri, &f, stored, pass);
                 delta += amount;
                 penumbra_delta = Some(amount);
             }
@@ -463,8 +483,19 @@ fn raster_triangles(
 }
 
 /// Render the LI buffer of `pw-restructured` (tile-major); returns it with per-pass stats and
-/// the number of (tile, triangle) pairs whose tile zmin/zmax were read for a culling test.
+/// the number of (tile, triangle) pairs whose tile zmin/zmax were read for a culling test. The
+/// penumbra fragment program runs in the frame's shader precision.
 pub fn render_li(
+    frame: &Frame,
+    set: &WedgeSet,
+    s: &RestructuredSettings,
+) -> (Vec<LiTile>, Vec<PassStats>, u64) {
+    crate::with_shader_float!(frame.gpu.shader, T => render_li_with::<T>(frame, set, s))
+}
+
+/// [`render_li`] with the penumbra fragment program in the precision `T` (module doc, "Shader
+/// precision").
+fn render_li_with<T: ShaderFloat>(
     frame: &Frame,
     set: &WedgeSet,
     s: &RestructuredSettings,
@@ -524,7 +555,7 @@ pub fn render_li(
         Passes::Single => timed("wedges-single-pass", &mut || {
             let (rt, mut c) = raster_triangles(&ctx, |r, _| r.umbra || r.penumbra);
             let probe = frame.probe_pass("wedges-single-pass");
-            c += li_pass(&ctx, &mut tiles, &rt, true, true, probe.as_ref());
+            c += li_pass::<T>(&ctx, &mut tiles, &rt, true, true, probe.as_ref());
             c
         }),
         Passes::Three => {
@@ -570,7 +601,7 @@ pub fn render_li(
             timed("penumbra", &mut || {
                 let (rt, mut c) = raster_triangles(&ctx, |r, _| r.penumbra);
                 let probe = frame.probe_pass("penumbra");
-                c += li_pass(&ctx, &mut tiles, &rt, false, true, probe.as_ref());
+                c += li_pass::<T>(&ctx, &mut tiles, &rt, false, true, probe.as_ref());
                 c
             });
         }

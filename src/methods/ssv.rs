@@ -13,7 +13,7 @@
 //!   paper's "negative half space"). The sum over the silhouette is Green's theorem: exact for
 //!   occluders without the single-silhouette or overlap artifacts (§5.3).
 //! * **Coverage** (`coverage`): `exact` clips the projected quad against the light
-//!   ([`edge_coverage_exact`](crate::light::coverage::edge_coverage_exact), §3.2.2; for a sphere [`sphere_edge_coverage_exact`], below);
+//!   ([`edge_coverage_exact`](crate::light::coverage::edge_coverage_exact), §3.2.2; for a sphere [`sphere_edge_coverage_exact`](crate::light::coverage::sphere_edge_coverage_exact), below);
 //!   `texture` looks the clipped projected edge up in the 4D coverage texture (§3.3) of
 //!   `texture-n` (8…64, default 32) with `filter` (`nearest` (default; the paper: "for normal
 //!   scenes, this filtering is not necessary"), `bilinear`, `quadrilinear`).
@@ -30,8 +30,11 @@
 //!   coverage of a rectangle (the clipping and area arithmetic,
 //!   [`crate::light::coverage::shader_edge_coverage`]) and, with `coverage = texture`, the
 //!   texture coordinates (the clipped projected edge) and the sign applied to the fetched
-//!   value — runs in the chosen precision; the texture unit's addressing and filtering stay
-//!   as they are. The sphere's coverage is not converted yet and stays in f64.
+//!   value — runs in the chosen precision, and so does a sphere's coverage (the chord in the
+//!   light space of the receiver, its `atan2` and sector area,
+//!   [`crate::light::coverage::shader_sphere_edge_coverage`]); the texture unit's addressing
+//!   and filtering stay as they are. The hard quads of pass 1 and the wedges (§3.1) are
+//!   geometry built on the CPU and submitted as vertices, and stay f64.
 //!
 //! Choices where the paper is silent:
 //! * The receiver point of a pixel is the depth-buffer point ([`Frame::receivers`]), the same
@@ -47,7 +50,7 @@
 //!   sphere (§3.1's bounding-sphere construction, [`WedgeLight::Sphere`]); the coverage is the
 //!   signed fraction of the disk through the center facing `p` — the sphere as the `raycast`
 //!   reference sees it — covered by the projected quad, computed exactly as sector minus
-//!   triangle ([`sphere_edge_coverage_exact`], the same arithmetic as `ssv-optimized`'s
+//!   triangle ([`sphere_edge_coverage_exact`](crate::light::coverage::sphere_edge_coverage_exact), the same arithmetic as `ssv-optimized`'s
 //!   spherical shader, Paper IV §4.2.1), with the rectangle's sign convention and every
 //!   V-buffer format. Following §5.3, there is no coverage texture for spheres:
 //!   `coverage = "texture"` with a sphere light is an input error naming `options.ssv.coverage`
@@ -83,7 +86,7 @@ use crate::gpu::vbuffer::{
 };
 use crate::light::coverage::{
     shader_edge_coverage, shader_projected_edge_in_light, shader_quad_side,
-    sphere_edge_coverage_exact,
+    shader_sphere_edge_coverage,
 };
 use crate::light::coverage_texture::{
     coverage_texture, CoverageFilter, CoverageTexture, CoverageTextureKey, DEFAULT_N, MAX_N, MIN_N,
@@ -253,7 +256,8 @@ impl CoverageSource<'_> {
         let light = match self.light {
             WedgeLight::Rect(light) => light,
             WedgeLight::Sphere { center, radius } => {
-                return [sphere_edge_coverage_exact(center, radius, p, w.e0, w.e1) as f32; 3];
+                let c = shader_sphere_edge_coverage::<T>(center, radius, p, w.e0, w.e1);
+                return [c.to_f64() as f32; 3];
             }
         };
         match (self.mode, &self.texture) {

@@ -44,7 +44,21 @@
 //! Options ([`SsvOptimizedOptions`]): `coverage = tables|exact`, `filter = bilinear|nearest`
 //! (area table), `split = stencil|plane`, `wedge = tight|bounding-sphere`, `sphere-sides`
 //! (sphere lights with `wedge = tight` only), `overlap = off|loops`, `light-split = 1…4`,
-//! `reserved-bits = 1…7` (default 5), `mode = auto|zpass|zfail`.
+//! `reserved-bits = 1…7` (default 5), `mode = auto|zpass|zfail`, `position = depth|f16`.
+//!
+//! Shader precision (`[options.gpu] shader`, [`crate::gpu::shader_float`]): the pixel shaders
+//! of §4.2 run in the chosen precision — the inside test of a half that crosses the near plane
+//! ([`ConvexPolyhedron::shader_contains`]), the clipping and projection of the edge
+//! ([`coverage::shader_projected_edge_in_light`], [`coverage::shader_clip_to_light_cone`]), the
+//! exact coverage ([`coverage::shader_edge_coverage`], [`AreaShape::shader_sector_fraction`]),
+//! with the tables the texture coordinates (the cube-map direction, the area table's
+//! `(θ + π)/2π`, the split table's `1023·c`, [`AreaTable::shader_sector_fraction`],
+//! [`SplitTable::shader_index`]) and the sector-minus-triangle arithmetic; the texture unit's
+//! addressing and filtering and the tables' contents stay as they are. `split = "plane"`'s
+//! plane equation runs in f32 at the default precision (the paper's hardware, whose errors
+//! near the plane §4.4 reports) and in the shader precision otherwise. The shadow volumes and
+//! wedges stay f64: "the test program first generates shadow volumes and wedge geometry on the
+//! CPU" (§4.2).
 //!
 //! Improvements (§5): `overlap = "loops"` renders every silhouette loop
 //! ([`crate::geometry::loops::silhouette_loops`]) into its own V-buffer and combines the loops'
@@ -65,8 +79,14 @@
 //!   receiver against the half's face planes.
 //! - Which half goes to which buffer: §4.3 says "back half → additive, front half →
 //!   subtractive"; §3 says the inner half (toward the umbra) adds. We use inner → additive.
-//! - Receiver points are the depth-buffer points in f64 (like every method here), not the
-//!   paper's 16-bit float position texture.
+//! - Receiver points (`position`): by default the depth-buffer points in f64, like every method
+//!   here; `position = "f16"` reads them from the paper's "16 bit per channel float texture"
+//!   of world positions (§4.2), each coordinate rounded to binary16 (IEEE half: 11
+//!   significant bits, so a point 2 units from the origin moves by up to 2⁻¹⁰). Measured on
+//!   256² renders against `depth` (f64 shaders): 237 pixels of `cube-of-spheres` and 217 of
+//!   `cube-of-spheres-sphere` move by more than 1/255 (largest 0.40 and 0.39, mean 1.5·10⁻⁴
+//!   and 1.4·10⁻⁴), nearly all (200 and 191) on the spheres themselves, where the receiver
+//!   lies close to the silhouette edges whose wedges it is tested against.
 //! - The overlap approximation renders each loop's quads z-pass (per-loop caps do not exist);
 //!   it is refused when the eye is in shadow. Light splitting is for rectangular lights only.
 //!
@@ -95,6 +115,8 @@ use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw};
 use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
 use crate::gpu::setup::{CullMode, RasterTriangle};
+use crate::gpu::shader_float::{Fp32, ShaderFloat, ShaderPrecision, FP16};
+use crate::gpu::shader_vec::{SVec2, SVec3};
 use crate::gpu::split_blend::{SplitFormat, SplitTarget, SplitVTile};
 use crate::gpu::stencil::{StencilFace, StencilFunc, StencilOp, StencilState};
 use crate::gpu::transform::ClipVertex;
@@ -145,6 +167,8 @@ pub struct Settings {
     /// Sides of the polygons circumscribing a sphere's silhouette disks in its tight wedges
     /// ([`tight_wedge::sphere_wedge_halfspaces`]).
     pub sphere_sides: usize,
+    /// Where the wedge shaders read the receiver point from (module doc, "Shader precision").
+    pub position: PositionBuffer,
 }
 
 /// A light (or a piece of one) as the shaders see it.
@@ -258,20 +282,34 @@ impl LightModel {
     /// Unsigned coverage of the light by the projected hard shadow quad of edge `e0 e1` seen
     /// from `p` (Paper IV §4.2.1, §4.2.2), in [0, 1].
     pub fn coverage(&self, p: DVec3, e0: DVec3, e1: DVec3, mode: CoverageMode) -> f64 {
+        self.shader_coverage::<f64>(p, e0, e1, mode)
+    }
+
+    /// [`LightModel::coverage`] computed by the shaders in the shader precision `T` (module
+    /// doc, "Shader precision").
+    pub fn shader_coverage<T: ShaderFloat>(
+        &self,
+        p: DVec3,
+        e0: DVec3,
+        e1: DVec3,
+        mode: CoverageMode,
+    ) -> T {
         match (self, mode) {
             (LightModel::Rect(r), CoverageMode::Exact) => {
-                coverage::edge_coverage_exact(r, p, e0, e1).abs().min(1.0)
+                coverage::shader_edge_coverage::<T>(r, p, e0, e1)
+                    .abs()
+                    .min(T::one())
             }
             (LightModel::Rect(r), CoverageMode::Tables(_)) => {
-                match coverage::projected_edge_in_light(r, p, e0, e1) {
-                    Some([a, b]) => sector_minus_triangle(a, b, AreaShape::Square, mode),
-                    None => 0.0,
+                match coverage::shader_projected_edge_in_light::<T>(r, p, e0, e1) {
+                    Some([a, b]) => shader_sector_minus_triangle(a, b, AreaShape::Square, mode),
+                    None => T::zero(),
                 }
             }
             (LightModel::Sphere { center, radius }, _) => {
-                match coverage::clip_to_light_cone(*center, *radius, p, e0, e1) {
-                    Some([a, b]) => sector_minus_triangle(a, b, AreaShape::Disk, mode),
-                    None => 0.0,
+                match coverage::shader_clip_to_light_cone::<T>(*center, *radius, p, e0, e1) {
+                    Some([a, b]) => shader_sector_minus_triangle(a, b, AreaShape::Disk, mode),
+                    None => T::zero(),
                 }
             }
         }
@@ -282,16 +320,26 @@ impl LightModel {
 /// `a b` through [`coverage::sector_minus_triangle`], with the sector from the paper's tables
 /// (atan2 cube map, area table) or exact ([`coverage::exact_sector_minus_triangle`]).
 pub fn sector_minus_triangle(a: DVec2, b: DVec2, shape: AreaShape, mode: CoverageMode) -> f64 {
+    shader_sector_minus_triangle(SVec2::from_f64(a), SVec2::from_f64(b), shape, mode)
+}
+
+/// [`sector_minus_triangle`] in the shader precision `T` (module doc, "Shader precision"):
+/// the atan2 cube map is looked up with the direction `(x, y, 0)` of `a` and `b` in `T` and
+/// its angle read as a `T`; the area table's texture coordinates are computed in `T`
+/// ([`AreaTable::shader_sector_fraction`]).
+pub fn shader_sector_minus_triangle<T: ShaderFloat>(
+    a: SVec2<T>,
+    b: SVec2<T>,
+    shape: AreaShape,
+    mode: CoverageMode,
+) -> T {
     match mode {
-        CoverageMode::Exact => coverage::exact_sector_minus_triangle(a, b, shape),
+        CoverageMode::Exact => coverage::shader_exact_sector_minus_triangle(a, b, shape),
         CoverageMode::Tables(filter) => {
             let map = Atan2CubeMap::get();
-            let sector = AreaTable::get(shape).sector_fraction(
-                map.atan2(a.y, a.x),
-                map.atan2(b.y, b.x),
-                filter,
-            );
-            coverage::sector_minus_triangle(a, b, shape, sector)
+            let angle = |v: SVec2<T>| T::from_f64(map.atan2(v.y.to_f64(), v.x.to_f64()));
+            let sector = AreaTable::get(shape).shader_sector_fraction(angle(a), angle(b), filter);
+            coverage::shader_sector_minus_triangle(a, b, shape, sector)
         }
     }
 }
@@ -305,6 +353,22 @@ option_names! {
         Exact = "exact",
     }
 }
+
+/// Where the wedge shaders read each pixel's world position (`[options.ssv-optimized]
+/// position`; Paper IV §4.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum PositionBuffer {
+    /// The pixel center un-projected at its stored depth, in f64 (every method's receiver).
+    Depth,
+    /// Paper IV §4.2's 16-bit float RGB texture of world positions: each coordinate of the
+    /// un-projected point rounded to binary16.
+    F16,
+}
+
+option_names!(PositionBuffer {
+    Depth = "depth",
+    F16 = "f16",
+});
 
 option_names!(HalfSplit {
     Stencil = "stencil",
@@ -352,6 +416,8 @@ option_table! {
         reserved_bits: u32 [1..=7] = 5;
         /// count pass 1 z-pass or z-fail; auto: z-fail when the near plane is in the shadow of a light center
         mode: CountMode = CountMode::Auto;
+        /// receiver positions the wedge shaders read: un-projected from the depth buffer, or a 16-bit float RGB position buffer (Paper IV §4.2)
+        position: PositionBuffer = PositionBuffer::Depth;
     }
 }
 
@@ -407,6 +473,7 @@ pub fn options(frame: &Frame) -> Result<Settings, InputError> {
         zfail,
         tight_wedges,
         sphere_sides: o.sphere_sides as usize,
+        position: o.position,
     })
 }
 
@@ -471,8 +538,9 @@ fn silhouettes(frame: &Frame, c: Vec3) -> Result<Vec<Vec<[DVec3; 2]>>, InputErro
 type GroupResult = (Vec<f32>, Counters, Vec<bool>, Vec<BufferDump>);
 
 /// Render one group (pass 1 quads + the wedges of `edges`) for light piece `light` into a
-/// fresh split V-buffer ([`GroupResult`]).
-fn render_group(
+/// fresh split V-buffer ([`GroupResult`]), the shaders in the precision `T` (module doc,
+/// "Shader precision").
+fn render_group<T: ShaderFloat>(
     frame: &Frame,
     light: &LightModel,
     quads: Vec<[ClipVertex; 3]>,
@@ -716,17 +784,21 @@ fn render_group(
                     let Some(p) = receivers[t][f.local] else {
                         return record(&|e| seen_depth(e).note("background"));
                     };
-                    if tested && !job.shape.contains(p, 0.0) {
+                    if tested && !job.shape.shader_contains::<T>(p, 0.0) {
                         return record(&|e| {
                             seen_depth(e).note("receiver outside the half (shader test)")
                         });
                     }
                     cnt.fragments_shaded += 1;
-                    let target = job
-                        .target
-                        .unwrap_or_else(|| plane_split_target(light.center(), &job.edge, p));
-                    let cov = light.coverage(p, job.edge[0], job.edge[1], s.coverage);
-                    let split = table.lookup(cov);
+                    let target = job.target.unwrap_or_else(|| match T::PRECISION {
+                        ShaderPrecision::F64 => {
+                            plane_split_target::<Fp32>(light.center(), &job.edge, p)
+                        }
+                        _ => plane_split_target::<T>(light.center(), &job.edge, p),
+                    });
+                    let cov = light.shader_coverage::<T>(p, job.edge[0], job.edge[1], s.coverage);
+                    let split = table.shader_lookup(cov);
+                    let cov = cov.to_f64();
                     let blend = st.v.blend(target, f.local, split, cnt);
                     record(&|e| {
                         let e = seen_depth(e)
@@ -807,22 +879,35 @@ fn split_dumps(
 }
 
 /// The plane-equation split (§4.4's first approach): the sign of the hard-quad plane equation
-/// evaluated in f32 at the receiver; inner (≤ 0, see
-/// [`crate::geometry::tight_wedge::quad_inner_halfspace`]) adds.
-fn plane_split_target(c: DVec3, e: &[DVec3; 2], p: DVec3) -> SplitTarget {
-    let (c, a, b, p) = (c.as_vec3(), e[0].as_vec3(), e[1].as_vec3(), p.as_vec3());
+/// evaluated at the receiver by the shader in the precision `S`; inner (≤ 0, see
+/// [`crate::geometry::tight_wedge::quad_inner_halfspace`]) adds. [`render_group`] evaluates it
+/// in f32 ([`Fp32`], the precision whose errors near the plane §4.4 reports) at the default
+/// shader precision, and in the shader precision otherwise.
+fn plane_split_target<S: ShaderFloat>(c: DVec3, e: &[DVec3; 2], p: DVec3) -> SplitTarget {
+    let c = SVec3::<S>::from_f64(c);
+    let (a, b, p) = (
+        SVec3::from_f64(e[0]),
+        SVec3::from_f64(e[1]),
+        SVec3::from_f64(p),
+    );
     let n = (a - c).cross(b - c);
-    if n.dot(p - c) <= 0.0 {
+    if n.dot(p - c) <= S::zero() {
         SplitTarget::Add
     } else {
         SplitTarget::Sub
     }
 }
 
-/// The receiver point of every sample, tile-major (`None` for background): the pixel center
-/// un-projected at its stored depth, in f64.
-fn receiver_tiles(frame: &Frame) -> Vec<Vec<Option<DVec3>>> {
+/// The receiver point of every sample, tile-major (`None` for background), as the wedge
+/// shaders read it (`position`, module doc): the pixel center un-projected at its stored
+/// depth, in f64, or that point stored in the 16-bit float RGB position buffer of Paper IV
+/// §4.2 (each coordinate rounded to binary16, [`FP16`]).
+fn receiver_tiles(frame: &Frame, position: PositionBuffer) -> Vec<Vec<Option<DVec3>>> {
     let tiling = &frame.tiling;
+    let stored = |p: DVec3| match position {
+        PositionBuffer::Depth => p,
+        PositionBuffer::F16 => DVec3::new(FP16.round(p.x), FP16.round(p.y), FP16.round(p.z)),
+    };
     (0..tiling.tile_count())
         .map(|t| {
             let r = tiling.rect(t);
@@ -832,7 +917,7 @@ fn receiver_tiles(frame: &Frame) -> Vec<Vec<Option<DVec3>>> {
                     let i = tiling.local(x, y);
                     if frame.tiles[t].prim[i] != BACKGROUND {
                         let z = frame.gpu.depth.to_window(frame.tiles[t].depth.values[i]);
-                        out[i] = Some(frame.proj.unproject(x, y, z));
+                        out[i] = Some(stored(frame.proj.unproject(x, y, z)));
                     }
                 }
             }
@@ -842,8 +927,9 @@ fn receiver_tiles(frame: &Frame) -> Vec<Vec<Option<DVec3>>> {
 }
 
 /// The visibility of one light piece (row-major, clamped) with the settings' overlap mode, the
-/// counters, per pixel whether a clamp changed a value, and the buffer dumps of its groups.
-fn piece_visibility(
+/// counters, per pixel whether a clamp changed a value, and the buffer dumps of its groups;
+/// the shaders in the precision `T`.
+fn piece_visibility<T: ShaderFloat>(
     frame: &Frame,
     light: &LightModel,
     s: &Settings,
@@ -860,7 +946,7 @@ fn piece_visibility(
         };
         let quads = shadow_volume_triangles(&meshes, c, &frame.proj, capping);
         let edges: Vec<[DVec3; 2]> = loops.into_iter().flatten().collect();
-        return Ok(render_group(frame, light, quads, &edges, s, receivers));
+        return Ok(render_group::<T>(frame, light, quads, &edges, s, receivers));
     }
     // §5.1: per loop, coverage c_l = 1 − V_l, combined c = max + ½·min, folded in loop order.
     let mut covered = vec![0.0f32; frame.pixel_count()];
@@ -879,7 +965,7 @@ fn piece_visibility(
             .probe
             .as_ref()
             .map(|p| p.enter(|sc| sc.group = Some(k as u32)));
-        let (v, cnt, cl, group_dumps) = render_group(frame, light, quads, l, s, receivers);
+        let (v, cnt, cl, group_dumps) = render_group::<T>(frame, light, quads, l, s, receivers);
         drop(scope);
         dumps.extend(group_dumps.into_iter().map(|mut d| {
             d.name = format!("{}-loop{k}", d.name);
@@ -935,7 +1021,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         .pieces(s.light_split)
         .expect("options checked the split");
     let pass_start = Instant::now();
-    let receivers = receiver_tiles(frame);
+    let receivers = receiver_tiles(frame, s.position);
     let mut sum = vec![0.0f32; frame.pixel_count()];
     let mut clamped = vec![false; frame.pixel_count()];
     let mut counters = Counters::default();
@@ -946,7 +1032,10 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             .as_ref()
             .filter(|_| pieces.len() > 1)
             .map(|p| p.enter(|sc| sc.piece = Some(k as u32)));
-        let (v, c, cl, piece_dumps) = piece_visibility(frame, piece, &s, &receivers)?;
+        // The shader precision is chosen once per piece's pass.
+        let (v, c, cl, piece_dumps) = crate::with_shader_float!(frame.gpu.shader, T => {
+            piece_visibility::<T>(frame, piece, &s, &receivers)
+        })?;
         drop(scope);
         frame.probe_record("pieces", |tap, i| {
             tap.event()
@@ -1011,7 +1100,14 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
                 ),
                 bytes_per_sample: 8,
             },
-        ],
+        ]
+        .into_iter()
+        .chain((s.position == PositionBuffer::F16).then(|| BufferPlan {
+            name: "position".into(),
+            format: "RGB16F (world positions, Paper IV §4.2)".into(),
+            bytes_per_sample: 6,
+        }))
+        .collect(),
         settings: serde_json::json!({ "resolved": s, "gpu": frame.gpu }),
     };
     let passes = vec![frame.pass.clone(), pass];
