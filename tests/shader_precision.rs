@@ -61,3 +61,8 @@ fn penumbra_map_fp24_and_fp16_change_the_visibility() {
 fn dbuffer_fp24_and_fp16_change_the_visibility() {
     narrower_formats_change(&small("disk-block", 64), "dbuffer");
 }
+
+#[test]
+fn wedge_blending_fp24_and_fp16_change_the_visibility() {
+    narrower_formats_change(&small("cube-of-spheres", 64), "wedge-blending");
+}

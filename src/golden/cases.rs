@@ -338,6 +338,11 @@ pub const VARIANTS: &[GoldenCase] = &[
         .gpu(&[("shader", "fp16")]),
     GoldenCase::variant("disk-block", "dbuffer", "shader-fp24", &[]).gpu(&[("shader", "fp24")]),
     GoldenCase::variant("disk-block", "dbuffer", "shader-fp16", &[]).gpu(&[("shader", "fp16")]),
+    // wedge-blending's regions in the shader precision, its vBuffer arithmetic capped at fp32.
+    GoldenCase::variant("cube-of-spheres", "wedge-blending", "shader-fp24", &[])
+        .gpu(&[("shader", "fp24")]),
+    GoldenCase::variant("cube-of-spheres", "wedge-blending", "shader-fp16", &[])
+        .gpu(&[("shader", "fp16")]),
     GoldenCase::variant("cube-of-spheres", "wedge-blending", "tile32", &[])
         .gpu(&[("tile-size", "32")]),
     // wedge-blending (Forest et al. 2006): packing, knobs, float targets, order.
