@@ -71,7 +71,7 @@
 //!   [`PartState::add_inner`]: occlusion, centroid, maximum X and Y), the rectangles' areas
 //!   and the inner adjustment's check, ε and the blend ([`blend::blend_part`]) and the
 //!   resolve `1 − Σ/4` — runs in `T` capped at fp32
-//!   ([`ShaderFloat::AtMostFp32`](crate::gpu::shader_float::ShaderFloat::AtMostFp32)): it was
+//!   ([`ShaderFloat::AtMostFp32`]): it was
 //!   f32 arithmetic before shader precision existed (the vBuffers' values are f32), so the
 //!   default f64 keeps its bits and equals `fp32` there, while `fp24` and `fp16` round every
 //!   operation as everywhere else. Its operands are the stored values (f32 unpacked; the 8-bit
