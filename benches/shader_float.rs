@@ -29,6 +29,7 @@ fn round(x: f64) -> f64 {
 
 impl ShaderFloat for Dyn {
     const PRECISION: ShaderPrecision = ShaderPrecision::F64;
+    type AtMostFp32 = penumbra::gpu::shader_float::Fp32;
     fn from_f64(x: f64) -> Self {
         Dyn(round(x))
     }

@@ -260,7 +260,7 @@ fn overlapping_penumbrae_keep_the_darkest() {
             .map(|(_, (m, sl))| (m, sl.clone()))
             .unzip();
         let g = cones_and_sheets(&m, &sl, &light, s.cone_segments);
-        penumbra_map::render_penumbra_map(&full.view, &full.shadow_map, &g, &s, false).0
+        penumbra_map::render_penumbra_map::<f64>(&full.view, &full.shadow_map, &g, &s, false).0
     };
     let (first, rest) = (map_of(0), map_of(1));
     let mut both = 0;

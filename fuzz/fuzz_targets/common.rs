@@ -25,6 +25,7 @@ use penumbra::geometry::tight_wedge::{
 use penumbra::gpu::counters::Counters;
 use penumbra::gpu::raster::{bin, draw, no_tile_culling};
 use penumbra::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
+use penumbra::gpu::shader_float::Fp32;
 use penumbra::gpu::tiling::Tiling;
 use penumbra::gpu::transform::{ClipVertex, Projection};
 use penumbra::light::coverage::{
@@ -918,8 +919,8 @@ fn rect_coverage(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) {
         }
     }
     let mut total = 0.0;
-    for region in edge_in_parts(l, p, e0, e1).iter().flatten() {
-        let b = region.bounds;
+    for region in edge_in_parts::<f64>(l, p, e0, e1).iter().flatten() {
+        let b = region.bounds::<Fp32>();
         assert!(
             region.area.is_finite()
                 && (0.0..=1.0 + UNIT_SLACK).contains(&region.area)

@@ -346,6 +346,19 @@ pub const VARIANTS: &[GoldenCase] = &[
         "position-f16",
         &[("position", "f16")],
     ),
+    // penumbra-map's pass-2 program (Z′ conversions, I, falloff) and dbuffer's screen program
+    // (|cx|, t, V) in fp24 and fp16.
+    GoldenCase::variant("cube-of-spheres-sphere", "penumbra-map", "shader-fp24", &[])
+        .gpu(&[("shader", "fp24")]),
+    GoldenCase::variant("cube-of-spheres-sphere", "penumbra-map", "shader-fp16", &[])
+        .gpu(&[("shader", "fp16")]),
+    GoldenCase::variant("disk-block", "dbuffer", "shader-fp24", &[]).gpu(&[("shader", "fp24")]),
+    GoldenCase::variant("disk-block", "dbuffer", "shader-fp16", &[]).gpu(&[("shader", "fp16")]),
+    // wedge-blending's regions in the shader precision, its vBuffer arithmetic capped at fp32.
+    GoldenCase::variant("cube-of-spheres", "wedge-blending", "shader-fp24", &[])
+        .gpu(&[("shader", "fp24")]),
+    GoldenCase::variant("cube-of-spheres", "wedge-blending", "shader-fp16", &[])
+        .gpu(&[("shader", "fp16")]),
     GoldenCase::variant("cube-of-spheres", "wedge-blending", "tile32", &[])
         .gpu(&[("tile-size", "32")]),
     // wedge-blending (Forest et al. 2006): packing, knobs, float targets, order.

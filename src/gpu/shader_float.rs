@@ -183,6 +183,13 @@ pub trait ShaderFloat:
     /// The precision this type computes in.
     const PRECISION: ShaderPrecision;
 
+    /// This format, or fp32 where this one is wider (f64): the scalar of a fragment program
+    /// whose arithmetic was fp32 before shader precision existed — `wedge-blending`'s vBuffer
+    /// arithmetic ([`crate::methods::wedge_blending::blend`]), whose values are the f32 the
+    /// vBuffers store — so that the default keeps its bits and the narrower formats round as
+    /// every other program does. Every value of it is an exact f32.
+    type AtMostFp32: ShaderFloat;
+
     /// `x` rounded to the format (a constant, a uniform or an interpolated input).
     fn from_f64(x: f64) -> Self;
 
@@ -269,6 +276,7 @@ pub trait ShaderFloat:
 
 impl ShaderFloat for f64 {
     const PRECISION: ShaderPrecision = ShaderPrecision::F64;
+    type AtMostFp32 = Fp32;
 
     fn from_f64(x: f64) -> Self {
         x
@@ -288,6 +296,7 @@ macro_rules! rounded_float {
 
         impl ShaderFloat for $name {
             const PRECISION: ShaderPrecision = $precision;
+            type AtMostFp32 = Self;
 
             fn from_f64(x: f64) -> Self {
                 $name($format.round(x))

@@ -15,6 +15,7 @@
 //!   image row j is GL row H−1−j (the flip is done exactly in fixed point, see [`super::fixed`]).
 //!   `z_w = (z/w)·0.5 + 0.5` in f32.
 
+use super::shader_float::ShaderFloat;
 use crate::scene::{Camera, Scene};
 use glam::{DMat4, DVec3, DVec4, Vec3};
 
@@ -193,11 +194,19 @@ impl Projection {
     /// Hansen's `ConvertToWorldSpace`). Monotone in `z_w` (every step is a correctly rounded
     /// monotone operation), so window-depth order and view-depth order agree.
     pub fn view_depth(&self, z_w: f64) -> f64 {
-        let (n, f) = (self.near, self.far);
-        if f.is_finite() {
+        self.shader_view_depth::<f64>(z_w)
+    }
+
+    /// [`Projection::view_depth`] as a fragment program computes it in the shader precision
+    /// `T` (`[options.gpu] shader`, [`crate::gpu::shader_float`]): `n`, `f` and `z_w` rounded
+    /// to `T`, every operation rounded (Wyman & Hansen §3, pseudocode lines (5)–(6)). Whether
+    /// the far plane is finite is the uniform's, decided before rounding.
+    pub fn shader_view_depth<T: ShaderFloat>(&self, z_w: T) -> T {
+        let (n, f) = (T::from_f64(self.near), T::from_f64(self.far));
+        if self.far.is_finite() {
             f * n / (f - z_w * (f - n))
         } else {
-            n / (1.0 - z_w)
+            n / (T::one() - z_w)
         }
     }
 

@@ -36,10 +36,15 @@
 //! part (the sector-minus-triangle of Paper IV §4.2.2, computed exactly as a polygon here), and
 //! its bounding box is what §4.3 combines into the part's bounding rectangle.
 //!
-//! Everything here is f64 (the project's shader arithmetic until shader precision is
-//! emulated); the rectangles are f32 because they are what the vBuffers store.
+//! The projection, the clipping and the regions are f64 (module doc of
+//! [`crate::methods::wedge_blending`], "Shader precision"); the rectangles are f32 because
+//! they are what the vBuffers store, and their arithmetic ([`BoundingRect::area`],
+//! [`BoundingRect::center`], [`RegionBeyondEdge::bounds`]) is the blending program's, in its
+//! scalar.
 
 use super::coverage::{projected_edge_near_clipped, RectLight};
+use crate::gpu::shader_float::ShaderFloat;
+use crate::gpu::shader_vec::SVec2;
 use glam::{DVec2, DVec3};
 
 /// Number of radial parts (§3.1).
@@ -96,13 +101,14 @@ impl BoundingRect {
         self.left > self.right || self.bottom > self.top
     }
 
-    /// The area (0 for an empty rectangle).
-    pub fn area(&self) -> f32 {
+    /// The area (0 for an empty rectangle), computed in the fragment program's scalar `S`
+    /// (at most fp32, [`ShaderFloat::AtMostFp32`]).
+    pub fn area<S: ShaderFloat>(&self) -> S {
         if self.is_empty() {
-            0.0
-        } else {
-            (self.right - self.left) * (self.top - self.bottom)
+            return S::zero();
         }
+        let [l, b, r, t] = [self.left, self.bottom, self.right, self.top].map(read::<S>);
+        (r - l) * (t - b)
     }
 
     /// The smallest rectangle holding both ("combine it with the bounding rectangle computed
@@ -136,13 +142,25 @@ impl BoundingRect {
         }
     }
 
-    /// The center.
-    pub fn center(&self) -> [f32; 2] {
+    /// The center, computed in `S` as [`BoundingRect::area`].
+    pub fn center<S: ShaderFloat>(&self) -> [S; 2] {
+        let half = S::from_f64(0.5);
         [
-            0.5 * (self.left + self.right),
-            0.5 * (self.bottom + self.top),
+            half * (read::<S>(self.left) + read(self.right)),
+            half * (read::<S>(self.bottom) + read(self.top)),
         ]
     }
+}
+
+/// A stored f32 value as a fragment program computing in `S` reads it.
+pub fn read<S: ShaderFloat>(x: f32) -> S {
+    S::from_f64(x as f64)
+}
+
+/// A value of `S` as an f32 field stores it: exact when `S` is at most fp32
+/// ([`ShaderFloat::AtMostFp32`]).
+pub fn stored<S: ShaderFloat>(x: S) -> f32 {
+    x.to_f64() as f32
 }
 
 /// The occluded region one edge gives in one part: the part of the square beyond the clipped
@@ -153,8 +171,8 @@ pub struct RegionBeyondEdge {
     pub chord: [DVec2; 2],
     /// The region's area as a fraction of the part (the part's area is 1 in part-local units).
     pub area: f64,
-    /// Its bounding box.
-    pub bounds: BoundingRect,
+    /// Its bounding box, lower-left and upper-right corners ([`RegionBeyondEdge::bounds`]).
+    pub extent: [DVec2; 2],
     /// Its first moment `∫ (x, y) dA` (the center of gravity times the area, §6).
     pub moment: DVec2,
 }
@@ -165,15 +183,25 @@ impl RegionBeyondEdge {
     /// the edge's hard shadow quad: nothing is covered, as [`super::coverage`]'s exact
     /// coverage is 0 there).
     pub fn new(a: DVec2, b: DVec2) -> Option<Self> {
+        Self::in_shader::<f64>(a, b)
+    }
+
+    /// [`RegionBeyondEdge::new`] computed by the half-wedge fragment program in the shader
+    /// precision `T` (`[options.gpu] shader`): the chord's ends rounded to `T`, every
+    /// operation of the polygon, its area, first moment and bounding box rounded; the fields
+    /// hold the `T` values exactly.
+    pub fn in_shader<T: ShaderFloat>(a: DVec2, b: DVec2) -> Option<Self> {
+        let (a, b) = (SVec2::<T>::from_f64(a), SVec2::from_f64(b));
+        let (zero, one) = (T::zero(), T::one());
         let cross = a.perp_dot(b);
-        if cross == 0.0 || !cross.is_finite() {
+        if cross == zero || !cross.is_finite() {
             return None;
         }
         // The ray from the center through q leaves the part where its larger coordinate is 1.
-        let exit = |q: DVec2| q / q.x.max(q.y);
-        let corner = DVec2::ONE;
-        let corner_between = a.perp_dot(corner) * cross > 0.0 && corner.perp_dot(b) * cross > 0.0;
-        let mut poly = [DVec2::ZERO; 5];
+        let exit = |q: SVec2<T>| q / q.x.max(q.y);
+        let corner = SVec2::new(one, one);
+        let corner_between = a.perp_dot(corner) * cross > zero && corner.perp_dot(b) * cross > zero;
+        let mut poly = [SVec2::new(zero, zero); 5];
         let mut n = 0;
         for q in [a, b, exit(b)] {
             poly[n] = q;
@@ -186,30 +214,40 @@ impl RegionBeyondEdge {
         poly[n] = exit(a);
         n += 1;
         let poly = &poly[..n];
-        let mut twice_area = 0.0;
-        let mut moment6 = DVec2::ZERO;
+        let mut twice_area = zero;
+        let mut moment6 = SVec2::new(zero, zero);
         for i in 0..n {
             let (p, q) = (poly[i], poly[(i + 1) % n]);
             let c = p.perp_dot(q);
-            twice_area += c;
-            moment6 += (p + q) * c;
+            twice_area = twice_area + c;
+            moment6 = moment6 + (p + q) * c;
         }
         let sign = twice_area.signum();
         let (lo, hi) = poly.iter().fold(
             (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-            |(lo, hi), q| (lo.min(*q), hi.max(*q)),
+            |(lo, hi), q| (lo.min(q.to_f64()), hi.max(q.to_f64())),
         );
         Some(RegionBeyondEdge {
-            chord: [a, b],
-            area: 0.5 * twice_area * sign,
-            bounds: BoundingRect {
-                left: lo.x as f32,
-                bottom: lo.y as f32,
-                right: hi.x as f32,
-                top: hi.y as f32,
-            },
-            moment: moment6 * (sign / 6.0),
+            chord: [a.to_f64(), b.to_f64()],
+            area: (T::from_f64(0.5) * twice_area * sign).to_f64(),
+            extent: [lo, hi],
+            moment: (moment6 * (sign / T::from_f64(6.0))).to_f64(),
         })
+    }
+}
+
+impl RegionBeyondEdge {
+    /// Its bounding box as a fragment program computing in `S` (at most fp32,
+    /// [`ShaderFloat::AtMostFp32`]) holds it: each corner rounded to `S`, stored as f32.
+    pub fn bounds<S: ShaderFloat>(&self) -> BoundingRect {
+        let [lo, hi] = self.extent;
+        let at = |x: f64| stored(S::from_f64(x));
+        BoundingRect {
+            left: at(lo.x),
+            bottom: at(lo.y),
+            right: at(hi.x),
+            top: at(hi.y),
+        }
     }
 }
 
@@ -257,7 +295,10 @@ pub fn clip_by_saturation(a: DVec2, b: DVec2, lo: DVec2, hi: DVec2) -> Option<[D
 /// receiver `p` (module doc), `None` for the parts the edge does not reach. The unsigned area
 /// of each region is the part's occluded light percentage from this edge; whether it is added
 /// (outer half-wedge) or subtracted (inner) is the caller's.
-pub fn edge_in_parts(
+///
+/// The region of each part is computed in the shader precision `T`
+/// ([`RegionBeyondEdge::in_shader`]); the projection and the clipping are f64 (module doc).
+pub fn edge_in_parts<T: ShaderFloat>(
     light: &RectLight,
     p: DVec3,
     e0: DVec3,
@@ -272,7 +313,7 @@ pub fn edge_in_parts(
     };
     for (k, slot) in out.iter_mut().enumerate() {
         *slot = clip_by_saturation(to_part(k, a), to_part(k, b), DVec2::ZERO, DVec2::ONE)
-            .and_then(|[ca, cb]| RegionBeyondEdge::new(ca, cb));
+            .and_then(|[ca, cb]| RegionBeyondEdge::in_shader::<T>(ca, cb));
     }
     out
 }
@@ -280,6 +321,7 @@ pub fn edge_in_parts(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::gpu::shader_float::Fp32;
     use crate::light::coverage::edge_coverage_exact;
     use proptest::prelude::*;
 
@@ -288,7 +330,7 @@ mod tests {
         // The chord from (0.5, 0) to (0, 0.5): the part minus the triangle (0,0),(0.5,0),(0,0.5).
         let r = RegionBeyondEdge::new(DVec2::new(0.5, 0.0), DVec2::new(0.0, 0.5)).unwrap();
         assert!((r.area - 0.875).abs() < 1e-15, "{}", r.area);
-        assert_eq!(r.bounds, BoundingRect::FULL);
+        assert_eq!(r.bounds::<Fp32>(), BoundingRect::FULL);
         // Reversing the chord does not change the region.
         let s = RegionBeyondEdge::new(DVec2::new(0.0, 0.5), DVec2::new(0.5, 0.0)).unwrap();
         assert!((s.area - r.area).abs() < 1e-15);
@@ -304,10 +346,10 @@ mod tests {
         let r = RegionBeyondEdge::new(DVec2::new(0.5, 0.1), DVec2::new(0.5, 0.3)).unwrap();
         let expected = 0.5 * (0.2 + 0.4) * 0.5;
         assert!((r.area - expected).abs() < 1e-15);
-        assert_eq!(r.bounds.left, 0.5);
-        assert_eq!(r.bounds.right, 1.0);
-        assert_eq!(r.bounds.bottom, 0.1);
-        assert!((r.bounds.top - 0.6).abs() < 1e-7);
+        assert_eq!(r.bounds::<Fp32>().left, 0.5);
+        assert_eq!(r.bounds::<Fp32>().right, 1.0);
+        assert_eq!(r.bounds::<Fp32>().bottom, 0.1);
+        assert!((r.bounds::<Fp32>().top - 0.6).abs() < 1e-7);
         assert!(RegionBeyondEdge::new(DVec2::new(0.2, 0.2), DVec2::new(0.4, 0.4)).is_none());
     }
 
@@ -355,7 +397,7 @@ mod tests {
             let l = light();
             let (p, e0, e1) = (DVec3::from(p), DVec3::from(e0), DVec3::from(e1));
             let exact = edge_coverage_exact(&l, p, e0, e1).abs();
-            let parts: f64 = edge_in_parts(&l, p, e0, e1)
+            let parts: f64 = edge_in_parts::<f64>(&l, p, e0, e1)
                 .iter()
                 .flatten()
                 .map(|r| r.area)
@@ -371,9 +413,9 @@ mod tests {
         ) {
             let (a, b) = (DVec2::from(a), DVec2::from(b));
             if let Some(r) = RegionBeyondEdge::new(a, b) {
-                let bx = r.bounds;
+                let bx = r.bounds::<Fp32>();
                 prop_assert!(bx.left >= 0.0 && bx.bottom >= 0.0 && bx.right <= 1.0 && bx.top <= 1.0);
-                prop_assert!(r.area <= bx.area() as f64 + 1e-6);
+                prop_assert!(r.area <= bx.area::<Fp32>().to_f64() + 1e-6);
                 let c = r.moment / r.area.max(1e-300);
                 if r.area > 1e-9 {
                     prop_assert!(c.x >= bx.left as f64 - 1e-6 && c.x <= bx.right as f64 + 1e-6);

@@ -97,7 +97,23 @@
 //!    A denominator that is not positive (or a t that is not finite) is **degenerate**: t = ½
 //!    (the corrected formula's value at the silhouette), counted. t outside [0, 1] is counted
 //!    before it is clamped to [0, 1] (`saturate`), and those pixels are
-//!    [`super::output::MethodStats::clamped_pixels`]; V of a clamped t is in [0, 1].
+//!    [`super::output::MethodStats::clamped_pixels`]; V of a clamped t is in [0, 1] up to the
+//!    rounding of the falloff, and is saturated to [0, 1] as the fragment's colour output.
+//!
+//!    **Shader precision** (`[options.gpu] shader`, [`crate::gpu::shader_float`]): the screen
+//!    pass's fragment program — §2.2: "the second render-pass renders the objects in screen
+//!    space using a fragment program to calculate visibility. This fragment program uses the
+//!    distances from the D-buffer by performing a texture look-up and calculates the
+//!    visibility using the retrieved values" — runs in the chosen precision (the paper's
+//!    QuadroFX 3000, §5, computes in fp32): |cx| from the interpolated receiver position
+//!    ([`receiver_distance`]), the texel's four distances as the program reads them, the side
+//!    and region comparisons, eq. 3's t ([`parameter_t`]), V(t) ([`Falloff::apply`]) and the
+//!    saturation of V. What stays f64: the volumes (§2.1, built on the CPU), the vertex
+//!    program of §3.2 (the distances |cX| and eq. 2's |cx_s| per vertex, as the vertex stage
+//!    computes everything in this project), the rasterizer's interpolation of those
+//!    distances into the D-buffer and its storage (`storage`, f32 or f16); and the D-buffer
+//!    draws' own additions the paper has no fragment program for — the R channel's bias and
+//!    the per-fragment `distances = exact` — which are measurement devices, not the method.
 //!
 //!    The stencil buffer of §6.2 ("used to avoid overwriting umbra regions") is not needed: the
 //!    screen pass computes each pixel's V once, from the D-buffer, with nothing drawn over it.
@@ -130,6 +146,8 @@ use crate::gpu::light_view::LightView;
 use crate::gpu::probe::{Overflow, PassProbe, PrimitiveKind, ProbeEvent, Raw, Tap};
 use crate::gpu::raster::{bin, draw_probed, no_tile_culling, Fragment};
 use crate::gpu::setup::{setup_all_barycentric, CullMode};
+use crate::gpu::shader_float::ShaderFloat;
+use crate::gpu::shader_vec::SVec3;
 use crate::gpu::texture::Filter;
 use crate::gpu::transform::ClipVertex;
 use crate::options::{option_names, option_table, OptionTable};
@@ -240,6 +258,12 @@ pub fn silhouette_distance(c: DVec3, n: DVec3, x: DVec3, e: DVec3) -> Option<f64
     s.is_finite().then_some(s)
 }
 
+/// |cx| of the screen pass's receiver `x` (the interpolated position) from the light center
+/// `c` (a uniform), as the fragment program computes it in the shader precision `T`.
+pub fn receiver_distance<T: ShaderFloat>(x: DVec3, c: DVec3) -> T {
+    (SVec3::<T>::from_f64(x) - SVec3::from_f64(c)).length()
+}
+
 /// Which side of c's hard shadow x is on (module doc, pass 3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub enum Side {
@@ -251,20 +275,22 @@ pub enum Side {
 
 /// Eq. 3: t of a receiver at distance `d` from c, with the volume distance `v` (|cx_uv| on the
 /// umbra side, |cx_pv| on the other) and `s` = |cx_s|; `None` when degenerate (module doc).
-pub fn parameter_t(eq: Eq3, side: Side, d: f64, v: f64, s: f64) -> Option<f64> {
-    let den = 2.0
+/// Computed in the shader precision `T` (module doc, "Shader precision"), every operation
+/// rounded; the degeneracy test is on the rounded denominator and quotient.
+pub fn parameter_t<T: ShaderFloat>(eq: Eq3, side: Side, d: T, v: T, s: T) -> Option<T> {
+    let den = T::from_f64(2.0)
         * v
         * match eq {
             Eq3::Corrected => d - s,
             Eq3::Printed => v - s,
         };
     let q = s * (d - v) / den;
-    if !(den > 0.0 && q.is_finite()) {
+    if !(den > T::zero() && q.is_finite()) {
         return None;
     }
     Some(match side {
         Side::Umbra => q,
-        Side::Penumbra => 1.0 - q,
+        Side::Penumbra => T::one() - q,
     })
 }
 
@@ -290,7 +316,8 @@ pub struct Shade {
     pub t: Option<f64>,
     /// Whether eq. 3 was degenerate (t = ½ used).
     pub degenerate: bool,
-    /// The visibility (in [0, 1]: computed from t clamped to [0, 1]).
+    /// The visibility: V of t clamped to [0, 1], saturated to [0, 1] as the fragment's colour
+    /// output (module doc, "Shader precision").
     pub v: f64,
 }
 
@@ -302,15 +329,18 @@ impl Shade {
 }
 
 /// The fragment program of the screen pass (module doc, pass 3): the receiver at distance `d`
-/// from c over the D-buffer texel `[|cx_o|, |cx_uv|, |cx_pv|, |cx_s|]`.
-pub fn screen_program(d: f64, texel: [f32; 4], s: &DBufferSettings) -> Shade {
-    let [o, uv, pv, cs] = texel.map(f64::from);
+/// from c over the D-buffer texel `[|cx_o|, |cx_uv|, |cx_pv|, |cx_s|]`, computed in the
+/// shader precision `T` (module doc, "Shader precision"): `d` and the texel's channels are
+/// read as `T`, every comparison is on those values and every operation of t and V(t) is
+/// rounded.
+pub fn screen_program<T: ShaderFloat>(d: T, texel: [f32; 4], s: &DBufferSettings) -> Shade {
+    let [o, uv, pv, cs] = texel.map(|x| T::from_f64(x as f64));
     let (side, v) = if d > o {
         (Side::Umbra, uv)
     } else {
         (Side::Penumbra, pv)
     };
-    if v <= 0.0 || d < v {
+    if v <= T::zero() || d < v {
         let (region, v) = match side {
             Side::Umbra => (Region::Umbra, 0.0),
             Side::Penumbra => (Region::Lit, 1.0),
@@ -327,11 +357,13 @@ pub fn screen_program(d: f64, texel: [f32; 4], s: &DBufferSettings) -> Shade {
         Side::Penumbra => Region::OuterPenumbra,
     };
     let t = parameter_t(s.eq3, side, d, v, cs);
+    let (zero, one) = (T::zero(), T::one());
+    let clamped = t.unwrap_or(T::from_f64(0.5)).clamp(zero, one);
     Shade {
         region,
-        t,
+        t: t.map(T::to_f64),
         degenerate: t.is_none(),
-        v: s.falloff.apply(t.unwrap_or(0.5).clamp(0.0, 1.0)),
+        v: s.falloff.apply(clamped).clamp(zero, one).to_f64(),
     }
 }
 
@@ -793,7 +825,9 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
 
     // Pass 3: the screen.
     let t = Instant::now();
-    let (visibility, shades, screen, c3) = screen_pass(frame, &view, &dbuffer, c, s);
+    let (visibility, shades, screen, c3) = crate::with_shader_float!(frame.gpu.shader, T => {
+        screen_pass::<T>(frame, &view, &dbuffer, c, s)
+    });
     let pass_screen = PassStats::since("screen", t, c3);
 
     Ok(DBufferRender {
@@ -815,8 +849,9 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
     })
 }
 
-/// Pass 3 (module doc): visibility per pixel, the shades, the screen stats, the counters.
-fn screen_pass(
+/// Pass 3 (module doc): visibility per pixel, the shades, the screen stats, the counters; the
+/// fragment program in the shader precision `T`.
+fn screen_pass<T: ShaderFloat>(
     frame: &Frame,
     view: &LightView,
     dbuffer: &[RgbaTile],
@@ -851,8 +886,9 @@ fn screen_pass(
             let (tile, local) = view.nearest_texel(x, y);
             cn.color_read_bytes += texel_bytes;
             let texel = dbuffer[tile].texel(local);
-            let d = (r.point.as_dvec3() - c).length();
+            let d = receiver_distance::<T>(r.point.as_dvec3(), c);
             let shade = screen_program(d, texel, s);
+            let d = d.to_f64();
             if let Some(tap) = tap {
                 let [tx, ty] = view.tiling.position(tile, local);
                 let e = ["R", "G", "B", "A"]
@@ -1070,6 +1106,50 @@ mod tests {
                 Some(0.5)
             );
         }
+    }
+
+    /// Eq. 3's t in fp32, fp24 and fp16 against f64 for inputs exact in every format
+    /// (multiples of 1/8 below 16): first-order error analysis with unit roundoff u. In
+    /// `q = s·(d − v)/(2v·(d − s))` the differences, the two products (2v is exact) and the
+    /// quotient round once each: |q_T − q| ≤ 5u·q; the penumbra side's `1 − q` adds u·|1 − q|.
+    /// The factor 1.01 covers the second-order terms (5u ≤ 0.25 %). fp16 must differ
+    /// somewhere.
+    #[test]
+    fn t_in_each_precision_is_within_the_rounding_bound() {
+        use crate::gpu::shader_float::{Fp16, Fp24, Fp32, ShaderFloat, FP16, FP24, FP32};
+        fn check<T: ShaderFloat>(mantissa_bits: i32) -> usize {
+            let u = libm::ldexp(1.0, -(mantissa_bits + 1));
+            let at = |x: f64| T::from_f64(x);
+            let mut differ = 0;
+            for d in [3.0, 4.125, 5.375, 7.875, 11.625] {
+                for v in [1.5, 2.25, 2.875, 3.125] {
+                    for s in [0.625, 1.125, 1.375, 2.0] {
+                        for side in [Side::Umbra, Side::Penumbra] {
+                            if !(d > v && v >= s) {
+                                continue;
+                            }
+                            let exact = parameter_t(Eq3::Corrected, side, d, v, s).unwrap();
+                            let t = parameter_t(Eq3::Corrected, side, at(d), at(v), at(s))
+                                .unwrap()
+                                .to_f64();
+                            let q = s * (d - v) / (2.0 * v * (d - s));
+                            let bound = 1.01
+                                * match side {
+                                    Side::Umbra => 5.0 * u * q,
+                                    Side::Penumbra => 5.0 * u * q + u * (1.0 - q),
+                                };
+                            let err = (t - exact).abs();
+                            assert!(err <= bound, "{d} {v} {s} {side:?}: {t} vs {exact}");
+                            differ += (err > 0.0) as usize;
+                        }
+                    }
+                }
+            }
+            differ
+        }
+        check::<Fp32>(FP32.mantissa_bits);
+        check::<Fp24>(FP24.mantissa_bits);
+        assert!(check::<Fp16>(FP16.mantissa_bits) > 0, "fp16 changed no t");
     }
 
     #[test]

@@ -36,6 +36,7 @@ use crate::gpu::counters::Counters;
 use crate::gpu::depth::DepthFormat;
 use crate::gpu::light_view::{LightView, MAX_LIGHT_VIEW_HALF_ANGLE_DEG};
 use crate::gpu::probe::{PassProbe, Tap};
+use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::texture::Filter;
 use crate::gpu::tiling::Tiling;
 use crate::options::{option_names, option_table, KeyDoc, OptionTable, OptionType};
@@ -282,10 +283,16 @@ pub enum Falloff {
 }
 
 impl Falloff {
-    /// The falloff of `x`.
-    pub fn apply(self, x: f64) -> f64 {
+    /// The falloff of `x`, computed by the fragment program in the shader precision `T`
+    /// (`[options.gpu] shader`, [`crate::gpu::shader_float`]; plain f64 arithmetic at
+    /// `T = f64`): the constants 3 and 2 are exact in every format, each product and the
+    /// difference rounded.
+    pub fn apply<T: ShaderFloat>(self, x: T) -> T {
         match self {
-            Falloff::Smoothstep => 3.0 * x * x - 2.0 * x * x * x,
+            Falloff::Smoothstep => {
+                let (three, two) = (T::from_f64(3.0), T::from_f64(2.0));
+                three * x * x - two * x * x * x
+            }
             Falloff::Linear => x,
             Falloff::Sqrt => x.sqrt(),
         }

@@ -61,7 +61,18 @@
 //!    can produce (at the sheet's silhouette edge, where the interpolated `Z_v` and the
 //!    rasterized depth meet). After these, `0 ≤ Z_F′ − Z_v ≤ Z_P′ − Z_v` with a positive
 //!    denominator, so `I` is in [0, 1] by construction; the count of `I` outside [0, 1]
-//!    (before any falloff or storage clamp) is kept to prove it. The program computes in f64.
+//!    (before any falloff or storage clamp) is kept to prove it (at f64; in a narrower
+//!    shader precision the rounded `I` and `I′` can leave [0, 1] by an ulp, counted the same).
+//!
+//!    **Shader precision** (`[options.gpu] shader`, [`crate::gpu::shader_float`]): lines
+//!    (3)–(8) run in the chosen precision (the paper's ATI Radeon 9700 PRO, §5 "Results",
+//!    computes in fp24): `Z_F`, `Z_P` and `Z_v` as the program reads them, the comparison of
+//!    line (4) and the two discard tests on those values, `ConvertToWorldSpace` of lines
+//!    (5)–(6) ([`Projection::shader_view_depth`](crate::gpu::transform::Projection::shader_view_depth)),
+//!    `I` ([`penumbra_intensity`]) and the falloff ([`Falloff::apply`]). What stays f64: the
+//!    silhouette, the cones and sheets and their per-vertex `Z_v` (§3: "We compute Z_vi on
+//!    the CPU on a per-vertex basis"), the rasterizer's interpolation of `Z_F` and `Z_v`, and
+//!    the storage of `I′` (the colour format and the depth channel's quantization).
 //! 3. **Screen** (§3 "for each pixel rendered from the camera's viewpoint, a comparison with the
 //!    depth in the shadow map determines if the pixel is completely shadowed. If not fully
 //!    shadowed, a lookup into the penumbra map gives an approximation of the light"): the
@@ -73,7 +84,11 @@
 //!    at the nearest texel (`quantize(z) > stored` → umbra, visibility 0; the comparison is
 //!    always nearest: the umbra is the hard shadow) and otherwise the penumbra map sampled
 //!    with `filter` (`nearest`, default, as the paper, or `bilinear`), clamped to the edge.
-//!    Values outside [0, 1] before the final clamp are counted ([`ScreenStats`]).
+//!    Values outside [0, 1] before the final clamp are counted ([`ScreenStats`]). In the
+//!    shader precision: the subtraction of `bias-stage = lookup`'s offset from the receiver's
+//!    light-view depth (fragment arithmetic); the shadow-map comparison of quantized depths
+//!    and the penumbra-map lookup with its filter are the texture unit's and stay as they
+//!    are, as does the receiver's light-view position (the vertex stage's, interpolated).
 //!
 //! Buffer dumps (`--dump-buffers`, [`super::dump`]), at the map size: `shadow-map`, the depth
 //! target of pass 1 as stored, and `penumbra-map`, the colour channel of pass 2 with its
@@ -113,6 +128,7 @@ use crate::gpu::light_view::LightView;
 use crate::gpu::probe::{Overflow, PassProbe, PrimitiveKind, ProbeEvent, Raw, Tap};
 use crate::gpu::raster::{bin, draw_probed, no_tile_culling, Fragment};
 use crate::gpu::setup::{setup_all_barycentric, CullMode};
+use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::texture::Filter;
 use crate::options::{option_names, option_table, OptionTable};
 use crate::plan::BufferPlan;
@@ -375,19 +391,23 @@ pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRende
         s.cone_segments,
     );
     let probe = map_probe("penumbra-map");
-    let (color, program, c2) = render_penumbra_map_probed(
-        &view,
-        &shadow_map,
-        &geometry,
-        s,
-        frame.dump_buffers,
-        probe.as_ref(),
-    );
+    let (color, program, c2) = crate::with_shader_float!(frame.gpu.shader, T => {
+        render_penumbra_map_probed::<T>(
+            &view,
+            &shadow_map,
+            &geometry,
+            s,
+            frame.dump_buffers,
+            probe.as_ref(),
+        )
+    });
     let pass2 = PassStats::since("penumbra-map", t, c2);
 
     // Pass 3: the screen.
     let t = Instant::now();
-    let (visibility, screen, c3) = screen_pass(frame, &view, &shadow_map, &color, s);
+    let (visibility, screen, c3) = crate::with_shader_float!(frame.gpu.shader, T => {
+        screen_pass::<T>(frame, &view, &shadow_map, &color, s)
+    });
     let pass3 = PassStats::since("screen", t, c3);
 
     let silhouette = (
@@ -422,17 +442,21 @@ pub enum Discard {
 /// Lines (3)–(7) of the penumbra-map fragment program (module doc, pass 2): the intensity
 /// `I` of a fragment at interpolated window depth `z_f` over a shadow-map surface at window
 /// depth `z_p`, for the silhouette point at view depth `z_v`, depths converted by `proj`.
-pub fn penumbra_intensity(
+///
+/// Computed in the shader precision `T` (module doc, "Shader precision"): the three inputs
+/// are rounded to `T` as the program reads them, the comparisons are made on the rounded
+/// values and every operation of the depth conversion and of `I` is rounded.
+pub fn penumbra_intensity<T: ShaderFloat>(
     z_f: f32,
     z_p: f64,
     z_v: f64,
     proj: &crate::gpu::transform::Projection,
-) -> Result<f64, Discard> {
-    let z_f = z_f as f64;
+) -> Result<T, Discard> {
+    let (z_f, z_p, z_v) = (T::from_f64(z_f as f64), T::from_f64(z_p), T::from_f64(z_v));
     if z_f > z_p {
         return Err(Discard::BehindSurface);
     }
-    let (z_p, z_f) = (proj.view_depth(z_p), proj.view_depth(z_f));
+    let (z_p, z_f) = (proj.shader_view_depth(z_p), proj.shader_view_depth(z_f));
     if z_p <= z_v {
         return Err(Discard::SurfaceNotBeyondSilhouette);
     }
@@ -455,20 +479,21 @@ pub fn cone_light(view: &LightView, radius: f32) -> ConeLight {
 
 /// Pass 2 (module doc): draw the cones and sheets of `geometry` over `shadow_map` (both in
 /// `view`) into a penumbra map; returns its colour tiles (recording their overflow events per
-/// sample when `record`, for a buffer dump), the program's stats and the pass counters.
-pub fn render_penumbra_map(
+/// sample when `record`, for a buffer dump), the program's stats and the pass counters. The
+/// fragment program computes in the shader precision `T` (module doc, "Shader precision").
+pub fn render_penumbra_map<T: ShaderFloat>(
     view: &LightView,
     shadow_map: &[DepthTile],
     geometry: &PenumbraGeometry,
     s: &PenumbraMapSettings,
     record: bool,
 ) -> (Vec<ColorTile>, ProgramStats, Counters) {
-    render_penumbra_map_probed(view, shadow_map, geometry, s, record, None)
+    render_penumbra_map_probed::<T>(view, shadow_map, geometry, s, record, None)
 }
 
 /// [`render_penumbra_map`] recording the clears and every fragment at the texels `probe`
 /// watches ([`crate::gpu::probe`]).
-pub fn render_penumbra_map_probed(
+pub fn render_penumbra_map_probed<T: ShaderFloat>(
     view: &LightView,
     shadow_map: &[DepthTile],
     geometry: &PenumbraGeometry,
@@ -530,7 +555,7 @@ pub fn render_penumbra_map_probed(
                     .value("Z_P", format.to_window(z_p))
                     .value("Z_v", z_v)
             };
-            let i = match penumbra_intensity(f.z, format.to_window(z_p), z_v, &view.proj) {
+            let i = match penumbra_intensity::<T>(f.z, format.to_window(z_p), z_v, &view.proj) {
                 Ok(i) => i,
                 Err(why) => {
                     match why {
@@ -546,10 +571,10 @@ pub fn render_penumbra_map_probed(
                     return;
                 }
             };
+            let (i, falloff) = (i.to_f64(), s.falloff.apply(i).to_f64());
             if !(0.0..=1.0).contains(&i) {
                 st.intensity_out_of_range += 1;
             }
-            let falloff = s.falloff.apply(i);
             // (9)–(10): colour and depth, LESS: the darkest wins.
             let out = Fragment {
                 z: falloff as f32,
@@ -606,8 +631,9 @@ pub fn render_penumbra_map_probed(
     (color, program, counters)
 }
 
-/// Pass 3 (module doc): visibility per pixel, the screen stats, the counters.
-fn screen_pass(
+/// Pass 3 (module doc): visibility per pixel, the screen stats, the counters; the fragment
+/// program's bias subtraction (`bias-stage = lookup`) in the shader precision `T`.
+fn screen_pass<T: ShaderFloat>(
     frame: &Frame,
     view: &LightView,
     shadow_map: &[DepthTile],
@@ -651,7 +677,10 @@ fn screen_pass(
             };
             c.depth_read_bytes += depth_bytes;
             let z = match slopes.get(prims[i] as usize) {
-                Some(&(m, z_max)) => (z as f64 - s.offset.amount(view.depth, m, z_max)) as f32,
+                Some(&(m, z_max)) => {
+                    let amount = T::from_f64(s.offset.amount(view.depth, m, z_max));
+                    (T::from_f64(z as f64) - amount).to_f64() as f32
+                }
                 None => z,
             };
             let event = event.map(|e| {
@@ -817,11 +846,12 @@ mod tests {
     fn intensity_is_the_depth_ratio_of_equation_1() {
         let p = proj();
         // Silhouette at 2, fragment at 3, surface at 6: I = (3 − 2)/(6 − 2).
-        let i = penumbra_intensity(window(&p, 3.0) as f32, window(&p, 6.0), 2.0, &p).unwrap();
+        let i =
+            penumbra_intensity::<f64>(window(&p, 3.0) as f32, window(&p, 6.0), 2.0, &p).unwrap();
         assert!((i - 0.25).abs() < 1e-6, "{i}");
         // Line (4): the fragment behind the surface.
         assert_eq!(
-            penumbra_intensity(window(&p, 7.0) as f32, window(&p, 6.0), 2.0, &p),
+            penumbra_intensity::<f64>(window(&p, 7.0) as f32, window(&p, 6.0), 2.0, &p),
             Err(Discard::BehindSurface)
         );
     }
@@ -833,19 +863,75 @@ mod tests {
         let tip = p.view_depth(z as f32 as f64);
         // The cone's tip on the occluder itself: Z_F′ = Z_P′ = Z_v, the paper's I is 0/0.
         assert_eq!(
-            penumbra_intensity(z as f32, z as f32 as f64, tip, &p),
+            penumbra_intensity::<f64>(z as f32, z as f32 as f64, tip, &p),
             Err(Discard::SurfaceNotBeyondSilhouette)
         );
         // A fragment rounded in front of its silhouette point over a surface beyond it.
         assert_eq!(
-            penumbra_intensity(z as f32, window(&p, 5.0), tip * (1.0 + 1e-9), &p),
+            penumbra_intensity::<f64>(z as f32, window(&p, 5.0), tip * (1.0 + 1e-9), &p),
             Err(Discard::InFrontOfSilhouette)
         );
         // At the silhouette point over a surface beyond it: I = 0, the darkest.
         assert_eq!(
-            penumbra_intensity(z as f32, window(&p, 5.0), tip, &p),
+            penumbra_intensity::<f64>(z as f32, window(&p, 5.0), tip, &p),
             Ok(0.0)
         );
+    }
+
+    /// First-order bound on |I_T − I| (module doc, "Shader precision") for inputs exact in
+    /// `T` (window depths on the fp16 grid, an integer `Z_v`; `proj` has n = 1, f = 10, so
+    /// `f·n` and `f − n` are exact) with unit roundoff `u`. `Z′ = f·n/(f − z·(f − n))`: the
+    /// product `z·(f − n)` (relative u) enters the difference `D = f − z·(f − n)` as an
+    /// absolute error `u·z·(f − n)`, the difference and the quotient round once each, so
+    /// `Z′` is off by `Z′·u·(z·(f − n)/D + 2)`. `N = Z_F′ − Z_v` and `M = Z_P′ − Z_v` add that
+    /// and their own rounding; `I = N/M` adds `u·I`. Relative errors below 5 % make the
+    /// second-order terms a fraction 0.05 of the first-order ones, covered by the factor 1.05.
+    fn intensity_bound(p: &Projection, z_f: f64, z_p: f64, z_v: f64, u: f64) -> f64 {
+        let (n, f) = (p.near, p.far);
+        let conversion = |z: f64| u * (z * (f - n) / (f - z * (f - n)) + 2.0);
+        let (zf, zp) = (p.view_depth(z_f), p.view_depth(z_p));
+        let (num, den) = (zf - z_v, zp - z_v);
+        let e_num = zf * conversion(z_f) + u * num;
+        let e_den = zp * conversion(z_p) + u * den;
+        let i = num / den;
+        1.05 * (e_num / den + i * e_den / den + i * u)
+    }
+
+    /// Pass 2's `I` in fp32, fp24 and fp16 against f64, within [`intensity_bound`]; fp16
+    /// must differ somewhere (the program does compute at `T`).
+    #[test]
+    fn intensity_in_each_precision_is_within_the_rounding_bound() {
+        use crate::gpu::shader_float::{Fp16, Fp24, Fp32, ShaderFloat, FP16, FP24, FP32};
+        fn check<T: ShaderFloat>(p: &Projection, mantissa_bits: i32) -> (usize, f64) {
+            let u = libm::ldexp(1.0, -(mantissa_bits + 1));
+            let grid = [0.5, 0.75, 0.875, 0.90625, 0.96875, 0.9951171875];
+            let (mut differ, mut worst) = (0, 0.0f64);
+            for z_f in grid {
+                for z_p in grid {
+                    for z_v in [1.0, 1.5, 2.0, 3.0] {
+                        let Ok(exact) = penumbra_intensity::<f64>(z_f as f32, z_p, z_v, p) else {
+                            continue;
+                        };
+                        let i = penumbra_intensity::<T>(z_f as f32, z_p, z_v, p)
+                            .unwrap_or_else(|d| panic!("{z_f} {z_p} {z_v}: {d:?}"))
+                            .to_f64();
+                        let bound = intensity_bound(p, z_f, z_p, z_v, u);
+                        let err = (i - exact).abs();
+                        assert!(err <= bound, "{z_f} {z_p} {z_v}: |{i} − {exact}| > {bound}");
+                        differ += (err > 0.0) as usize;
+                        worst = worst.max(err / bound.max(f64::MIN_POSITIVE));
+                    }
+                }
+            }
+            (differ, worst)
+        }
+        let p = proj();
+        assert_eq!((p.near, p.far), (1.0, 10.0));
+        let (_, w32) = check::<Fp32>(&p, FP32.mantissa_bits);
+        let (_, w24) = check::<Fp24>(&p, FP24.mantissa_bits);
+        let (d16, w16) = check::<Fp16>(&p, FP16.mantissa_bits);
+        assert!(d16 > 0, "fp16 changed no I");
+        eprintln!("worst error / bound: fp32 {w32:.3}, fp24 {w24:.3}, fp16 {w16:.3}");
     }
 
     #[test]

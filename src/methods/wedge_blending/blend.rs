@@ -64,6 +64,13 @@
 //!   the center is −1) can only reach here unpacked (PK4UB clamps it to 0); it is added
 //!   without ε so the Green sum over the loops stays exact, and the rectangle is left as is.
 //!
+//! # Shader precision
+//! Every function here computes in the fragment program's scalar `S`, the shader precision
+//! capped at fp32 ([`ShaderFloat::AtMostFp32`]; the method's module doc, "Shader
+//! precision"): the stored f32 values are read as `S` ([`read`]), every operation rounds,
+//! and results are stored as f32 ([`stored`], exact). Unions, intersections, clamps and
+//! comparisons are exact in every format.
+//!
 //! # Center of gravity (§6, `centroid = on`)
 //! §6 proposes to "weight the bounding rectangles intersection area" by the center of gravity
 //! of the occluded area, stored as one of 256 positions per part. The paper gives no formula;
@@ -75,7 +82,8 @@
 //! region's moment, divided by the new occlusion; the blend combines the two centroids
 //! weighted by their occlusions minus ε at the overlap's center.
 
-use crate::light::radial_parts::{BoundingRect, RegionBeyondEdge};
+use crate::gpu::shader_float::ShaderFloat;
+use crate::light::radial_parts::{read, stored, BoundingRect, RegionBeyondEdge};
 
 /// One radial part of a vBuffer pixel (module doc).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -132,37 +140,43 @@ impl PartState {
 
     /// Move the center of gravity for a change of `delta_area` with first moment
     /// `delta_moment` (module doc, "Center of gravity").
-    fn shift_centroid(&mut self, delta_area: f32, delta_moment: [f32; 2]) {
-        let total = self.occlusion + delta_area;
-        if total > 0.0 {
-            let m = self.occlusion.max(0.0);
-            self.centroid =
-                [0, 1].map(|k| ((m * self.centroid[k] + delta_moment[k]) / total).clamp(0.0, 1.0));
+    fn shift_centroid<S: ShaderFloat>(&mut self, delta_area: S, delta_moment: [S; 2]) {
+        let occlusion = read::<S>(self.occlusion);
+        let total = occlusion + delta_area;
+        if total > S::zero() {
+            let m = occlusion.max(S::zero());
+            self.centroid = [0, 1].map(|k| {
+                let c = (m * read(self.centroid[k]) + delta_moment[k]) / total;
+                stored(c.clamp(S::zero(), S::one()))
+            });
         }
     }
 
-    /// An outer half-wedge fragment (§4.3): add the region's area, grow the rectangle.
-    pub fn add_outer(&mut self, r: &RegionBeyondEdge) {
-        let area = r.area as f32;
-        self.shift_centroid(area, [r.moment.x as f32, r.moment.y as f32]);
-        self.occlusion += area;
-        self.rect = self.rect.union(&r.bounds);
+    /// An outer half-wedge fragment (§4.3): add the region's area, grow the rectangle; in the
+    /// program's scalar `S` (module doc, "Shader precision").
+    pub fn add_outer<S: ShaderFloat>(&mut self, r: &RegionBeyondEdge) {
+        let area = S::from_f64(r.area);
+        self.shift_centroid(area, [S::from_f64(r.moment.x), S::from_f64(r.moment.y)]);
+        self.occlusion = stored(read::<S>(self.occlusion) + area);
+        self.rect = self.rect.union(&r.bounds::<S>());
     }
 
     /// An inner half-wedge fragment (§4.3): subtract the region's area, raise the maximum X
-    /// and Y of the occluding edges.
-    pub fn add_inner(&mut self, r: &RegionBeyondEdge) {
-        let area = r.area as f32;
-        self.shift_centroid(-area, [-r.moment.x as f32, -r.moment.y as f32]);
-        self.occlusion -= area;
+    /// and Y of the occluding edges; in the program's scalar `S`.
+    pub fn add_inner<S: ShaderFloat>(&mut self, r: &RegionBeyondEdge) {
+        let area = S::from_f64(r.area);
+        let moment = [-S::from_f64(r.moment.x), -S::from_f64(r.moment.y)];
+        self.shift_centroid(-area, moment);
+        self.occlusion = stored(read::<S>(self.occlusion) - area);
         for (k, m) in self.max_edge.iter_mut().enumerate() {
-            *m = m.max(r.chord[0][k] as f32).max(r.chord[1][k] as f32);
+            let ends = r.chord.map(|q| S::from_f64(q[k]));
+            *m = stored(read::<S>(*m).max(ends[0]).max(ends[1]));
         }
     }
 
     /// The rectangle with the inner adjustment of Fig. 10 applied as `adjust` says (module
-    /// doc, "The inner adjustment").
-    pub fn occluded_rect(&self, adjust: InnerAdjust) -> BoundingRect {
+    /// doc, "The inner adjustment"), its area check in the program's scalar `S`.
+    pub fn occluded_rect<S: ShaderFloat>(&self, adjust: InnerAdjust) -> BoundingRect {
         let [mx, my] = self.max_edge;
         if (mx == 0.0 && my == 0.0) || adjust == InnerAdjust::Never {
             return self.rect;
@@ -172,7 +186,8 @@ impl PartState {
             top: self.rect.top.min(my),
             ..self.rect
         };
-        if adjust == InnerAdjust::Checked && clipped.area() < self.occlusion - AREA_CHECK_SLACK {
+        let slack = read::<S>(self.occlusion) - read(AREA_CHECK_SLACK);
+        if adjust == InnerAdjust::Checked && clipped.area::<S>() < slack {
             return self.rect;
         }
         clipped
@@ -207,54 +222,62 @@ pub struct Rules {
 }
 
 /// `A/B` clamped to [0, 1]; 1 for an empty or zero-area rectangle (module doc).
-fn fill_ratio(occlusion: f32, rect: &BoundingRect) -> f32 {
-    let b = rect.area();
-    if b > 0.0 {
-        (occlusion / b).clamp(0.0, 1.0)
+fn fill_ratio<S: ShaderFloat>(occlusion: S, rect: &BoundingRect) -> S {
+    let b = rect.area::<S>();
+    if b > S::zero() {
+        (occlusion / b).clamp(S::zero(), S::one())
     } else {
-        1.0
+        S::one()
     }
 }
 
 /// The rectangle of area `occlusion` with the shape of `rect`, centered at `centroid` and
 /// moved inside `rect` (module doc, "Center of gravity").
-fn compact_rect(occlusion: f32, rect: &BoundingRect, centroid: [f32; 2]) -> BoundingRect {
+fn compact_rect<S: ShaderFloat>(
+    occlusion: S,
+    rect: &BoundingRect,
+    centroid: [f32; 2],
+) -> BoundingRect {
     let k = fill_ratio(occlusion, rect).sqrt();
-    let half = [
-        0.5 * k * (rect.right - rect.left),
-        0.5 * k * (rect.top - rect.bottom),
-    ];
-    let lo = [rect.left, rect.bottom];
-    let hi = [rect.right, rect.top];
-    let c: [f32; 2] = std::array::from_fn(|i| {
+    let half_of = S::from_f64(0.5);
+    let [left, bottom, right, top] = [rect.left, rect.bottom, rect.right, rect.top].map(read::<S>);
+    let half = [half_of * k * (right - left), half_of * k * (top - bottom)];
+    let lo = [left, bottom];
+    let hi = [right, top];
+    let c: [S; 2] = std::array::from_fn(|i| {
         let (a, b) = (lo[i] + half[i], hi[i] - half[i]);
         if a <= b {
-            centroid[i].clamp(a, b)
+            read::<S>(centroid[i]).clamp(a, b)
         } else {
-            0.5 * (lo[i] + hi[i])
+            half_of * (lo[i] + hi[i])
         }
     });
     BoundingRect {
-        left: c[0] - half[0],
-        bottom: c[1] - half[1],
-        right: c[0] + half[0],
-        top: c[1] + half[1],
+        left: stored(c[0] - half[0]),
+        bottom: stored(c[1] - half[1]),
+        right: stored(c[0] + half[0]),
+        top: stored(c[1] + half[1]),
     }
 }
 
 /// The effective overlapped area ε of two occluded regions (module doc, "Blending"):
 /// `(A_f/B_f)·(A_s/B_s)·β`, or with `centroid` the overlap of the two compact model
-/// rectangles. Returns ε and the center of the overlap.
-pub fn overlap_estimate(f: &PartState, s: &PartState, rules: Rules) -> (f32, [f32; 2]) {
-    let (rf, rs) = (f.occluded_rect(rules.adjust), s.occluded_rect(rules.adjust));
+/// rectangles, in the program's scalar `S` (module doc, "Shader precision"). Returns ε and
+/// the center of the overlap.
+pub fn overlap_estimate<S: ShaderFloat>(f: &PartState, s: &PartState, rules: Rules) -> (S, [S; 2]) {
+    let (rf, rs) = (
+        f.occluded_rect::<S>(rules.adjust),
+        s.occluded_rect::<S>(rules.adjust),
+    );
+    let (af, a_s) = (read::<S>(f.occlusion), read::<S>(s.occlusion));
     if rules.centroid {
-        let mf = compact_rect(f.occlusion, &rf, f.centroid);
-        let ms = compact_rect(s.occlusion, &rs, s.centroid);
+        let mf = compact_rect(af, &rf, f.centroid);
+        let ms = compact_rect(a_s, &rs, s.centroid);
         let overlap = mf.intersection(&ms);
         return (overlap.area(), overlap.center());
     }
     let overlap = rf.intersection(&rs);
-    let eps = fill_ratio(f.occlusion, &rf) * fill_ratio(s.occlusion, &rs) * overlap.area();
+    let eps = fill_ratio(af, &rf) * fill_ratio(a_s, &rs) * overlap.area();
     (eps, overlap.center())
 }
 
@@ -273,19 +296,30 @@ pub struct BlendOutcome {
 /// module doc). The result's occlusion is limited to 1 (a part cannot be more than fully
 /// occluded; the packed storage would clamp it anyway, this makes the unpacked variant do the
 /// same so that the two differ only by quantization and the silhouette vBuffer's clamps).
-pub fn blend_part(f: &PartState, s: &PartState, rules: Rules) -> (PartState, BlendOutcome) {
-    let (mut out, case, eps) = blend_unlimited(f, s, rules);
+///
+/// The arithmetic is the fragment program's, in its scalar `S` (module doc, "Shader
+/// precision"); the operands are the stored f32 values and the result is stored as f32.
+pub fn blend_part<S: ShaderFloat>(
+    f: &PartState,
+    s: &PartState,
+    rules: Rules,
+) -> (PartState, BlendOutcome) {
+    let (mut out, case, eps) = blend_unlimited::<S>(f, s, rules);
     let limited = out.occlusion > 1.0;
     out.occlusion = out.occlusion.min(1.0);
     (out, BlendOutcome { case, eps, limited })
 }
 
 /// [`blend_part`] before the limit.
-fn blend_unlimited(f: &PartState, s: &PartState, rules: Rules) -> (PartState, BlendCase, f32) {
+fn blend_unlimited<S: ShaderFloat>(
+    f: &PartState,
+    s: &PartState,
+    rules: Rules,
+) -> (PartState, BlendCase, f32) {
     if s.occlusion == 0.0 {
         return (*f, BlendCase::Skipped, 0.0);
     }
-    let rs = s.occluded_rect(rules.adjust);
+    let rs = s.occluded_rect::<S>(rules.adjust);
     if f.occlusion == 0.0 {
         let copy = PartState {
             occlusion: s.occlusion,
@@ -295,35 +329,36 @@ fn blend_unlimited(f: &PartState, s: &PartState, rules: Rules) -> (PartState, Bl
         };
         return (copy, BlendCase::Copied, 0.0);
     }
+    let (af, a_s) = (read::<S>(f.occlusion), read::<S>(s.occlusion));
     if f.occlusion < 0.0 || s.occlusion < 0.0 {
         let sum = PartState {
-            occlusion: f.occlusion + s.occlusion,
+            occlusion: stored(af + a_s),
             ..*f
         };
         return (sum, BlendCase::Accumulated, 0.0);
     }
-    let (eps, at) = overlap_estimate(f, s, rules);
-    let occlusion = f.occlusion + s.occlusion - eps;
+    let (eps, at) = overlap_estimate::<S>(f, s, rules);
+    let occlusion = af + a_s - eps;
     let out = PartState {
-        occlusion,
-        rect: f.occluded_rect(rules.adjust).union(&rs),
+        occlusion: stored(occlusion),
+        rect: f.occluded_rect::<S>(rules.adjust).union(&rs),
         max_edge: [0.0, 0.0],
-        centroid: if occlusion > 0.0 {
+        centroid: if occlusion > S::zero() {
             [0, 1].map(|k| {
-                ((f.occlusion * f.centroid[k] + s.occlusion * s.centroid[k] - eps * at[k])
-                    / occlusion)
-                    .clamp(0.0, 1.0)
+                let moment = af * read(f.centroid[k]) + a_s * read(s.centroid[k]) - eps * at[k];
+                stored((moment / occlusion).clamp(S::zero(), S::one()))
             })
         } else {
             f.centroid
         },
     };
-    (out, BlendCase::Blended, eps)
+    (out, BlendCase::Blended, stored(eps))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::gpu::shader_float::Fp32;
 
     const PLAIN: Rules = Rules {
         adjust: InnerAdjust::Checked,
@@ -339,8 +374,49 @@ mod tests {
             occlusion,
             rect,
             max_edge: [0.0, 0.0],
-            centroid: rect.center(),
+            centroid: rect.center::<Fp32>().map(stored),
         }
+    }
+
+    /// ε in fp32, fp24 and fp16 against f64 for operands exact in every format (rectangle
+    /// coordinates multiples of 1/8, occlusions multiples of 1/64): first-order error analysis
+    /// with unit roundoff u. Each area B = (r − l)(t − b) has exact differences and one
+    /// rounded product (u); each ratio A/B rounds once more (2u; the clamp to [0, 1] does not
+    /// increase an error); β's area is one product (u); ε's two products round once each (2u):
+    /// |ε_S − ε| ≤ 7u·ε. The factor 1.01 covers the second-order terms (7u ≤ 0.35 %). fp16
+    /// must differ somewhere (the blend does compute in `S`).
+    #[test]
+    fn epsilon_in_each_precision_is_within_the_rounding_bound() {
+        use crate::gpu::shader_float::{Fp16, Fp24, FP16, FP24, FP32};
+        fn check<S: ShaderFloat>(mantissa_bits: i32) -> usize {
+            let u = libm::ldexp(1.0, -(mantissa_bits + 1));
+            let rects = [
+                r(0.0, 0.0, 1.0, 1.0),
+                r(0.125, 0.25, 0.875, 0.625),
+                r(0.375, 0.0, 1.0, 0.75),
+                r(0.0, 0.5, 0.625, 1.0),
+            ];
+            let mut differ = 0;
+            for (rf, rs) in rects.iter().flat_map(|a| rects.iter().map(move |b| (a, b))) {
+                for af in [0.046875, 0.203125, 0.328125] {
+                    for a_s in [0.078125, 0.140625, 0.421875] {
+                        let (f, s) = (part(af, *rf), part(a_s, *rs));
+                        let exact = overlap_estimate::<f64>(&f, &s, PLAIN).0;
+                        let eps = overlap_estimate::<S>(&f, &s, PLAIN).0.to_f64();
+                        let err = (eps - exact).abs();
+                        assert!(
+                            err <= 1.01 * 7.0 * u * exact,
+                            "{f:?} {s:?}: {eps} vs {exact}"
+                        );
+                        differ += (err > 0.0) as usize;
+                    }
+                }
+            }
+            differ
+        }
+        check::<Fp32>(FP32.mantissa_bits);
+        check::<Fp24>(FP24.mantissa_bits);
+        assert!(check::<Fp16>(FP16.mantissa_bits) > 0, "fp16 changed no ε");
     }
 
     fn r(left: f32, bottom: f32, right: f32, top: f32) -> BoundingRect {
@@ -356,7 +432,7 @@ mod tests {
     fn disjoint_rectangles_are_not_corrected() {
         let f = part(0.1, r(0.0, 0.0, 0.4, 0.5));
         let s = part(0.2, r(0.5, 0.0, 1.0, 0.5));
-        let (out, o) = blend_part(&f, &s, PLAIN);
+        let (out, o) = blend_part::<Fp32>(&f, &s, PLAIN);
         assert_eq!(o.case, BlendCase::Blended);
         assert_eq!(o.eps, 0.0);
         assert_eq!(out.occlusion, 0.1 + 0.2);
@@ -368,7 +444,7 @@ mod tests {
         // Final: 0.2 in [0,1]×[0,0.5] (B = 0.5); silhouette: 0.04 filling [0.2,0.4]×[0.1,0.3].
         let f = part(0.2, r(0.0, 0.0, 1.0, 0.5));
         let s = part(0.04, r(0.2, 0.1, 0.4, 0.3));
-        let (out, BlendOutcome { eps, .. }) = blend_part(&f, &s, PLAIN);
+        let (out, BlendOutcome { eps, .. }) = blend_part::<Fp32>(&f, &s, PLAIN);
         // ε = (0.2/0.5)·(0.04/0.04)·0.04 = 0.016.
         assert!((eps - 0.016).abs() < 1e-7, "{eps}");
         assert!((out.occlusion - (0.24 - 0.016)).abs() < 1e-7);
@@ -380,7 +456,7 @@ mod tests {
         let rect = r(0.25, 0.25, 0.75, 0.75);
         let f = part(0.125, rect);
         let s = part(0.25, rect);
-        let (out, BlendOutcome { eps, .. }) = blend_part(&f, &s, PLAIN);
+        let (out, BlendOutcome { eps, .. }) = blend_part::<Fp32>(&f, &s, PLAIN);
         // ε = 0.5·1·0.25.
         assert!((eps - 0.125).abs() < 1e-7);
         assert!((out.occlusion - 0.25).abs() < 1e-7);
@@ -391,10 +467,10 @@ mod tests {
         // An umbra (whole part) over any penumbra gives the whole part.
         let f = part(0.3, r(0.1, 0.2, 0.9, 0.8));
         let s = PartState::hard(1);
-        let (out, o) = blend_part(&f, &s, PLAIN);
+        let (out, o) = blend_part::<Fp32>(&f, &s, PLAIN);
         assert!((out.occlusion - 1.0).abs() < 1e-6);
         assert!(!o.limited);
-        let (out, _) = blend_part(&s, &f, PLAIN);
+        let (out, _) = blend_part::<Fp32>(&s, &f, PLAIN);
         assert!((out.occlusion - 1.0).abs() < 1e-6);
     }
 
@@ -402,14 +478,14 @@ mod tests {
     fn dynamic_branch_cases() {
         let f = part(0.3, r(0.1, 0.2, 0.9, 0.8));
         assert_eq!(
-            blend_part(&f, &PartState::CLEARED, PLAIN).1.case,
+            blend_part::<Fp32>(&f, &PartState::CLEARED, PLAIN).1.case,
             BlendCase::Skipped
         );
-        let (copy, o) = blend_part(&PartState::CLEARED, &f, PLAIN);
+        let (copy, o) = blend_part::<Fp32>(&PartState::CLEARED, &f, PLAIN);
         assert_eq!(o.case, BlendCase::Copied);
         assert_eq!(copy.occlusion, 0.3);
         let hole = PartState::hard(-1);
-        let (sum, o) = blend_part(&PartState::hard(1), &hole, PLAIN);
+        let (sum, o) = blend_part::<Fp32>(&PartState::hard(1), &hole, PLAIN);
         assert_eq!(
             (o.case, o.eps, sum.occlusion),
             (BlendCase::Accumulated, 0.0, 0.0)
@@ -419,7 +495,7 @@ mod tests {
             occlusion: 0.9,
             ..part(0.9, r(0.0, 0.0, 1.0, 0.7))
         };
-        let (out, o) = blend_part(&PartState::hard(1), &small, PLAIN);
+        let (out, o) = blend_part::<Fp32>(&PartState::hard(1), &small, PLAIN);
         assert!(o.limited);
         assert_eq!(out.occlusion, 1.0);
     }
@@ -430,10 +506,16 @@ mod tests {
         // An inner edge from (0.5, 0) to (0, 0.4): the part minus the triangle stays.
         let region =
             RegionBeyondEdge::new(glam::DVec2::new(0.5, 0.0), glam::DVec2::new(0.0, 0.4)).unwrap();
-        s.add_inner(&region);
+        s.add_inner::<Fp32>(&region);
         assert!((s.occlusion - 0.1).abs() < 1e-7);
-        assert_eq!(s.occluded_rect(InnerAdjust::Checked), r(0.0, 0.0, 0.5, 0.4));
-        assert_eq!(s.occluded_rect(InnerAdjust::Never), BoundingRect::FULL);
+        assert_eq!(
+            s.occluded_rect::<Fp32>(InnerAdjust::Checked),
+            r(0.0, 0.0, 0.5, 0.4)
+        );
+        assert_eq!(
+            s.occluded_rect::<Fp32>(InnerAdjust::Never),
+            BoundingRect::FULL
+        );
         // The centroid of the remaining triangle (1/3 of (0.5, 0.4)).
         assert!((s.centroid[0] - 0.5 / 3.0).abs() < 1e-5, "{:?}", s.centroid);
         assert!((s.centroid[1] - 0.4 / 3.0).abs() < 1e-5);
@@ -449,16 +531,19 @@ mod tests {
             RegionBeyondEdge::new(glam::DVec2::new(1.0, 0.3), glam::DVec2::new(0.8, 0.5)).unwrap();
         let bite2 =
             RegionBeyondEdge::new(glam::DVec2::new(0.8, 0.5), glam::DVec2::new(1.0, 0.7)).unwrap();
-        s.add_inner(&bite);
-        s.add_inner(&bite2);
+        s.add_inner::<Fp32>(&bite);
+        s.add_inner::<Fp32>(&bite2);
         // Occluded: the whole part but a small notch; max edge (1, 0.7).
         assert!(s.occlusion > 0.9);
         let clipped = BoundingRect {
             top: 0.7,
             ..BoundingRect::FULL
         };
-        assert_eq!(s.occluded_rect(InnerAdjust::Always), clipped);
-        assert_eq!(s.occluded_rect(InnerAdjust::Checked), BoundingRect::FULL);
+        assert_eq!(s.occluded_rect::<Fp32>(InnerAdjust::Always), clipped);
+        assert_eq!(
+            s.occluded_rect::<Fp32>(InnerAdjust::Checked),
+            BoundingRect::FULL
+        );
     }
 
     #[test]
@@ -474,8 +559,8 @@ mod tests {
             centroid: [0.9, 0.9],
             ..part(0.04, rect)
         };
-        let (plain, _) = overlap_estimate(&f, &s, PLAIN);
-        let (centroid, _) = overlap_estimate(&f, &s, CENTROID);
+        let plain = overlap_estimate::<Fp32>(&f, &s, PLAIN).0.to_f64();
+        let centroid = overlap_estimate::<Fp32>(&f, &s, CENTROID).0.to_f64();
         assert!((plain - 0.0016).abs() < 1e-7);
         assert_eq!(centroid, 0.0);
         // Same place: the centroid model subtracts the whole smaller occlusion.
@@ -483,7 +568,7 @@ mod tests {
             centroid: [0.1, 0.1],
             ..s
         };
-        let (same, _) = overlap_estimate(&f, &s, CENTROID);
+        let same = overlap_estimate::<Fp32>(&f, &s, CENTROID).0.to_f64();
         assert!((same - 0.04).abs() < 1e-6, "{same}");
     }
 }

@@ -62,6 +62,30 @@
 //! light center, [`silhouette_loops`]) or `meshes` (all loops of one mesh in one silhouette
 //! vBuffer).
 //!
+//! **Shader precision** (`[options.gpu] shader`, [`crate::gpu::shader_float`]). Forest et al.
+//! ran ARB/NV fragment programs on a GeForce 7800 GTX (§5.1, §5.2), whose `float` is fp32.
+//! * The half-wedge program's region of each radial part — the polygon beyond the clipped
+//!   chord, its area, first moment and bounding box ([`RegionBeyondEdge::in_shader`](crate::light::radial_parts::RegionBeyondEdge::in_shader))
+//!   — runs in the chosen precision `T`.
+//! * The vBuffer arithmetic — the half-wedge updates ([`PartState::add_outer`],
+//!   [`PartState::add_inner`]: occlusion, centroid, maximum X and Y), the rectangles' areas
+//!   and the inner adjustment's check, ε and the blend ([`blend::blend_part`]) and the
+//!   resolve `1 − Σ/4` — runs in `T` capped at fp32
+//!   ([`ShaderFloat::AtMostFp32`]): it was
+//!   f32 arithmetic before shader precision existed (the vBuffers' values are f32), so the
+//!   default f64 keeps its bits and equals `fp32` there, while `fp24` and `fp16` round every
+//!   operation as everywhere else. Its operands are the stored values (f32 unpacked; the 8-bit
+//!   values PK4UB unpacks, exact) and its results are stored as f32 (exact: the scalar is at
+//!   most fp32), then packed; PK4UB's quantization is the instruction's and is exact.
+//! * Still f64: the shadow-volume pass and the wedges (CPU geometry, §4.1–§4.2); the
+//!   per-fragment tests before the program's arithmetic — the outside bounding planes in
+//!   viewport space (Fig. 7) and the side of the hard quad (its depth test is the
+//!   rasterizer's, its plane sign `ssv`'s [`quad_side`]) — and the edge's projection with the
+//!   local near plane and its clipping by saturation ([`edge_in_parts`]): the projection is
+//!   [`crate::light::coverage`]'s and is converted with the rest of that module; the clip's
+//!   validity test has an absolute tolerance (10⁻¹² of the coordinates) that needs a bound per
+//!   format before it can run narrower.
+//!
 //! Choices where the paper is silent:
 //! * **Order.** Meshes in scene order, within a mesh its loops in the order
 //!   [`silhouette_loops`] finds them (by their first edge in adjacency order); within a
@@ -122,10 +146,11 @@ use crate::gpu::pack4ub::{FloatTarget, StoreEvents};
 use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw};
 use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
 use crate::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
+use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::tiling::Tiling;
 use crate::gpu::transform::{ClipVertex, WindowPlane};
 use crate::light::coverage::{quad_side, RectLight};
-use crate::light::radial_parts::{edge_in_parts, PART_COUNT};
+use crate::light::radial_parts::{edge_in_parts, read, stored, PART_COUNT};
 use crate::options::{option_names, option_table, OptionTable, OptionType, Switch};
 use crate::plan::{BufferPlan, CountMode, MethodPlan};
 use crate::scene::LightShape;
@@ -595,25 +620,30 @@ struct PrimRole {
 /// every pass at its pixel ([`crate::gpu::probe`]; the blend steps: [`blend_steps`]).
 pub fn render(frame: &Frame, s: &Settings) -> Result<BlendingRender, InputError> {
     let silhouettes = silhouettes(frame, s)?;
-    Ok(match s.packing {
-        Packing::Bit8 => render_with(
-            frame,
-            s,
-            &silhouettes,
-            &Packed8 {
-                target: s.target,
-                centroid: s.centroid,
-            },
-        ),
-        Packing::F32 => render_with(
-            frame,
-            s,
-            &silhouettes,
-            &UnpackedF32 {
-                centroid: s.centroid,
-            },
-        ),
-    })
+    let packed = Packed8 {
+        target: s.target,
+        centroid: s.centroid,
+    };
+    let unpacked = UnpackedF32 {
+        centroid: s.centroid,
+    };
+    // The vBuffer programs' scalar: the shader precision, at most fp32 (module doc).
+    Ok(
+        crate::with_shader_float!(frame.gpu.shader, T => match s.packing {
+            Packing::Bit8 => render_with::<_, T>(
+                frame,
+                s,
+                &silhouettes,
+                &packed,
+            ),
+            Packing::F32 => render_with::<_, T>(
+                frame,
+                s,
+                &silhouettes,
+                &unpacked,
+            ),
+        }),
+    )
 }
 
 /// Visit the pixels of tile `t` inside the image: (tile-local index, row-major index).
@@ -648,7 +678,7 @@ fn on_dirty_tiles<P: Send>(
         })
 }
 
-fn render_with<S: VBufferStorage>(
+fn render_with<S: VBufferStorage, T: ShaderFloat>(
     frame: &Frame,
     s: &Settings,
     silhouettes: &[Silhouette],
@@ -928,7 +958,7 @@ fn render_with<S: VBufferStorage>(
                 }
                 cnt.fragments_shaded += 1;
                 tile.dirty = true;
-                let regions = edge_in_parts(&light, p, a, b);
+                let regions = edge_in_parts::<T>(&light, p, a, b);
                 if regions.iter().all(Option::is_none) {
                     tile.counters.missed_light += 1;
                     return record(&|e| seen(e).note("the edge reaches no part of the light"));
@@ -940,9 +970,9 @@ fn render_with<S: VBufferStorage>(
                     let Some(r) = region else { continue };
                     tile.counters.part_updates += 1;
                     if job.inner {
-                        part.add_inner(r);
+                        part.add_inner::<T::AtMostFp32>(r);
                     } else {
-                        part.add_outer(r);
+                        part.add_outer::<T::AtMostFp32>(r);
                     }
                 }
                 let (px, clamps) = storage.store(&parts, &mut tile.counters.stores);
@@ -997,7 +1027,7 @@ fn render_with<S: VBufferStorage>(
                 let mut fp = storage.load(&tile.last[i]);
                 let mut eps = [0.0; PART_COUNT];
                 for (k, (f, sp)) in fp.iter_mut().zip(&sp).enumerate() {
-                    let (out, o) = blend_part(f, sp, rules);
+                    let (out, o) = blend_part::<T::AtMostFp32>(f, sp, rules);
                     *f = out;
                     eps[k] = o.eps;
                     let k = &mut tile.counters;
@@ -1071,8 +1101,11 @@ fn render_with<S: VBufferStorage>(
             }
             resolve.color_read_bytes += fin_bytes;
             let parts = storage.load(&tile.last[i]);
-            let occluded = parts.iter().map(|p| p.occlusion).sum::<f32>() * 0.25;
-            unclamped[g] = 1.0 - occluded;
+            let sum = parts.iter().fold(T::AtMostFp32::zero(), |sum, p| {
+                sum + read::<T::AtMostFp32>(p.occlusion)
+            });
+            let quarter = T::AtMostFp32::from_f64(0.25);
+            unclamped[g] = stored(T::AtMostFp32::one() - sum * quarter);
         });
     }
     let visibility: Vec<f32> = unclamped.iter().map(|v| v.clamp(0.0, 1.0)).collect();
