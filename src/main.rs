@@ -106,7 +106,7 @@ enum ExperimentCmd {
     },
     /// Issue 11: error added by each shader precision and buffer format, overflow of each
     /// buffer format over stacks of N = 1…512 quads, the papers' precision claims checked
-    /// (default scenes cube-of-spheres and cube-of-spheres-sphere).
+    /// (default scenes cube-of-spheres, cube-of-spheres-sphere and disk-block).
     Precision {
         /// Scene files or built-in names.
         scenes: Vec<String>,

@@ -11,8 +11,8 @@
 //! 2. **Storage formats** at f64: each narrow buffer format against the widest format of the
 //!    same method ([`STORAGE`]: the 8-bit and f16 V-buffers of Paper III against f32, the 12-
 //!    and 8-bit LI buffers of Paper I against 16 bits, Paper IV's split V-buffer with fewer or
-//!    more carry bits against the paper's 5, wedge blending's packed 8-bit vBuffer against
-//!    f32), and the depth formats D16 and D32F against D24 for every rasterized method, with
+//!    more carry bits against the paper's 5, Paper IV's 16-bit float position buffer against
+//!    positions from depth, wedge blending's packed 8-bit vBuffer against f32), and the depth formats D16 and D32F against D24 for every rasterized method, with
 //!    the pixels whose visibility *flips* (|Δ| > ½).
 //! 3. **Overflow**: the stacked-quad family [`overlap_stack`] (N = 1…512 two-sided quads 0.002
 //!    apart; a point light for the stencil, a sphere for the LI buffers, a rectangle for the
@@ -59,8 +59,8 @@ use std::path::Path;
 /// Where the experiment writes by default.
 pub const DEFAULT_OUT: &str = "out/experiment/precision";
 /// The built-in scenes measured when none is given: a rectangle and a sphere light over the
-/// same occluders.
-pub const SCENES: [&str; 2] = ["cube-of-spheres", "cube-of-spheres-sphere"];
+/// same occluders, and a disk light (the only light `dbuffer` renders).
+pub const SCENES: [&str; 3] = ["cube-of-spheres", "cube-of-spheres-sphere", "disk-block"];
 /// Default image side of parts 1 and 2.
 pub const DEFAULT_SIZE: u32 = 128;
 /// Image side of the overflow renders.
@@ -109,62 +109,35 @@ pub struct StorageVariant {
     pub wide: &'static str,
 }
 
+impl StorageVariant {
+    /// `method`'s `key = narrow` measured against `key = wide`.
+    pub const fn of(
+        method: &'static str,
+        key: &'static str,
+        narrow: &'static str,
+        wide: &'static str,
+    ) -> Self {
+        StorageVariant {
+            method,
+            key,
+            narrow,
+            wide,
+        }
+    }
+}
+
 /// Part 2's buffer formats (module doc).
 pub const STORAGE: &[StorageVariant] = &[
-    StorageVariant {
-        method: "ssv",
-        key: "vbuffer",
-        narrow: "f16",
-        wide: "f32",
-    },
-    StorageVariant {
-        method: "ssv",
-        key: "vbuffer",
-        narrow: "8bit",
-        wide: "f32",
-    },
-    StorageVariant {
-        method: "pw2002",
-        key: "li",
-        narrow: "12",
-        wide: "16",
-    },
-    StorageVariant {
-        method: "pw2002",
-        key: "li",
-        narrow: "8",
-        wide: "16",
-    },
-    StorageVariant {
-        method: "pw-restructured",
-        key: "li",
-        narrow: "12",
-        wide: "16",
-    },
-    StorageVariant {
-        method: "pw-restructured",
-        key: "li",
-        narrow: "8",
-        wide: "16",
-    },
-    StorageVariant {
-        method: "ssv-optimized",
-        key: "reserved-bits",
-        narrow: "3",
-        wide: "5",
-    },
-    StorageVariant {
-        method: "ssv-optimized",
-        key: "reserved-bits",
-        narrow: "7",
-        wide: "5",
-    },
-    StorageVariant {
-        method: "wedge-blending",
-        key: "packing",
-        narrow: "8bit",
-        wide: "f32",
-    },
+    StorageVariant::of("ssv", "vbuffer", "f16", "f32"),
+    StorageVariant::of("ssv", "vbuffer", "8bit", "f32"),
+    StorageVariant::of("pw2002", "li", "12", "16"),
+    StorageVariant::of("pw2002", "li", "8", "16"),
+    StorageVariant::of("pw-restructured", "li", "12", "16"),
+    StorageVariant::of("pw-restructured", "li", "8", "16"),
+    StorageVariant::of("ssv-optimized", "reserved-bits", "3", "5"),
+    StorageVariant::of("ssv-optimized", "reserved-bits", "7", "5"),
+    StorageVariant::of("ssv-optimized", "position", "f16", "depth"),
+    StorageVariant::of("wedge-blending", "packing", "8bit", "f32"),
 ];
 
 /// The light of an overflow configuration's stack.
@@ -195,8 +168,6 @@ impl StackLight {
 /// A buffer format whose overflow the stack family measures.
 #[derive(Debug, Clone, Copy)]
 pub struct OverflowConfig {
-    /// Name in the tables and plot, e.g. `pw2002 li=16 wrap`.
-    pub label: &'static str,
     /// The method.
     pub method: &'static str,
     /// The stack's light.
@@ -205,107 +176,52 @@ pub struct OverflowConfig {
     pub knobs: &'static [(&'static str, &'static str)],
 }
 
+impl OverflowConfig {
+    /// `method` with `knobs` on the stack under `light`.
+    pub const fn of(
+        method: &'static str,
+        light: StackLight,
+        knobs: &'static [(&'static str, &'static str)],
+    ) -> Self {
+        OverflowConfig {
+            method,
+            light,
+            knobs,
+        }
+    }
+
+    /// The name in the tables and the plot: the method and its options, e.g.
+    /// `pw2002 li=16 overflow=wrap`.
+    pub fn label(&self) -> String {
+        let knobs: Vec<String> = self.knobs.iter().map(|(k, v)| format!("{k}={v}")).collect();
+        format!("{} {}", self.method, knobs.join(" "))
+    }
+}
+
 /// Part 3's formats (module doc): the 8-bit stencil wrapping and saturating (`hard-sv`; every
 /// stencil pass of the other methods is the same buffer), Paper I's LI buffers, Paper III's
 /// V-buffers, Paper IV's split V-buffer with 1…7 carry bits, wedge blending's packed vBuffer.
-pub const OVERFLOW_CONFIGS: &[OverflowConfig] = &[
-    OverflowConfig {
-        label: "hard-sv stencil wrap",
-        method: "hard-sv",
-        light: StackLight::Point,
-        knobs: &[("stencil", "wrap")],
-    },
-    OverflowConfig {
-        label: "hard-sv stencil saturate",
-        method: "hard-sv",
-        light: StackLight::Point,
-        knobs: &[("stencil", "saturate")],
-    },
-    OverflowConfig {
-        label: "pw2002 li=16 wrap",
-        method: "pw2002",
-        light: StackLight::Sphere,
-        knobs: &[("li", "16"), ("overflow", "wrap")],
-    },
-    OverflowConfig {
-        label: "pw2002 li=16 saturate",
-        method: "pw2002",
-        light: StackLight::Sphere,
-        knobs: &[("li", "16"), ("overflow", "saturate")],
-    },
-    OverflowConfig {
-        label: "pw2002 li=12 wrap",
-        method: "pw2002",
-        light: StackLight::Sphere,
-        knobs: &[("li", "12"), ("overflow", "wrap")],
-    },
-    OverflowConfig {
-        label: "pw2002 li=12 saturate",
-        method: "pw2002",
-        light: StackLight::Sphere,
-        knobs: &[("li", "12"), ("overflow", "saturate")],
-    },
-    OverflowConfig {
-        label: "pw2002 li=8 wrap",
-        method: "pw2002",
-        light: StackLight::Sphere,
-        knobs: &[("li", "8"), ("overflow", "wrap")],
-    },
-    OverflowConfig {
-        label: "pw2002 li=8 saturate",
-        method: "pw2002",
-        light: StackLight::Sphere,
-        knobs: &[("li", "8"), ("overflow", "saturate")],
-    },
-    OverflowConfig {
-        label: "ssv vbuffer=f32",
-        method: "ssv",
-        light: StackLight::Rect,
-        knobs: &[("vbuffer", "f32")],
-    },
-    OverflowConfig {
-        label: "ssv vbuffer=f16",
-        method: "ssv",
-        light: StackLight::Rect,
-        knobs: &[("vbuffer", "f16")],
-    },
-    OverflowConfig {
-        label: "ssv vbuffer=8bit",
-        method: "ssv",
-        light: StackLight::Rect,
-        knobs: &[("vbuffer", "8bit")],
-    },
-    OverflowConfig {
-        label: "ssv-optimized reserved-bits=1",
-        method: "ssv-optimized",
-        light: StackLight::Rect,
-        knobs: &[("reserved-bits", "1")],
-    },
-    OverflowConfig {
-        label: "ssv-optimized reserved-bits=3",
-        method: "ssv-optimized",
-        light: StackLight::Rect,
-        knobs: &[("reserved-bits", "3")],
-    },
-    OverflowConfig {
-        label: "ssv-optimized reserved-bits=5",
-        method: "ssv-optimized",
-        light: StackLight::Rect,
-        knobs: &[("reserved-bits", "5")],
-    },
-    OverflowConfig {
-        label: "ssv-optimized reserved-bits=7",
-        method: "ssv-optimized",
-        light: StackLight::Rect,
-        knobs: &[("reserved-bits", "7")],
-    },
-    OverflowConfig {
-        label: "wedge-blending packing=8bit",
-        method: "wedge-blending",
-        light: StackLight::Rect,
-        knobs: &[("packing", "8bit")],
-    },
-];
+pub const OVERFLOW_CONFIGS: &[OverflowConfig] = {
+    use StackLight::*;
+    &[
+        OverflowConfig::of("hard-sv", Point, &[("stencil", "wrap")]),
+        OverflowConfig::of("hard-sv", Point, &[("stencil", "saturate")]),
+        OverflowConfig::of("pw2002", Sphere, &[("li", "16"), ("overflow", "wrap")]),
+        OverflowConfig::of("pw2002", Sphere, &[("li", "16"), ("overflow", "saturate")]),
+        OverflowConfig::of("pw2002", Sphere, &[("li", "12"), ("overflow", "wrap")]),
+        OverflowConfig::of("pw2002", Sphere, &[("li", "12"), ("overflow", "saturate")]),
+        OverflowConfig::of("pw2002", Sphere, &[("li", "8"), ("overflow", "wrap")]),
+        OverflowConfig::of("pw2002", Sphere, &[("li", "8"), ("overflow", "saturate")]),
+        OverflowConfig::of("ssv", Rect, &[("vbuffer", "f32")]),
+        OverflowConfig::of("ssv", Rect, &[("vbuffer", "f16")]),
+        OverflowConfig::of("ssv", Rect, &[("vbuffer", "8bit")]),
+        OverflowConfig::of("ssv-optimized", Rect, &[("reserved-bits", "1")]),
+        OverflowConfig::of("ssv-optimized", Rect, &[("reserved-bits", "3")]),
+        OverflowConfig::of("ssv-optimized", Rect, &[("reserved-bits", "5")]),
+        OverflowConfig::of("ssv-optimized", Rect, &[("reserved-bits", "7")]),
+        OverflowConfig::of("wedge-blending", Rect, &[("packing", "8bit")]),
+    ]
+};
 
 /// The stack sizes N of part 3: every N up to 8, then around each format's limit (Paper III's
 /// 8-bit V-buffer, Paper IV's carry bits, Paper I's LI buffers, the 8-bit stencil).
@@ -561,7 +477,7 @@ pub fn overflow_rows(
                     }
                 }
                 rows.push(OverflowRow {
-                    config: c.label.to_string(),
+                    config: c.label(),
                     n,
                     overflow_pixels: events.iter().filter(|e| **e).count() as u64,
                     corrupted_pixels: (0..v.len()).filter(|&i| events[i] && off(i)).count() as u64,
@@ -572,6 +488,17 @@ pub fn overflow_rows(
         }
     }
     Ok(rows)
+}
+
+/// The configurations of `rows`, in order of first appearance.
+fn config_labels(rows: &[OverflowRow]) -> Vec<&str> {
+    let mut labels: Vec<&str> = Vec::new();
+    for r in rows {
+        if !labels.contains(&r.config.as_str()) {
+            labels.push(&r.config);
+        }
+    }
+    labels
 }
 
 /// The first measured N at which `config` corrupted a pixel, if any.
@@ -618,14 +545,17 @@ pub fn claims(s: &Study) -> Vec<String> {
         None => "overflow events from the first N".to_string(),
     };
     let mut out = Vec::new();
-    let li16 = first_corrupted(&s.overflow, "pw2002 li=16 wrap");
-    if s.overflow.iter().any(|r| r.config == "pw2002 li=16 wrap") {
+    let li16 = first_corrupted(&s.overflow, "pw2002 li=16 overflow=wrap");
+    if s.overflow
+        .iter()
+        .any(|r| r.config == "pw2002 li=16 overflow=wrap")
+    {
         out.push(format!(
             "Paper I §6: the signed 16-bit LI buffer \"guarantees\" at least 127 overlapping \
              umbra volumes — measured (wrap): {}; {}. The arithmetic: 255 − 255·N leaves \
              [−32768, 32767] at N = 130. {}",
-            first("pw2002 li=16 wrap"),
-            clean("pw2002 li=16 wrap"),
+            first("pw2002 li=16 overflow=wrap"),
+            clean("pw2002 li=16 overflow=wrap"),
             if li16.is_none_or(|n| n > 127) {
                 "Reproduced."
             } else {
@@ -672,6 +602,22 @@ pub fn claims(s: &Study) -> Vec<String> {
              stack: {}. (The buffer arithmetic alone: 36 full contributions fit with 5 carry \
              bits, `tests/optimized_ssv.rs`.)",
             per_bits.join("; ")
+        ));
+    }
+    let position = storage_row(s, "ssv-optimized", "position=f16");
+    if !position.is_empty() {
+        let scenes: Vec<String> = position
+            .iter()
+            .map(|r| {
+                format!(
+                    "{}: mean |Δ| {:.2e}, max {:.3}, {:.2} % of pixels > 1/255",
+                    r.scene, r.all.mean_abs, r.all.max_abs, r.all.pct_over_1_255
+                )
+            })
+            .collect();
+        out.push(format!(
+            "Paper IV §4.2: each pixel's world position in a 16-bit-per-channel float texture              (the paper's choice) against the position reconstructed from depth: {}.",
+            scenes.join("; ")
         ));
     }
     let f16 = storage_row(s, "ssv", "vbuffer=f16");
@@ -826,13 +772,7 @@ pub fn summary(s: &Study) -> String {
     out += "\n## Overflow: first corrupted N per format\n\n\
             | format | last N without overflow events | first N with a corrupted pixel | corrupted pixels at the largest N | largest error without events |\n\
             |---|---|---|---|---|\n";
-    let mut labels: Vec<&str> = Vec::new();
-    for r in &s.overflow {
-        if !labels.contains(&r.config.as_str()) {
-            labels.push(&r.config);
-        }
-    }
-    for c in labels {
+    for c in config_labels(&s.overflow) {
         let mine: Vec<&OverflowRow> = s.overflow.iter().filter(|r| r.config == c).collect();
         let last = mine.iter().max_by_key(|r| r.n);
         let worst = mine.iter().map(|r| r.worst_clean).fold(0.0, f64::max);
@@ -979,13 +919,10 @@ impl Plot for OverflowPlot<'_> {
             .axis_desc_style(("sans-serif", 14))
             .draw()
             .map_err(err)?;
-        let mut labels: Vec<&str> = Vec::new();
-        for r in self.0 {
-            if !labels.contains(&r.config.as_str()) && first_corrupted(self.0, &r.config).is_some()
-            {
-                labels.push(&r.config);
-            }
-        }
+        let labels: Vec<&str> = config_labels(self.0)
+            .into_iter()
+            .filter(|c| first_corrupted(self.0, c).is_some())
+            .collect();
         for (i, c) in labels.iter().enumerate() {
             let colour = PALETTE[i % PALETTE.len()];
             let points: Vec<(f64, f64)> = self
@@ -1062,20 +999,23 @@ mod tests {
         let configs = &OVERFLOW_CONFIGS[..2];
         let rows = overflow_rows(configs, &[1, 255, 256], STACK_IMAGE).unwrap();
         let get = |c: &str, n: u32| rows.iter().find(|r| r.config == c && r.n == n).unwrap();
-        for c in ["hard-sv stencil wrap", "hard-sv stencil saturate"] {
+        for c in ["hard-sv stencil=wrap", "hard-sv stencil=saturate"] {
             assert_eq!(get(c, 1).overflow_pixels, 0, "{c}");
             assert_eq!(get(c, 255).overflow_pixels, 0, "{c}");
             assert!(get(c, 256).overflow_pixels > 0, "{c}");
         }
-        assert_eq!(first_corrupted(&rows, "hard-sv stencil wrap"), Some(256));
-        assert_eq!(first_corrupted(&rows, "hard-sv stencil saturate"), None);
+        assert_eq!(first_corrupted(&rows, "hard-sv stencil=wrap"), Some(256));
+        assert_eq!(first_corrupted(&rows, "hard-sv stencil=saturate"), None);
         // Without overflow the hard shadow of the stack agrees with the point-light reference
         // but for edge pixels: below ½ everywhere else.
         assert!(rows.iter().all(|r| r.corrupted_pixels <= r.off_pixels));
     }
 
     fn config(label: &str) -> OverflowConfig {
-        *OVERFLOW_CONFIGS.iter().find(|c| c.label == label).unwrap()
+        *OVERFLOW_CONFIGS
+            .iter()
+            .find(|c| c.label() == label)
+            .unwrap()
     }
 
     /// Paper I §6's claim, from the LI arithmetic: ±255 per umbra in a signed 16-bit buffer
@@ -1083,7 +1023,12 @@ mod tests {
     /// 127). The experiment must find exactly that: no event at 129, corrupted pixels at 130.
     #[test]
     fn li16_wraps_first_at_130_stacked_umbrae() {
-        let rows = overflow_rows(&[config("pw2002 li=16 wrap")], &[129, 130], STACK_IMAGE).unwrap();
+        let rows = overflow_rows(
+            &[config("pw2002 li=16 overflow=wrap")],
+            &[129, 130],
+            STACK_IMAGE,
+        )
+        .unwrap();
         assert_eq!(rows[0].overflow_pixels, 0);
         assert_eq!(rows[0].corrupted_pixels, 0);
         assert!(rows[1].corrupted_pixels > 0);

@@ -59,6 +59,11 @@ impl<T: ShaderFloat> SVec2<T> {
         DVec2::new(self.x.to_f64(), self.y.to_f64())
     }
 
+    /// `x·o.x + y·o.y`, each operation rounded.
+    pub fn dot(self, o: Self) -> T {
+        self.x * o.x + self.y * o.y
+    }
+
     /// `x·y′ − y·x′`.
     pub fn perp_dot(self, o: Self) -> T {
         self.x * o.y - self.y * o.x

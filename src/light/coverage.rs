@@ -552,10 +552,23 @@ pub fn shader_clip_to_light_cone<T: ShaderFloat>(
         }
     }
     let (s0, s1) = span?;
+    // A point of the chord lies in the unit disk: it is inside the cone. Where the edge passes
+    // next to the cone's apex `p` its projection divides by a height at the rounding of the
+    // coordinates (found by fuzzing: a receiver 10⁻⁶ from the line of an edge that ends next
+    // to it gave a chord point 1.063 from the center), so a point outside is moved onto the
+    // rim along its ray: only rounding is removed, and the sector and triangle stay those of
+    // points of the disk. The coverage there is ill-posed anyway: `p` is then on the quad's
+    // plane.
     let project = |s: T| {
         let q = o + d * s;
         let zq = one + q.z;
-        SVec2::new(q.x / zq, q.y / zq)
+        let r = SVec2::new(q.x / zq, q.y / zq);
+        let r2 = r.dot(r);
+        if r2 > one {
+            r / r2.sqrt()
+        } else {
+            r
+        }
     };
     // The chord keeps the edge's direction.
     let (a, b) = (project(s0), project(s1));
@@ -845,6 +858,25 @@ mod tests {
             let [q0, q1] = projected_edge_in_light(&l, p, a, b).expect("the edge projects");
             for q in [q0, q1] {
                 assert!(q.abs().max_element() <= 1.0, "{q}");
+            }
+        }
+    }
+
+    /// A receiver 10⁻⁶ from the line of an edge that ends 0.0014 from it, under a sphere of
+    /// radius 13.3 (found by fuzzing,
+    /// `fuzz/regressions/coverage/sphere-receiver-1e-6-from-edge-line-end-next-to-it-chord-1.063.bin`):
+    /// a chord end next to the cone's apex came out 1.063 from the disk's center. Every chord
+    /// point lies in the unit disk.
+    #[test]
+    fn chord_next_to_the_apex_stays_in_the_disk() {
+        let c = DVec3::new(11.0, 0.0, 13.3017578125);
+        let p = DVec3::new(0.0, 0.0, 0.0009765625);
+        let e0 = DVec3::new(13.3017578125, 6.3427723944187164e-6, 13.3017578125);
+        let e1 = DVec3::new(-0.0009765625, 0.0, 6.750632906005194e-7);
+        for (a, b) in [(e0, e1), (e1, e0)] {
+            let [q0, q1] = clip_to_light_cone(c, 13.3017578125, p, a, b).expect("a chord");
+            for q in [q0, q1] {
+                assert!(q.length() <= 1.0, "{q}");
             }
         }
     }
