@@ -10,7 +10,14 @@
 //! * `method/raycast-samples16`: the `raycast` reference with `samples = 16` on that frame;
 //! * `method/ssv`, `method/wedge-blending-8bit`, `method/wedge-blending-f32`: the soft shadow
 //!   volumes of Paper III and penumbra-wedges blending (Forest et al. 2006, packed and
-//!   unpacked) side by side on that frame.
+//!   unpacked) side by side on that frame;
+//! * `method/hard-sv`, `method/ssv-optimized`: the remaining methods that take the rectangular
+//!   light, on that frame, so that every method of [`penumbra::methods::ALL`] is timed;
+//! * `method/pw2002`, `method/pw-restructured`, `method/penumbra-map`: the methods that take
+//!   only spherical lights, on `cube-of-spheres-sphere` (the same occluders under a sphere
+//!   light) at 256×256;
+//! * `method/dbuffer`: the D-buffer (CGI 2004), which takes only disk lights, on `disk-block`
+//!   at 256×256.
 //!
 //! The method benchmarks run [`penumbra::methods::run`] on a prebuilt frame, so they exclude
 //! the depth pass (measured on its own) and the shading of the image.
@@ -33,11 +40,29 @@ const SCENE: &str = "cube-of-spheres";
 /// Image width and height in pixels.
 const SIZE: u32 = 256;
 
-/// `cube-of-spheres` at [`SIZE`]×[`SIZE`] with `nsample.n = 16` and `raycast.samples = 16`.
-fn scene() -> Scene {
-    let mut scene = builtin::load(SCENE).expect("built-in scene cube-of-spheres");
+/// The methods timed on [`SCENE`] besides those with options of their own (`nsample`,
+/// `raycast`, `wedge-blending`), which take the rectangular light.
+const RECT_METHODS: &[&str] = &["hard-sv", "ssv-optimized", "ssv"];
+/// The methods that take only spherical lights, timed on [`SPHERE_SCENE`].
+const SPHERE_METHODS: &[&str] = &["pw2002", "pw-restructured", "penumbra-map"];
+/// [`SCENE`]'s occluders under a sphere light.
+const SPHERE_SCENE: &str = "cube-of-spheres-sphere";
+/// The methods that take only disk lights, timed on [`DISK_SCENE`].
+const DISK_METHODS: &[&str] = &["dbuffer"];
+/// The built-in scene of the D-buffer paper's Fig. 1/7.
+const DISK_SCENE: &str = "disk-block";
+
+/// The built-in scene `name` at [`SIZE`]×[`SIZE`].
+fn sized(name: &str) -> Scene {
+    let mut scene = builtin::load(name).expect("built-in scene");
     scene.width = SIZE;
     scene.height = SIZE;
+    scene
+}
+
+/// `cube-of-spheres` at [`SIZE`]×[`SIZE`] with `nsample.n = 16` and `raycast.samples = 16`.
+fn scene() -> Scene {
+    let mut scene = sized(SCENE);
     set_option(&mut scene, "nsample", "n", 16);
     set_option(&mut scene, "raycast", "samples", 16);
     scene
@@ -88,12 +113,20 @@ fn pipeline(c: &mut Criterion) {
     let mut group = c.benchmark_group("method");
     group.sampling_mode(SamplingMode::Flat);
     group.measurement_time(Duration::from_secs(5));
-    for (name, method) in [
+    let named = [
         ("nsample-n16", "nsample"),
         ("raycast-samples16", "raycast"),
-        ("ssv", "ssv"),
         ("wedge-blending-8bit", "wedge-blending"),
-    ] {
+    ];
+    for method in penumbra::methods::ALL {
+        let timed = named.iter().any(|(_, m)| m == method)
+            || [RECT_METHODS, SPHERE_METHODS, DISK_METHODS]
+                .iter()
+                .any(|list| list.contains(method));
+        assert!(timed, "method {method} has no benchmark");
+    }
+    let plain = RECT_METHODS.iter().map(|m| (*m, *m));
+    for (name, method) in named.into_iter().chain(plain) {
         group.bench_function(name, |b| {
             b.iter(|| penumbra::methods::run(black_box(method), black_box(&frame)).expect(method))
         });
@@ -111,6 +144,17 @@ fn pipeline(c: &mut Criterion) {
                 .expect("wedge-blending")
         })
     });
+    for (scene_name, methods) in [(SPHERE_SCENE, SPHERE_METHODS), (DISK_SCENE, DISK_METHODS)] {
+        let scene = sized(scene_name);
+        let frame = Frame::render(&scene, GpuSettings::default()).expect("scene pass");
+        for method in methods {
+            group.bench_function(*method, |b| {
+                b.iter(|| {
+                    penumbra::methods::run(black_box(method), black_box(&frame)).expect(method)
+                })
+            });
+        }
+    }
     group.finish();
 }
 
