@@ -616,7 +616,8 @@ pub fn claims(s: &Study) -> Vec<String> {
             })
             .collect();
         out.push(format!(
-            "Paper IV §4.2: each pixel's world position in a 16-bit-per-channel float texture              (the paper's choice) against the position reconstructed from depth: {}.",
+            "Paper IV §4.2: each pixel's world position in a 16-bit-per-channel float texture \
+             (the paper's choice) against the position reconstructed from depth: {}.",
             scenes.join("; ")
         ));
     }
