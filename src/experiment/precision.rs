@@ -67,33 +67,31 @@ pub const DEFAULT_SIZE: u32 = 128;
 pub const STACK_IMAGE: u32 = 40;
 /// Light samples of the overflow study's reference.
 pub const STACK_REFERENCE_SAMPLES: &str = "256";
+/// The methods with no fragment arithmetic the shader precision rounds: the reference and
+/// the hard-shadow stencil methods. Every other method is measured in part 1.
+pub const NO_SHADER_ARITHMETIC: [&str; 3] = ["raycast", "nsample", "hard-sv"];
+
 /// The soft methods, whose fragment programs the shader precision rounds.
-pub const SHADER_METHODS: [&str; 7] = [
-    "pw2002",
-    "pw-restructured",
-    "ssv",
-    "ssv-optimized",
-    "wedge-blending",
-    "penumbra-map",
-    "dbuffer",
-];
+pub fn shader_methods() -> impl Iterator<Item = &'static str> {
+    crate::methods::ALL
+        .iter()
+        .copied()
+        .filter(|m| !NO_SHADER_ARITHMETIC.contains(m))
+}
+
+/// The rasterized methods whose depth formats are compared (every method but the ray tracer).
+pub fn depth_methods() -> impl Iterator<Item = &'static str> {
+    crate::methods::ALL
+        .iter()
+        .copied()
+        .filter(|m| *m != crate::methods::REFERENCE)
+}
+
 /// The narrow shader precisions, each measured against f64.
 pub const NARROW_PRECISIONS: [ShaderPrecision; 3] = [
     ShaderPrecision::Fp32,
     ShaderPrecision::Fp24,
     ShaderPrecision::Fp16,
-];
-/// The rasterized methods whose depth formats are compared (every method but the ray tracer).
-pub const DEPTH_METHODS: [&str; 9] = [
-    "nsample",
-    "hard-sv",
-    "pw2002",
-    "pw-restructured",
-    "ssv",
-    "ssv-optimized",
-    "wedge-blending",
-    "penumbra-map",
-    "dbuffer",
 ];
 
 /// A narrow buffer format of a method and the wider one it is measured against.
@@ -348,7 +346,7 @@ pub fn shader_rows(scene: &Scene) -> Result<(Vec<ShaderRow>, ErrorMaps), InputEr
     let base = crate::render::gpu_settings(scene)?;
     let mut rows = Vec::new();
     let mut maps = Vec::new();
-    for method in SHADER_METHODS {
+    for method in shader_methods() {
         if !crate::methods::supports_scene(method, scene) {
             continue;
         }
@@ -403,7 +401,7 @@ pub fn storage_rows(scene: &Scene) -> Result<Vec<StorageRow>, InputError> {
             &wide.visibility,
         );
     }
-    for method in DEPTH_METHODS {
+    for method in depth_methods() {
         if !crate::methods::supports_scene(method, scene) {
             continue;
         }
@@ -530,6 +528,20 @@ fn storage_row<'a>(s: &'a Study, method: &str, setting: &str) -> Vec<&'a Storage
         .collect()
 }
 
+/// `rows`' errors, one clause per scene: mean and max |Δ| and the pixels visibly off.
+fn per_scene(rows: &[&StorageRow]) -> String {
+    let clauses: Vec<String> = rows
+        .iter()
+        .map(|r| {
+            format!(
+                "{}: mean |Δ| {:.2e}, max {:.3}, {:.2} % of pixels > 1/255",
+                r.scene, r.all.mean_abs, r.all.max_abs, r.all.pct_over_1_255
+            )
+        })
+        .collect();
+    clauses.join("; ")
+}
+
 /// The papers' precision claims checked on `s`, one line each: what the paper says, what was
 /// measured, and whether it reproduced.
 pub fn claims(s: &Study) -> Vec<String> {
@@ -564,25 +576,16 @@ pub fn claims(s: &Study) -> Vec<String> {
         ));
     }
     if s.overflow.iter().any(|r| r.config == "ssv vbuffer=8bit") {
-        let rows = storage_row(s, "ssv", "vbuffer=8bit");
-        let scenes: Vec<String> = rows
-            .iter()
-            .map(|r| {
-                format!(
-                    "{}: max |Δ| {:.4}, {:.2} % of pixels > 1/255 vs f32",
-                    r.scene, r.all.max_abs, r.all.pct_over_1_255
-                )
-            })
-            .collect();
+        let scenes = per_scene(&storage_row(s, "ssv", "vbuffer=8bit"));
         out.push(format!(
             "Paper III §4.2: an 8-bit V-buffer with 6 value bits and 2 overflow bits suffices \
-             for its scenes — on the stack: {} ({}); on the scenes: {}.",
+             for its scenes — on the stack: {} ({}); on the scenes against f32: {}.",
             first("ssv vbuffer=8bit"),
             clean("ssv vbuffer=8bit"),
             if scenes.is_empty() {
                 "not measured".to_string()
             } else {
-                scenes.join("; ")
+                scenes
             }
         ));
     }
@@ -606,37 +609,19 @@ pub fn claims(s: &Study) -> Vec<String> {
     }
     let position = storage_row(s, "ssv-optimized", "position=f16");
     if !position.is_empty() {
-        let scenes: Vec<String> = position
-            .iter()
-            .map(|r| {
-                format!(
-                    "{}: mean |Δ| {:.2e}, max {:.3}, {:.2} % of pixels > 1/255",
-                    r.scene, r.all.mean_abs, r.all.max_abs, r.all.pct_over_1_255
-                )
-            })
-            .collect();
         out.push(format!(
             "Paper IV §4.2: each pixel's world position in a 16-bit-per-channel float texture \
              (the paper's choice) against the position reconstructed from depth: {}.",
-            scenes.join("; ")
+            per_scene(&position)
         ));
     }
     let f16 = storage_row(s, "ssv", "vbuffer=f16");
     if !f16.is_empty() {
-        let scenes: Vec<String> = f16
-            .iter()
-            .map(|r| {
-                format!(
-                    "{}: max |Δ| {:.2e}, mean {:.2e}, {:.2} % of pixels > 1/255",
-                    r.scene, r.all.max_abs, r.all.mean_abs, r.all.pct_over_1_255
-                )
-            })
-            .collect();
         let ok = f16.iter().all(|r| r.all.pct_over_1_255 < 0.1);
         out.push(format!(
             "Paper III §4.2: a 16-bit float V-buffer \"would suffice for most scenes\" — against \
              f32: {}. {}",
-            scenes.join("; "),
+            per_scene(&f16),
             if ok {
                 "Reproduced (under 0.1 % of pixels visibly off)."
             } else {
@@ -668,65 +653,78 @@ pub fn study(scenes: &[Scene], size: u32) -> Result<(Study, ErrorMaps), InputErr
     Ok((s, maps))
 }
 
-/// `shader.csv`.
-pub fn shader_csv(rows: &[ShaderRow]) -> String {
-    let mut out = String::from(
-        "scene,method,precision,mean_abs,max_abs,rmse,pct_over_1_255,pct_changed,\
-         penumbra_mean_abs,penumbra_max_abs,penumbra_pixels\n",
-    );
+/// A CSV file: `header`, then one line per row.
+fn csv_file<R>(header: &str, rows: &[R], line: impl Fn(&R) -> String) -> String {
+    let mut out = format!("{header}\n");
     for r in rows {
-        let _ = writeln!(
-            out,
-            "{},{},{},{:e},{:e},{:e},{},{},{:e},{:e},{}",
-            r.scene,
-            r.method,
-            r.precision,
-            r.all.mean_abs,
-            r.all.max_abs,
-            r.all.rmse,
-            r.all.pct_over_1_255,
-            r.pct_changed,
-            r.penumbra.mean_abs,
-            r.penumbra.max_abs,
-            r.penumbra.pixels
-        );
+        out += &line(r);
+        out.push('\n');
     }
     out
+}
+
+/// `shader.csv`.
+pub fn shader_csv(rows: &[ShaderRow]) -> String {
+    csv_file(
+        "scene,method,precision,mean_abs,max_abs,rmse,pct_over_1_255,pct_changed,\
+         penumbra_mean_abs,penumbra_max_abs,penumbra_pixels",
+        rows,
+        |r| {
+            format!(
+                "{},{},{},{:e},{:e},{:e},{},{},{:e},{:e},{}",
+                r.scene,
+                r.method,
+                r.precision,
+                r.all.mean_abs,
+                r.all.max_abs,
+                r.all.rmse,
+                r.all.pct_over_1_255,
+                r.pct_changed,
+                r.penumbra.mean_abs,
+                r.penumbra.max_abs,
+                r.penumbra.pixels
+            )
+        },
+    )
 }
 
 /// `storage.csv`.
 pub fn storage_csv(rows: &[StorageRow]) -> String {
-    let mut out =
-        String::from("scene,method,setting,against,mean_abs,max_abs,pct_over_1_255,flipped\n");
-    for r in rows {
-        let _ = writeln!(
-            out,
-            "{},{},{},{},{:e},{:e},{},{}",
-            r.scene,
-            r.method,
-            r.setting,
-            r.against,
-            r.all.mean_abs,
-            r.all.max_abs,
-            r.all.pct_over_1_255,
-            r.flipped
-        );
+    csv_file(
+        "scene,method,setting,against,mean_abs,max_abs,pct_over_1_255,flipped",
+        rows,
+        |r| r.cells().join(","),
+    )
+}
+
+impl StorageRow {
+    /// The row's values as the CSV file and the summary's table show them.
+    fn cells(&self) -> [String; 8] {
+        [
+            self.scene.clone(),
+            self.method.clone(),
+            self.setting.clone(),
+            self.against.clone(),
+            format!("{:.3e}", self.all.mean_abs),
+            format!("{:.3e}", self.all.max_abs),
+            format!("{:.3}", self.all.pct_over_1_255),
+            self.flipped.to_string(),
+        ]
     }
-    out
 }
 
 /// `overflow.csv`.
 pub fn overflow_csv(rows: &[OverflowRow]) -> String {
-    let mut out =
-        String::from("config,n,overflow_pixels,corrupted_pixels,off_pixels,worst_clean\n");
-    for r in rows {
-        let _ = writeln!(
-            out,
-            "{},{},{},{},{},{}",
-            r.config, r.n, r.overflow_pixels, r.corrupted_pixels, r.off_pixels, r.worst_clean
-        );
-    }
-    out
+    csv_file(
+        "config,n,overflow_pixels,corrupted_pixels,off_pixels,worst_clean",
+        rows,
+        |r| {
+            format!(
+                "{},{},{},{},{},{}",
+                r.config, r.n, r.overflow_pixels, r.corrupted_pixels, r.off_pixels, r.worst_clean
+            )
+        },
+    )
 }
 
 /// `summary.md`: the three tables and the claims.
@@ -757,18 +755,7 @@ pub fn summary(s: &Study) -> String {
             | scene | method | setting | against | mean \\|Δ\\| | max \\|Δ\\| | % > 1/255 | flipped |\n\
             |---|---|---|---|---|---|---|---|\n";
     for r in &s.storage {
-        let _ = writeln!(
-            out,
-            "| {} | {} | {} | {} | {:.2e} | {:.2e} | {:.3} | {} |",
-            r.scene,
-            r.method,
-            r.setting,
-            r.against,
-            r.all.mean_abs,
-            r.all.max_abs,
-            r.all.pct_over_1_255,
-            r.flipped
-        );
+        let _ = writeln!(out, "| {} |", r.cells().join(" | "));
     }
     out += "\n## Overflow: first corrupted N per format\n\n\
             | format | last N without overflow events | first N with a corrupted pixel | corrupted pixels at the largest N | largest error without events |\n\
@@ -840,8 +827,8 @@ impl Plot for ShaderPlot<'_> {
             v
         };
         for (i, (scene, method)) in series.iter().enumerate() {
-            let colour = PALETTE
-                [SHADER_METHODS.iter().position(|m| m == method).unwrap_or(i) % PALETTE.len()];
+            let colour =
+                PALETTE[shader_methods().position(|m| m == method).unwrap_or(i) % PALETTE.len()];
             let mut points: Vec<(f64, f64)> = self
                 .0
                 .iter()
