@@ -65,3 +65,35 @@ pub fn png_and_svg(
     }
     Ok((png, svg))
 }
+
+/// The chart every experiment plot starts from: a white `root` with `caption` on top, the
+/// common margin and an x label area of 44 pixels, `y_label_area` pixels for the y labels.
+pub fn chart_on<'a, 'b, DB: DrawingBackend>(
+    root: &'a DrawingArea<DB, Shift>,
+    caption: &str,
+    y_label_area: u32,
+) -> Result<ChartBuilder<'a, 'b, DB>, String> {
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let mut chart = ChartBuilder::on(root);
+    chart
+        .caption(caption, ("sans-serif", 20))
+        .margin(14)
+        .x_label_area_size(44)
+        .y_label_area_size(y_label_area);
+    Ok(chart)
+}
+
+/// Draws `chart`'s legend at `position` in the style of every experiment plot.
+pub fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 11))
+        .draw()
+        .map_err(|e| e.to_string())
+}

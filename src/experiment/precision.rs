@@ -37,7 +37,7 @@
 //! `overflow.{png,svg}` (corrupted pixels against N), and `maps/SCENE-METHOD-PRECISION.png`.
 //! The report embeds the plots when it finds them ([`crate::report`]).
 
-use super::plotting::{png_and_svg, Plot, PALETTE};
+use super::plotting::{chart_on, draw_legend, png_and_svg, Plot, PALETTE};
 use super::{configured, sized};
 use crate::error::InputError;
 use crate::frame::{Frame, GpuSettings};
@@ -806,15 +806,8 @@ impl Plot for ShaderPlot<'_> {
             .map(|r| r.all.mean_abs)
             .fold(PLOT_FLOOR * 10.0, f64::max)
             * 3.0;
-        root.fill(&WHITE).map_err(err)?;
-        let mut chart = ChartBuilder::on(root)
-            .caption(
-                "mean |visibility − f64| per shader precision",
-                ("sans-serif", 20),
-            )
-            .margin(14)
-            .x_label_area_size(44)
-            .y_label_area_size(70)
+        let mut chart = chart_on(root, "mean |visibility − f64| per shader precision", 70)?;
+        let mut chart = chart
             .build_cartesian_2d(8.0f64..25.0, (PLOT_FLOOR..y_hi).log_scale())
             .map_err(err)?;
         chart
@@ -873,13 +866,7 @@ impl Plot for ShaderPlot<'_> {
                     });
             }
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 11))
-            .draw()
-            .map_err(err)?;
+        draw_legend(&mut chart, SeriesLabelPosition::MiddleRight)?;
         root.present().map_err(err)
     }
 }
@@ -899,15 +886,12 @@ impl Plot for OverflowPlot<'_> {
             .max(1) as f64
             * 1.1;
         let x_hi = self.0.iter().map(|r| r.n).max().unwrap_or(2).max(2) as f64 * 1.2;
-        root.fill(&WHITE).map_err(err)?;
-        let mut chart = ChartBuilder::on(root)
-            .caption(
-                "corrupted pixels (overflow event and |error| > ½) per stack size",
-                ("sans-serif", 20),
-            )
-            .margin(14)
-            .x_label_area_size(44)
-            .y_label_area_size(60)
+        let mut chart = chart_on(
+            root,
+            "corrupted pixels (overflow event and |error| > ½) per stack size",
+            60,
+        )?;
+        let mut chart = chart
             .build_cartesian_2d((1.0f64..x_hi).log_scale(), 0.0f64..y_hi)
             .map_err(err)?;
         chart
@@ -938,14 +922,7 @@ impl Plot for OverflowPlot<'_> {
                 .label(*c)
                 .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], style));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 11))
-            .draw()
-            .map_err(err)?;
+        draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
         root.present().map_err(err)
     }
 }
