@@ -689,8 +689,11 @@ fn square_fraction<T: ShaderFloat>(clipped: &[SVec2<T>]) -> T {
     (shader_polygon_area(clipped) / T::from_f64(4.0)).min(T::one())
 }
 
-/// Clip a homogeneous polygon `(S, T, W)` to the light square and dehomogenise it (vertices
-/// with `W = 0` left by the clip are the zero vector and are dropped).
+/// Clip a homogeneous polygon `(S, T, W)` to the light square and dehomogenise it into the
+/// square ([`in_light_square`]; vertices with `W = 0` left by the clip are the zero vector
+/// and are dropped). Found by fuzzing: a vertex at p's level, a direction with `W` at the
+/// rounding of the clip (−10⁻¹³ one way, 8.6·10⁻¹⁴ the other), left a vertex at
+/// t = −1.0000083 in one edge direction only, and the coverage's antisymmetry off by 2·10⁻⁶.
 fn clip_to_light<T: ShaderFloat>(poly: &[SVec3<T>]) -> Vec<SVec2<T>> {
     let mut out = poly.to_vec();
     for border in light_borders() {
@@ -701,7 +704,7 @@ fn clip_to_light<T: ShaderFloat>(poly: &[SVec3<T>]) -> Vec<SVec2<T>> {
     }
     out.iter()
         .filter(|x| x.z > T::zero())
-        .map(|x| x.truncate() / x.z)
+        .map(|x| in_light_square(*x))
         .collect()
 }
 
@@ -879,6 +882,29 @@ mod tests {
                 assert!(q.length() <= 1.0, "{q}");
             }
         }
+    }
+
+    /// A rectangle light 1.5·10¹⁰ across seen from 1558 beyond its plane, an edge whose
+    /// projection runs nearly through its center (found by fuzzing,
+    /// `fuzz/regressions/coverage/rect-1.5e10-light-edge-projects-through-center-antisymmetry-2e-6.bin`):
+    /// the clipped region kept a vertex 8.3·10⁻⁶ outside the square in one edge direction only
+    /// (coverage −0.49999905 one way, 0.50000112 the other). Reversing the edge negates the
+    /// coverage to within 10⁻⁹ (the region's vertices are exact to about that).
+    #[test]
+    fn huge_light_coverage_is_antisymmetric() {
+        let l = RectLight::new(
+            DVec3::new(0.0, 0.76171875, -7.25),
+            DVec3::new(2.7939677238464355e-9, 14614528000.0, 0.75),
+            DVec3::new(1419771904.0, 0.75, 14614528000.0),
+        );
+        let p = DVec3::new(26.75, 0.0, 16384.0);
+        let e0 = DVec3::new(0.75, -14417920000.0, 26.75);
+        let e1 = DVec3::new(0.0, 16384.0, 0.0);
+        let (c, r) = (
+            edge_coverage_exact(&l, p, e0, e1),
+            edge_coverage_exact(&l, p, e1, e0),
+        );
+        assert!((c + r).abs() < 1e-9, "{c} {r}");
     }
 
     #[test]
