@@ -484,7 +484,8 @@ fn run_raycast(frame: &Frame) -> Result<MethodOutput, InputError> {
     let plan = MethodPlan {
         method: "raycast".into(),
         passes: vec![frame.pass.name.clone(), "raycast".into()],
-        buffers: vec![],
+        // The frame's scene pass writes the depth buffer whatever the receivers are read from.
+        buffers: vec![BufferPlan::depth(&frame.gpu)],
         settings: serde_json::json!({
             "samples": settings.samples,
             "seed": settings.seed,
