@@ -186,8 +186,9 @@ pub trait ShaderFloat:
     /// This format, or fp32 where this one is wider (f64): the scalar of a fragment program
     /// whose arithmetic was fp32 before shader precision existed — `wedge-blending`'s vBuffer
     /// arithmetic ([`crate::methods::wedge_blending::blend`]), whose values are the f32 the
-    /// vBuffers store — so that the default keeps its bits and the narrower formats round as
-    /// every other program does. Every value of it is an exact f32.
+    /// vBuffers store, and `ssv-optimized`'s plane-equation split (Paper IV §4.4) — so that the
+    /// default keeps its bits and the narrower formats round as every other program does.
+    /// Every value of it is an exact f32.
     type AtMostFp32: ShaderFloat;
 
     /// `x` rounded to the format (a constant, a uniform or an interpolated input).

@@ -115,7 +115,7 @@ use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw};
 use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
 use crate::gpu::setup::{CullMode, RasterTriangle};
-use crate::gpu::shader_float::{Fp32, ShaderFloat, ShaderPrecision, FP16};
+use crate::gpu::shader_float::{ShaderFloat, FP16};
 use crate::gpu::shader_vec::{SVec2, SVec3};
 use crate::gpu::split_blend::{SplitFormat, SplitTarget, SplitVTile};
 use crate::gpu::stencil::{StencilFace, StencilFunc, StencilOp, StencilState};
@@ -790,11 +790,8 @@ fn render_group<T: ShaderFloat>(
                         });
                     }
                     cnt.fragments_shaded += 1;
-                    let target = job.target.unwrap_or_else(|| match T::PRECISION {
-                        ShaderPrecision::F64 => {
-                            plane_split_target::<Fp32>(light.center(), &job.edge, p)
-                        }
-                        _ => plane_split_target::<T>(light.center(), &job.edge, p),
+                    let target = job.target.unwrap_or_else(|| {
+                        plane_split_target::<T::AtMostFp32>(light.center(), &job.edge, p)
                     });
                     let cov = light.shader_coverage::<T>(p, job.edge[0], job.edge[1], s.coverage);
                     let split = table.shader_lookup(cov);
@@ -881,8 +878,8 @@ fn split_dumps(
 /// The plane-equation split (§4.4's first approach): the sign of the hard-quad plane equation
 /// evaluated at the receiver by the shader in the precision `S`; inner (≤ 0, see
 /// [`crate::geometry::tight_wedge::quad_inner_halfspace`]) adds. [`render_group`] evaluates it
-/// in f32 ([`Fp32`], the precision whose errors near the plane §4.4 reports) at the default
-/// shader precision, and in the shader precision otherwise.
+/// in the shader precision capped at fp32 ([`ShaderFloat::AtMostFp32`]): f32 at the default,
+/// the precision whose errors near the plane §4.4 reports.
 fn plane_split_target<S: ShaderFloat>(c: DVec3, e: &[DVec3; 2], p: DVec3) -> SplitTarget {
     let c = SVec3::<S>::from_f64(c);
     let (a, b, p) = (
