@@ -902,7 +902,7 @@ fn screen_pass<T: ShaderFloat>(
                     Some(t) => e.value("t", t),
                     None => e,
                 };
-                let clamped = shade.t.is_some_and(|t| !(0.0..=1.0).contains(&t));
+                let clamped = shade.clamped();
                 let note = format!(
                     "{:?}{}",
                     shade.region,
