@@ -254,27 +254,103 @@ pub fn shader_projected_edge_in_light<T: ShaderFloat>(
     for plane in projection.slab_planes() {
         clip_segment(&mut a, &mut b, |x| plane.dot(x))?;
     }
-    let mut a = projection.apply(a);
-    let mut b = projection.apply(b);
-    for border in light_borders() {
-        clip_segment(&mut a, &mut b, border)?;
+    let mut a = BorderPoint::new(projection.apply(a));
+    let mut b = BorderPoint::new(projection.apply(b));
+    for (k, border) in light_borders().into_iter().enumerate() {
+        clip_segment_marking(&mut a, &mut b, |x| border(x.x), |x| x.on_border(k))?;
     }
-    if a.z <= zero || b.z <= zero {
+    if a.x.z <= zero || b.x.z <= zero {
         return None;
     }
-    Some([in_light_square(a), in_light_square(b)])
+    Some([in_light_square(a)?, in_light_square(b)?])
 }
 
-/// The light coordinates `(S/W, T/W)` of a homogeneous point clipped to the light square,
-/// clamped to `[−1, 1]²`. The point lies in the square, but where its `W` is at the rounding
-/// of the coordinates it was interpolated from, dividing puts it anywhere (found by fuzzing: a
+/// The light coordinates `(S/W, T/W)` of a homogeneous point clipped to the light square: a
+/// coordinate of a point on a border ([`BorderPoint`]) is that border's ±1 exactly, the others
+/// are clamped to `[−1, 1]`; `None` for a point on two opposite borders (a direction at
+/// infinity, `W = 0`). The point lies in the square, but where its `W` is at the rounding of
+/// the coordinates it was interpolated from, dividing puts it anywhere (found by fuzzing: a
 /// receiver 6·10⁻⁹ from an edge lying at its own level, so that the whole projected edge is at
-/// infinity and its clipped ends have `W` ≈ 2·10⁻¹⁶, gave s = −1.118); the clamp removes only
-/// that rounding, and keeps texture coordinates in the texture.
-fn in_light_square<T: ShaderFloat>(x: SVec3<T>) -> SVec2<T> {
+/// infinity and its clipped ends have `W` ≈ 2·10⁻¹⁶, gave s = −1.118); the clamp and the snap
+/// remove only that rounding, and keep texture coordinates in the texture.
+fn in_light_square<T: ShaderFloat>(x: BorderPoint<T>) -> Option<SVec2<T>> {
     let one = T::one();
-    let q = x.truncate() / x.z;
-    SVec2::new(q.x.clamp(-one, one), q.y.clamp(-one, one))
+    let on = |k: usize| x.on & (1 << k) != 0;
+    let snap = |q: T, plus: usize, minus: usize| match (on(plus), on(minus)) {
+        (true, true) => None,
+        (true, false) => Some(one),
+        (false, true) => Some(-one),
+        (false, false) => Some(q.clamp(-one, one)),
+    };
+    let q = x.x.truncate() / x.x.z;
+    Some(SVec2::new(snap(q.x, 0, 1)?, snap(q.y, 2, 3)?))
+}
+
+/// A homogeneous light-plane point `(S, T, W)` with the set of light borders it lies on (bit
+/// `k`: the `k`-th functional of [`light_borders`]), so that dehomogenising can put it on them
+/// exactly ([`in_light_square`]). A point a clip creates lies on the border it was clipped
+/// to, and a point interpolated between two points lies on every border both lie on (the
+/// borders are linear functionals). Found by fuzzing: a rectangle 2·10⁻⁶ of its length wide
+/// and skewed, an edge whose projection halves it, and the corners of the covered half
+/// interpolated between points at infinity (`W` ≈ 10⁻¹⁰ from coordinates of size 8): they
+/// came out at t = ±0.99999 instead of ±1, and the coverage's antisymmetry was off by
+/// 2.3·10⁻⁶ (`fuzz/regressions/coverage/rect-5e5-to-1-skewed-light-antisymmetry-2.3e-6.bin`).
+#[derive(Debug, Clone, Copy)]
+struct BorderPoint<T> {
+    x: SVec3<T>,
+    /// Bit `k` set: the point lies on border `k`.
+    on: u8,
+}
+
+impl<T: ShaderFloat> BorderPoint<T> {
+    /// The point `x` on the borders whose functionals are exactly 0 at it (a direction at
+    /// infinity along `T`, `(0, T, 0)`, lies on both `s` borders).
+    fn new(x: SVec3<T>) -> Self {
+        let on = light_borders()
+            .iter()
+            .enumerate()
+            .filter(|(_, border)| border(x) == T::zero())
+            .fold(0, |on, (k, _)| on | 1 << k);
+        BorderPoint { x, on }
+    }
+
+    /// The same point, marked as lying on border `k` (a clip to that border created it).
+    fn on_border(self, k: usize) -> Self {
+        BorderPoint {
+            on: self.on | 1 << k,
+            ..self
+        }
+    }
+}
+
+impl<T: ShaderFloat> std::ops::Add for BorderPoint<T> {
+    type Output = Self;
+    fn add(self, other: Self) -> Self {
+        BorderPoint {
+            x: self.x + other.x,
+            on: self.on & other.on,
+        }
+    }
+}
+
+impl<T: ShaderFloat> std::ops::Sub for BorderPoint<T> {
+    type Output = Self;
+    fn sub(self, other: Self) -> Self {
+        BorderPoint {
+            x: self.x - other.x,
+            on: self.on & other.on,
+        }
+    }
+}
+
+impl<T: ShaderFloat> std::ops::Mul<T> for BorderPoint<T> {
+    type Output = Self;
+    fn mul(self, k: T) -> Self {
+        BorderPoint {
+            x: self.x * k,
+            on: self.on,
+        }
+    }
 }
 
 /// The edge `e0 e1` projected from `p` onto the light plane, in light coordinates `(s, t)`,
@@ -690,21 +766,21 @@ fn square_fraction<T: ShaderFloat>(clipped: &[SVec2<T>]) -> T {
 }
 
 /// Clip a homogeneous polygon `(S, T, W)` to the light square and dehomogenise it into the
-/// square ([`in_light_square`]; vertices with `W = 0` left by the clip are the zero vector
-/// and are dropped). Found by fuzzing: a vertex at p's level, a direction with `W` at the
-/// rounding of the clip (−10⁻¹³ one way, 8.6·10⁻¹⁴ the other), left a vertex at
+/// square ([`in_light_square`], [`BorderPoint`]; vertices with `W = 0` left by the clip are
+/// the zero vector and are dropped). Found by fuzzing: a vertex at p's level, a direction with
+/// `W` at the rounding of the clip (−10⁻¹³ one way, 8.6·10⁻¹⁴ the other), left a vertex at
 /// t = −1.0000083 in one edge direction only, and the coverage's antisymmetry off by 2·10⁻⁶.
 fn clip_to_light<T: ShaderFloat>(poly: &[SVec3<T>]) -> Vec<SVec2<T>> {
-    let mut out = poly.to_vec();
-    for border in light_borders() {
-        out = clip_polygon(&out, border);
+    let mut out: Vec<BorderPoint<T>> = poly.iter().map(|x| BorderPoint::new(*x)).collect();
+    for (k, border) in light_borders().into_iter().enumerate() {
+        out = clip_polygon_marking(&out, |x| border(x.x), |x| x.on_border(k));
         if out.is_empty() {
             return Vec::new();
         }
     }
-    out.iter()
-        .filter(|x| x.z > T::zero())
-        .map(|x| in_light_square(*x))
+    out.into_iter()
+        .filter(|x| x.x.z > T::zero())
+        .filter_map(in_light_square)
         .collect()
 }
 
@@ -714,6 +790,17 @@ where
     V: Copy + std::ops::Sub<Output = V> + std::ops::Add<Output = V> + std::ops::Mul<T, Output = V>,
     T: ShaderFloat,
     F: Fn(V) -> T,
+{
+    clip_polygon_marking(poly, dist, |x| x)
+}
+
+/// [`clip_polygon`], passing each vertex the clip creates through `cut`.
+fn clip_polygon_marking<V, T, F, M>(poly: &[V], dist: F, cut: M) -> Vec<V>
+where
+    V: Copy + std::ops::Sub<Output = V> + std::ops::Add<Output = V> + std::ops::Mul<T, Output = V>,
+    T: ShaderFloat,
+    F: Fn(V) -> T,
+    M: Fn(V) -> V,
 {
     let zero = T::zero();
     let n = poly.len();
@@ -726,7 +813,7 @@ where
             out.push(a);
         }
         if (da >= zero) != (db >= zero) {
-            out.push(a + (b - a) * (da / (da - db)));
+            out.push(cut(a + (b - a) * (da / (da - db))));
         }
     }
     out
@@ -739,17 +826,28 @@ where
     T: ShaderFloat,
     F: Fn(V) -> T,
 {
+    clip_segment_marking(a, b, dist, |x| x)
+}
+
+/// [`clip_segment`], passing an end the clip moves through `cut`.
+fn clip_segment_marking<V, T, F, M>(a: &mut V, b: &mut V, dist: F, cut: M) -> Option<()>
+where
+    V: Copy + std::ops::Sub<Output = V> + std::ops::Add<Output = V> + std::ops::Mul<T, Output = V>,
+    T: ShaderFloat,
+    F: Fn(V) -> T,
+    M: Fn(V) -> V,
+{
     let zero = T::zero();
     let (da, db) = (dist(*a), dist(*b));
     match (da >= zero, db >= zero) {
         (true, true) => Some(()),
         (false, false) => None,
         (true, false) => {
-            *b = *a + (*b - *a) * (da / (da - db));
+            *b = cut(*a + (*b - *a) * (da / (da - db)));
             Some(())
         }
         (false, true) => {
-            *a = *a + (*b - *a) * (da / (da - db));
+            *a = cut(*a + (*b - *a) * (da / (da - db)));
             Some(())
         }
     }
@@ -774,6 +872,38 @@ mod tests {
         let c = edge_coverage_exact(&l, p, e0, e1);
         assert!((c.abs() - 0.25).abs() < 1e-12, "{c}");
         assert_eq!(edge_coverage_exact(&l, p, e1, e0), -c);
+    }
+
+    /// The fuzz finding [`BorderPoint`] fixes: a skewed rectangle 2·10⁻⁶ of its length wide
+    /// (`s` spans ±3.1·10⁶ world units, `t` ±8.5), and an edge crossing `p`'s level whose
+    /// projection runs through the whole square along `t`, 10⁻⁶ from its middle: the quad covers
+    /// the side `s` below that line, `½ + (s(−1) + s(1))/4` of the light, where `s(t)` is the
+    /// line through the projections of two points of the edge between the light and `p`. Before
+    /// the fix the corners (−1, ±1) came out at t = ±0.99999 one way round and the two
+    /// directions differed by 2.3·10⁻⁶.
+    #[test]
+    fn thin_skewed_light_halved_by_an_edge_keeps_its_corners() {
+        let l = RectLight::new(
+            DVec3::new(0.25, 3.0, 0.75),
+            DVec3::new(0.0, 3145728.0, 0.0),
+            DVec3::new(6.25, -5.75, 0.0),
+        );
+        let p = DVec3::new(-15.196115436540616, -6.661371913947409, -6.660914982462424);
+        let e0 = DVec3::new(-17.068359375, -8.5341796875, -8.5341796875);
+        let e1 = DVec3::new(-8.5341796875, -0.0009765625, 1.2489267343781473e-38);
+        let lp = l.local(p);
+        let project = |x: DVec3| {
+            let lx = l.local(x);
+            assert!(lx.z > 0.0 && lx.z < lp.z, "{x} not between the light and p");
+            (lp + (lx - lp) * (lp.z / (lp.z - lx.z))).truncate()
+        };
+        let (a, b) = (project(e1), project(e1.lerp(e0, 0.5)));
+        let s_at = |t: f64| a.x + (b.x - a.x) * (t - a.y) / (b.y - a.y);
+        let expected = 0.5 + (s_at(-1.0) + s_at(1.0)) / 4.0;
+        let c = edge_coverage_exact(&l, p, e0, e1);
+        let reversed = edge_coverage_exact(&l, p, e1, e0);
+        assert!((c.abs() - expected).abs() < 1e-12, "{c} vs {expected}");
+        assert!((c + reversed).abs() < 1e-12, "{c} vs {reversed}");
     }
 
     #[test]
