@@ -575,14 +575,25 @@ fn quad_plane_sine(c: DVec3, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
 /// projects onto the light center, or the edge crosses the light's plane at its center or
 /// `p`'s level at `p`.
 fn rect_condition(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
+    // A point's s and t carry the light frame's own rounding, ε·|x − c|·|dual| (found by
+    // fuzzing: a rectangle 1.5·10²⁶ across, whose dual vectors' rounding put 10⁻¹⁸ of error
+    // into light coordinates of size 10⁻²⁵): their sizes count at least that large.
+    let scale = l.local_scale();
+    let size = |x: DVec3, lx: DVec3| {
+        let frame = (x - l.center).length() * scale;
+        lx.x.abs().max(frame.x) + lx.y.abs().max(frame.y)
+    };
     let lp = l.local(p);
+    let p_size = size(p, lp);
     let (mut terms, mut smallest) = (0.0f64, f64::INFINITY);
+    let mut projected = Vec::new();
     for e in [e0, e1] {
         let le = l.local(e);
         let s = le.x * lp.z - lp.x * le.z;
         let t = le.y * lp.z - lp.y * le.z;
+        projected.push(DVec2::new(s, t));
         terms = terms
-            .max((le.x.abs() + le.y.abs()) * lp.z.abs() + (lp.x.abs() + lp.y.abs()) * le.z.abs())
+            .max(size(e, le) * lp.z.abs() + p_size * le.z.abs())
             .max(lp.z.abs() + le.z.abs());
         smallest = smallest
             .min(s.abs().max(t.abs()))
@@ -590,6 +601,12 @@ fn rect_condition(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
             .min(le.z.abs())
             .min(lp.z.abs());
     }
+    // How far the projected edge's line passes from the light center (in S, T units): where
+    // it runs through the center, the quad's region flips between the two half-lights (p
+    // crosses the quad's plane as seen in the light's frame). Found by fuzzing: the
+    // 1.5·10²⁶ light above, the line 10⁻²⁵ of the light from its center.
+    let [a, b] = [projected[0], projected[1]];
+    smallest = smallest.min(a.perp_dot(b).abs() / a.length().max(b.length()));
     let (l0, l1) = (l.local(e0), l.local(e1));
     // The edge's points at the light's plane (height 0) and at p's level, relative to the
     // center and to p.

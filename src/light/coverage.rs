@@ -137,6 +137,14 @@ impl RectLight {
         )
     }
 
+    /// Light-frame units per world unit along `s` and `t`: `|dual_u|` and `|dual_v|`, the
+    /// vectors [`RectLight::local`] takes dot products with. A world point `x` has its `s`
+    /// and `t` known to about `ε·|x − c|` times these (the dual vectors are rounded), however
+    /// small the coordinates themselves come out.
+    pub fn local_scale(&self) -> DVec2 {
+        DVec2::new(self.dual_u.length(), self.dual_v.length())
+    }
+
     /// The world point at light-frame coordinates `(s, t, h)`.
     pub fn world(&self, local: DVec3) -> DVec3 {
         self.center + local.x * self.u + local.y * self.v + local.z * self.normal
@@ -251,8 +259,13 @@ pub fn shader_projected_edge_in_light<T: ShaderFloat>(
     ];
     let mut a = seg[0];
     let mut b = seg[1];
-    for plane in projection.slab_planes() {
-        clip_segment(&mut a, &mut b, |x| plane.dot(x))?;
+    for (k, plane) in projection.slab_planes().into_iter().enumerate() {
+        clip_segment_marking(
+            &mut a,
+            &mut b,
+            |x| plane.dot(x),
+            |x| projection.onto_slab_plane(k, x),
+        )?;
     }
     let mut a = BorderPoint::new(projection.apply(a));
     let mut b = BorderPoint::new(projection.apply(b));
@@ -727,10 +740,27 @@ impl<T: ShaderFloat> ProjectionFromPoint<T> {
 
     fn clip_to_slab(&self, poly: &[SVec4<T>]) -> Vec<SVec4<T>> {
         let mut out = poly.to_vec();
-        for plane in self.slab_planes() {
-            out = clip_polygon(&out, |x| plane.dot(x));
+        for (k, plane) in self.slab_planes().into_iter().enumerate() {
+            out = clip_polygon_marking(&out, |x| plane.dot(x), |x| self.onto_slab_plane(k, x));
         }
         out
+    }
+
+    /// The point `x`, which a clip to slab plane `k` ([`ProjectionFromPoint::slab_planes`])
+    /// created, put on that plane exactly: `h = 0` in the light's plane, `h = h_p·w` (flipped
+    /// back) at `p`'s level, so that [`ProjectionFromPoint::apply`] gives it `W = 0` exactly —
+    /// a direction. Interpolated, its `h` carries rounding of the size of the coordinates it
+    /// came from, and where the light is large (its `s, t` small) that residue outweighs the
+    /// direction's `S, T` (found by fuzzing: a rectangle 1.5·10²⁶ across, a vertex at `p`'s
+    /// level with `W` = 1.8·10⁻¹⁵ beside `S` = −1.3·10⁻²⁴, which turned a half-light
+    /// coverage of −0.5 into 1.5·10⁻⁹ in one edge direction).
+    fn onto_slab_plane(&self, k: usize, x: SVec4<T>) -> SVec4<T> {
+        let h = if k == 0 {
+            T::zero()
+        } else {
+            x.w * self.p.z * self.flip
+        };
+        SVec4::new(x.x, x.y, h, x.w)
     }
 
     /// `(s, t, h, w) ↦ (S, T, W)`: homogeneous light-plane coordinates of the projection.
@@ -903,6 +933,28 @@ mod tests {
         let c = edge_coverage_exact(&l, p, e0, e1);
         let reversed = edge_coverage_exact(&l, p, e1, e0);
         assert!((c.abs() - expected).abs() < 1e-12, "{c} vs {expected}");
+        assert!((c + reversed).abs() < 1e-12, "{c} vs {reversed}");
+    }
+
+    /// The fuzz finding [`ProjectionFromPoint::onto_slab_plane`] fixes: a rectangle
+    /// 1.5·10²⁶ across, so that light coordinates `s` are of size 10⁻²⁵, and an edge whose
+    /// projection halves it; the quad's vertex where the ray through `e1` leaves the slab at
+    /// `p`'s level is a direction (`W = 0`), but interpolated it had `W` = 1.8·10⁻¹⁵, which
+    /// outweighed its `S` = −1.3·10⁻²⁴ and made the coverage 1.5·10⁻⁹ instead of ½ in one edge
+    /// direction.
+    #[test]
+    fn huge_light_vertex_at_the_receivers_level_stays_a_direction() {
+        let l = RectLight::new(
+            DVec3::new(26.75, 0.015625, 0.0),
+            DVec3::new(-1.0, 26.75, 1.5474113062823904e26),
+            DVec3::new(16.1279296875, 6.067004998634556e24, 26.25),
+        );
+        let p = DVec3::new(0.0, 0.0, 4.75);
+        let e0 = DVec3::new(12.25, -4.3900599175968137e24, -26.0);
+        let e1 = DVec3::new(12.5, 4.3900599175968137e24, 0.5);
+        let c = edge_coverage_exact(&l, p, e0, e1);
+        let reversed = edge_coverage_exact(&l, p, e1, e0);
+        assert!((c.abs() - 0.5).abs() < 1e-12, "{c}");
         assert!((c + reversed).abs() < 1e-12, "{c} vs {reversed}");
     }
 
