@@ -74,6 +74,7 @@ use crate::gpu::shader_vec::{SVec2, SVec3, SVec4};
 use crate::light::lookup_tables::AreaShape;
 use crate::scene::{Light, LightShape};
 use glam::{DVec2, DVec3};
+use smallvec::SmallVec;
 use std::f64::consts::PI;
 
 /// A rectangular (parallelogram) light in f64 with its affine frame (module doc,
@@ -203,7 +204,7 @@ pub fn shader_edge_coverage<T: ShaderFloat>(
         l0.extend(zero),
     ];
     let in_slab = projection.clip_to_slab(&quad);
-    let projected: Vec<SVec3<T>> = in_slab.iter().map(|x| projection.apply(*x)).collect();
+    let projected: Polygon<SVec3<T>> = in_slab.iter().map(|x| projection.apply(*x)).collect();
     sign * clipped_area_fraction(&projected)
 }
 
@@ -471,7 +472,7 @@ pub fn clip_polygon_to_box(poly: &[DVec2], lo: DVec2, hi: DVec2) -> Vec<DVec2> {
     let mut out = clip_polygon(poly, |p: DVec2| p.x - lo.x);
     out = clip_polygon(&out, |p: DVec2| hi.x - p.x);
     out = clip_polygon(&out, |p: DVec2| p.y - lo.y);
-    clip_polygon(&out, |p: DVec2| hi.y - p.y)
+    clip_polygon(&out, |p: DVec2| hi.y - p.y).into_vec()
 }
 
 /// Signed exact coverage of the disk that the sphere light (`center`, `radius`) shows to `p` by
@@ -738,11 +739,22 @@ impl<T: ShaderFloat> ProjectionFromPoint<T> {
         ]
     }
 
-    fn clip_to_slab(&self, poly: &[SVec4<T>]) -> Vec<SVec4<T>> {
-        let mut out = poly.to_vec();
-        for (k, plane) in self.slab_planes().into_iter().enumerate() {
-            out = clip_polygon_marking(&out, |x| plane.dot(x), |x| self.onto_slab_plane(k, x));
-        }
+    fn clip_to_slab(&self, poly: &[SVec4<T>]) -> Polygon<SVec4<T>> {
+        let [near, far] = self.slab_planes();
+        let mut half = Polygon::new();
+        clip_polygon_into(
+            poly,
+            |x| near.dot(x),
+            |x| self.onto_slab_plane(0, x),
+            &mut half,
+        );
+        let mut out = Polygon::new();
+        clip_polygon_into(
+            &half,
+            |x| far.dot(x),
+            |x| self.onto_slab_plane(1, x),
+            &mut out,
+        );
         out
     }
 
@@ -754,13 +766,19 @@ impl<T: ShaderFloat> ProjectionFromPoint<T> {
     /// direction's `S, T` (found by fuzzing: a rectangle 1.5·10²⁶ across, a vertex at `p`'s
     /// level with `W` = 1.8·10⁻¹⁵ beside `S` = −1.3·10⁻²⁴, which turned a half-light
     /// coverage of −0.5 into 1.5·10⁻⁹ in one edge direction).
+    ///
+    /// At `p`'s level `w` is first recomputed from `h` as `h/h_p` (flipped back): a point cut
+    /// from the ray through an edge end has that end's exact `h` but a `w` interpolated from 1
+    /// to 0, as `1 − λ` with an absolute error of ε, which is relative error ε/w; found by
+    /// fuzzing: a light 10⁻⁵ across seen from 8.75 away, w = 1.1·10⁻⁶ carrying 10⁻¹⁰ of
+    /// relative error, and p's light coordinates 2.6·10⁶ turned that into directions off by
+    /// 10⁻⁹ and coverages 1.8·10⁻⁵ apart in the two edge directions.
     fn onto_slab_plane(&self, k: usize, x: SVec4<T>) -> SVec4<T> {
-        let h = if k == 0 {
-            T::zero()
-        } else {
-            x.w * self.p.z * self.flip
-        };
-        SVec4::new(x.x, x.y, h, x.w)
+        if k == 0 {
+            return SVec4::new(x.x, x.y, T::zero(), x.w);
+        }
+        let w = x.z * self.flip / self.p.z;
+        SVec4::new(x.x, x.y, w * self.p.z * self.flip, w)
     }
 
     /// `(s, t, h, w) ↦ (S, T, W)`: homogeneous light-plane coordinates of the projection.
@@ -800,32 +818,44 @@ fn square_fraction<T: ShaderFloat>(clipped: &[SVec2<T>]) -> T {
 /// the zero vector and are dropped). Found by fuzzing: a vertex at p's level, a direction with
 /// `W` at the rounding of the clip (−10⁻¹³ one way, 8.6·10⁻¹⁴ the other), left a vertex at
 /// t = −1.0000083 in one edge direction only, and the coverage's antisymmetry off by 2·10⁻⁶.
-fn clip_to_light<T: ShaderFloat>(poly: &[SVec3<T>]) -> Vec<SVec2<T>> {
-    let mut out: Vec<BorderPoint<T>> = poly.iter().map(|x| BorderPoint::new(*x)).collect();
+fn clip_to_light<T: ShaderFloat>(poly: &[SVec3<T>]) -> Polygon<SVec2<T>> {
+    let mut a: Polygon<BorderPoint<T>> = poly.iter().map(|x| BorderPoint::new(*x)).collect();
+    let mut b = Polygon::new();
+    // Each clip writes the other buffer; swapping the references moves no vertices.
+    let (mut src, mut dst) = (&mut a, &mut b);
     for (k, border) in light_borders().into_iter().enumerate() {
-        out = clip_polygon_marking(&out, |x| border(x.x), |x| x.on_border(k));
-        if out.is_empty() {
-            return Vec::new();
+        clip_polygon_into(src, |x| border(x.x), |x| x.on_border(k), dst);
+        if dst.is_empty() {
+            return Polygon::new();
         }
+        std::mem::swap(&mut src, &mut dst);
     }
-    out.into_iter()
+    src.iter()
         .filter(|x| x.x.z > T::zero())
+        .copied()
         .filter_map(in_light_square)
         .collect()
 }
 
+/// A clipped polygon, on the stack up to 12 vertices: a quad clipped by the two slab planes
+/// and the four light borders has at most 10, so the fragment programs never allocate.
+type Polygon<V> = SmallVec<[V; 12]>;
+
 /// One Sutherland–Hodgman step: keep the part of `poly` where `dist ≥ 0`.
-fn clip_polygon<V, T, F>(poly: &[V], dist: F) -> Vec<V>
+fn clip_polygon<V, T, F>(poly: &[V], dist: F) -> Polygon<V>
 where
     V: Copy + std::ops::Sub<Output = V> + std::ops::Add<Output = V> + std::ops::Mul<T, Output = V>,
     T: ShaderFloat,
     F: Fn(V) -> T,
 {
-    clip_polygon_marking(poly, dist, |x| x)
+    let mut out = Polygon::new();
+    clip_polygon_into(poly, dist, |x| x, &mut out);
+    out
 }
 
-/// [`clip_polygon`], passing each vertex the clip creates through `cut`.
-fn clip_polygon_marking<V, T, F, M>(poly: &[V], dist: F, cut: M) -> Vec<V>
+/// [`clip_polygon`] into `out` (cleared first), passing each vertex the clip creates through
+/// `cut`.
+fn clip_polygon_into<V, T, F, M>(poly: &[V], dist: F, cut: M, out: &mut Polygon<V>)
 where
     V: Copy + std::ops::Sub<Output = V> + std::ops::Add<Output = V> + std::ops::Mul<T, Output = V>,
     T: ShaderFloat,
@@ -834,7 +864,7 @@ where
 {
     let zero = T::zero();
     let n = poly.len();
-    let mut out = Vec::with_capacity(n + 2);
+    out.clear();
     for i in 0..n {
         let a = poly[i];
         let b = poly[(i + 1) % n];
@@ -846,7 +876,6 @@ where
             out.push(cut(a + (b - a) * (da / (da - db))));
         }
     }
-    out
 }
 
 /// Clip the segment `a b` to `dist ≥ 0` in place; `None` when nothing is left.
@@ -955,6 +984,27 @@ mod tests {
         let c = edge_coverage_exact(&l, p, e0, e1);
         let reversed = edge_coverage_exact(&l, p, e1, e0);
         assert!((c.abs() - 0.5).abs() < 1e-12, "{c}");
+        assert!((c + reversed).abs() < 1e-12, "{c} vs {reversed}");
+    }
+
+    /// The fuzz finding the `w = h/h_p` of [`ProjectionFromPoint::onto_slab_plane`] fixes: a
+    /// skewed light 10⁻⁵ across seen from 8.75 away (p's light coordinates 2.6·10⁶) and an
+    /// edge 6.5·10⁻⁹ long next to the light; the rays from the center through its ends reach
+    /// p's level at w ≈ 1.1·10⁻⁶, near p. With w interpolated the two edge directions gave
+    /// −0.145796 and 0.145778.
+    #[test]
+    fn tiny_light_rays_reaching_the_receivers_level_keep_their_w() {
+        let x = 1.0052695870399475e-5;
+        let l = RectLight::new(
+            DVec3::new(1.511366173271439e-13, x, x),
+            DVec3::new(x, 8.37724655866623e-6, x),
+            DVec3::splat(x),
+        );
+        let p = DVec3::new(8.75, 8.843688195366776e-18, 8.843688195366776e-18);
+        let e0 = DVec3::splat(x);
+        let e1 = DVec3::new(x, x, 1.0046176612377167e-5);
+        let c = edge_coverage_exact(&l, p, e0, e1);
+        let reversed = edge_coverage_exact(&l, p, e1, e0);
         assert!((c + reversed).abs() < 1e-12, "{c} vs {reversed}");
     }
 
