@@ -9,16 +9,18 @@
 use crate::error::InputError;
 use crate::geometry::adjacency::{self, Adjacency};
 use crate::gpu::buffers::{alloc_tiles, DepthTile};
-use crate::gpu::depth::{DepthFormat, DepthState};
+use crate::gpu::counters::Counters;
+use crate::gpu::depth::{DepthFormat, DepthFunc, DepthState};
+use crate::gpu::hiz::TileReceiverBounds;
 use crate::gpu::probe::{PassProbe, Probe, ProbeEvent, Tap};
 use crate::gpu::raster::{bin, draw, no_tile_culling};
 pub use crate::gpu::setup::setup_all;
-use crate::gpu::setup::CullMode;
+use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::shader_float::ShaderPrecision;
 use crate::gpu::tiling::Tiling;
 use crate::gpu::transform::{ClipVertex, Projection};
 use crate::methods::output::PassStats;
-use crate::options::{option_names, option_table, OptionTable, PowerOfTwo};
+use crate::options::{option_names, option_table, OptionTable, PowerOfTwo, Switch};
 use crate::scene::{Mesh, Scene};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -59,6 +61,9 @@ pub struct GpuSettings {
     pub depth: DepthFormat,
     /// Arithmetic of the fragment programs ([`crate::gpu::shader_float`]).
     pub shader: ShaderPrecision,
+    /// Whether passes consult the hierarchical-Z unit ([`crate::gpu::hiz`]) to reject
+    /// (tile, triangle) pairs before rasterizing them; the output bits are the same either way.
+    pub hiz: bool,
 }
 
 impl Default for GpuSettings {
@@ -89,6 +94,8 @@ option_table! {
         depth: DepthFormat = DepthFormat::D24;
         /// arithmetic of the fragment programs, every operation rounded: f64, IEEE fp32, ATI R300 fp24 (7-bit exponent, 16-bit mantissa, no denormals) or IEEE fp16 (half)
         shader: ShaderPrecision = ShaderPrecision::F64;
+        /// hierarchical Z: passes reject whole tiles of a triangle with the tiles' zmin/zmax and receiver bounds before rasterizing (same output bits on and off; counters show the work saved)
+        hiz: Switch = Switch::On;
     }
 }
 
@@ -99,6 +106,7 @@ impl GpuOptions {
             tile_size: self.tile_size.0,
             depth: self.depth,
             shader: self.shader,
+            hiz: self.hiz == Switch::On,
         }
     }
 }
@@ -145,6 +153,9 @@ pub struct Frame<'s> {
     prim_rows: OnceLock<Vec<u32>>,
     /// Row-major depth-buffer receivers, computed on first use ([`Frame::receivers`]).
     depth_receivers: OnceLock<(Vec<Option<Receiver>>, usize)>,
+    /// Per-tile bounds of [`Frame::receivers`], computed on first use
+    /// ([`Frame::receiver_bounds`]).
+    receiver_bounds: OnceLock<TileReceiverBounds>,
     /// Whether methods hand back every buffer they resolved, with its event map
     /// ([`crate::methods::dump`], `--dump-buffers`); false after [`Frame::render`], set with
     /// [`Frame::dumping`].
@@ -242,6 +253,7 @@ impl<'s> Frame<'s> {
             pass,
             prim_rows: OnceLock::new(),
             depth_receivers: OnceLock::new(),
+            receiver_bounds: OnceLock::new(),
             dump_buffers: false,
             probe: None,
         })
@@ -289,6 +301,7 @@ impl<'s> Frame<'s> {
             pass: self.pass.clone(),
             prim_rows: self.prim_rows.clone(),
             depth_receivers: self.depth_receivers.clone(),
+            receiver_bounds: self.receiver_bounds.clone(),
             dump_buffers: self.dump_buffers,
             probe: self.probe.clone(),
         }
@@ -362,6 +375,41 @@ impl<'s> Frame<'s> {
     /// would be the reference's ([`Frame::snapped_receivers`] counts these pixels).
     pub fn receivers(&self) -> &[Option<Receiver>] {
         &self.depth_receivers_and_snaps().0
+    }
+
+    /// Whether the hierarchical-Z unit ([`crate::gpu::hiz`], on with `[options.gpu] hiz`)
+    /// rejects `tri` in tile `t` for a pass that tests the scene depth with `func` (without
+    /// writing it) and leaves every buffer alone for a fragment whose test outcome is `idle`
+    /// (z-pass volume counting does nothing where the test fails: `idle = false`; z-fail
+    /// nothing where it passes: `idle = true`). The zmin/zmax read and the rejection are
+    /// counted in `c`.
+    pub fn hiz_rejects_depth(
+        &self,
+        t: usize,
+        tri: &RasterTriangle,
+        func: DepthFunc,
+        idle: bool,
+        c: &mut Counters,
+    ) -> bool {
+        if !self.gpu.hiz {
+            return false;
+        }
+        let depth = &self.tiles[t].depth;
+        c.hiz_read_bytes += depth.hiz_read_bytes();
+        let culled = depth.depth_outcome(func, tri) == Some(idle);
+        c.tiles_culled_hiz += culled as u64;
+        culled
+    }
+
+    /// The hierarchical-Z unit's per-tile bounds of [`Frame::receivers`]
+    /// ([`crate::gpu::hiz`]), computed once per frame.
+    pub fn receiver_bounds(&self) -> &TileReceiverBounds {
+        self.receiver_bounds.get_or_init(|| {
+            let receivers = self.receivers();
+            TileReceiverBounds::new(&self.tiling, |x, y| {
+                receivers[(y * self.scene.width + x) as usize].map(|r| r.point.as_dvec3())
+            })
+        })
     }
 
     /// How many receivers of [`Frame::receivers`] were moved onto their triangle's plane

@@ -312,8 +312,8 @@ fn an_untextured_light_gets_a_one_channel_vbuffer() {
 }
 
 /// `pw-restructured` (Paper II §4): with `culling = off` no tile is culled and no tile
-/// zmin/zmax is read (the count `pw_restructured::render_li` returns), and the plan lists no
-/// zmin/zmax buffer; with the default `zmin-zmax` tiles are culled on
+/// zmin/zmax is read (the counters' `hiz_read_bytes`, in units of the depth format), and the
+/// plan lists no zmin/zmax buffer; with the default `zmin-zmax` tiles are culled on
 /// `cube-of-spheres-sphere`, each culled tile after a zmin/zmax read, with fewer fragments and
 /// the same image.
 #[test]
@@ -325,7 +325,9 @@ fn pw_restructured_culls_tiles_only_with_culling_on() {
         let frame = Frame::render(scene, penumbra::render::gpu_settings(scene).unwrap()).unwrap();
         let (s, _) = pw_restructured::read_settings(&frame).unwrap();
         let set = pw2002::frame_wedges(&frame, &s.wedge).unwrap();
-        pw_restructured::render_li(&frame, &set, &s).2
+        let (_, passes) = pw_restructured::render_li(&frame, &set, &s);
+        let bytes: u64 = passes.iter().map(|p| p.counters.hiz_read_bytes).sum();
+        bytes / frame.gpu.depth.bytes()
     };
     let (reads_on, reads_off) = (tile_reads(&on), tile_reads(&off));
     let on = run_one(&on, "pw-restructured");

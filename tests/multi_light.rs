@@ -143,7 +143,7 @@ fn pw2002_and_restructured_agree_on_the_shared_li_buffer_of_two_lights() {
             passes,
             culling: Culling::ZminZmax,
         };
-        let (t, _, _) = pw_restructured::render_li(&frame, &set, &s);
+        let (t, _) = pw_restructured::render_li(&frame, &set, &s);
         let b = pw2002::li_row_major(&frame, &t);
         let diff: Vec<_> = (0..a.len())
             .filter(|&i| a[i] != b[i])

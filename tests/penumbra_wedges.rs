@@ -26,7 +26,7 @@ fn li_pw2002(frame: &Frame, s: &WedgeSettings) -> Vec<i32> {
 
 fn li_restructured(frame: &Frame, s: &RestructuredSettings) -> Vec<i32> {
     let set = pw2002::frame_wedges(frame, &s.wedge).expect("wedges");
-    let (t, _, _) = pw_restructured::render_li(frame, &set, s);
+    let (t, _) = pw_restructured::render_li(frame, &set, s);
     pw2002::li_row_major(frame, &t)
 }
 

@@ -107,7 +107,7 @@ pub fn sweep(scene: &Scene) -> Result<Vec<Row>, InputError> {
         for round in 0..TIMING_RUNS {
             for (v, s) in settings.iter().enumerate() {
                 let start = Instant::now();
-                let (_, stats, tile_tests) = render_li(&frame, &set, s);
+                let (_, stats) = render_li(&frame, &set, s);
                 times[v].push(start.elapsed().as_secs_f64());
                 if round > 0 {
                     continue;
@@ -124,12 +124,7 @@ pub fn sweep(scene: &Scene) -> Result<Vec<Row>, InputError> {
                     writes: c.stencil_write_bytes + c.color_write_bytes / wedge.li.bytes(),
                     tiles_visited: c.tiles_visited,
                     tiles_culled: c.tiles_culled_hiz,
-                    hiz_reads: tile_tests
-                        * match s.culling {
-                            Culling::Off => 0,
-                            Culling::Zmax => 1,
-                            Culling::ZminZmax => 2,
-                        },
+                    hiz_reads: c.hiz_read_bytes / frame.gpu.depth.bytes(),
                     fragments_shaded: c.fragments_shaded,
                     seconds: 0.0,
                 });

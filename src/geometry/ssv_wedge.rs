@@ -40,6 +40,7 @@
 //! because the coverage it then computes for every pixel is exactly 0 outside the real
 //! penumbra volume (Paper III §3.2.2 and [`crate::light::coverage`]), only slower.
 
+use crate::gpu::hiz::{plane_rejects_box, InsideTestRounding};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::shader_vec::SVec3;
 use crate::gpu::transform::{ClipVertex, Projection};
@@ -238,6 +239,16 @@ impl SsvWedge {
         self.planes
             .iter()
             .all(|h| SVec3::from_f64(h.normal).dot(p - SVec3::from_f64(h.origin)) >= T::zero())
+    }
+
+    /// Whether [`SsvWedge::shader_contains`] in the format of `rounding` fails at every point of the
+    /// box `[lo, hi]`: one of the four planes rejects the whole box, with a margin for the
+    /// program's rounding ([`plane_rejects_box`]). The hierarchical-Z unit's test of a wedge
+    /// against a tile's receiver bounds ([`crate::gpu::hiz`]).
+    pub fn rejects_box(&self, bounds: [DVec3; 2], rounding: &InsideTestRounding) -> bool {
+        self.planes
+            .iter()
+            .any(|h| plane_rejects_box(h.normal, h.origin, bounds, rounding))
     }
 
     /// Whether `p` is within distance `r` of the inside of every plane (a conservative test

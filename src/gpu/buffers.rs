@@ -117,7 +117,40 @@ impl DepthTile {
     /// the triangle is at or behind every stored sample (triangle zmin ≥ tile zmax), i.e. no
     /// fragment of it can pass. Reads the tile's zmax (not counted as depth traffic: on-chip).
     pub fn rejects_less(&self, tri: &RasterTriangle) -> bool {
-        self.format.quantize(tri.z_range[0]) >= self.zmax
+        self.depth_outcome(DepthFunc::Less, tri) == Some(false)
+    }
+
+    /// The outcome every fragment of `tri` in this tile has under the depth test `func`, when
+    /// the tile's zmin/zmax decide it for all of them ([`super::hiz`]): `Some(false)` when
+    /// none can pass, `Some(true)` when all pass, `None` when it depends on the sample. A
+    /// fragment's depth is the triangle's depth plane at a covered sample, between its vertex
+    /// depths ([`RasterTriangle::z_range`]), and quantizing is monotone. A triangle reaching
+    /// depth 0 is left undecided (a fragment depth of −0.0 quantizes out of order in D32F).
+    /// Only `Less` and `GEqual` are decided; other functions give `None`.
+    pub fn depth_outcome(&self, func: DepthFunc, tri: &RasterTriangle) -> Option<bool> {
+        if tri.z_range[0].is_nan() || tri.z_range[0] <= 0.0 {
+            return None;
+        }
+        let (near, far) = (
+            self.format.quantize(tri.z_range[0]),
+            self.format.quantize(tri.z_range[1]),
+        );
+        // Every fragment at or behind every stored sample / in front of every one.
+        let behind = near >= self.zmax;
+        let in_front = far < self.zmin;
+        match func {
+            DepthFunc::Less if behind => Some(false),
+            DepthFunc::Less if in_front => Some(true),
+            DepthFunc::GEqual if behind => Some(true),
+            DepthFunc::GEqual if in_front => Some(false),
+            _ => None,
+        }
+    }
+
+    /// Bytes one hierarchical-Z read of this tile's zmin and zmax costs (two values in the
+    /// depth format; [`Counters::hiz_read_bytes`]).
+    pub fn hiz_read_bytes(&self) -> u64 {
+        2 * self.format.bytes()
     }
 }
 

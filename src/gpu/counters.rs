@@ -23,7 +23,9 @@ pub struct Counters {
     pub triangles_rasterized: u64,
     /// (triangle, tile) pairs visited by traversal.
     pub tiles_visited: u64,
-    /// Tiles rejected by a hierarchical-Z (zmin/zmax) test before any fragment was made.
+    /// (tile, triangle) pairs rejected by the hierarchical-Z unit before any fragment was
+    /// made: a zmin/zmax test, or a wedge's planes against the tile's receiver bounds
+    /// ([`crate::frame::TileReceiverBounds`]).
     pub tiles_culled_hiz: u64,
     /// Samples that passed the coverage test (fragments generated).
     pub fragments_rasterized: u64,
@@ -43,14 +45,19 @@ pub struct Counters {
     pub color_read_bytes: u64,
     /// Colour/LI/V-buffer writes, in bytes.
     pub color_write_bytes: u64,
+    /// Hierarchical-Z reads (a tile's zmin/zmax, or its receiver bounds), in bytes at the
+    /// storage size of the values read.
+    pub hiz_read_bytes: u64,
     /// Writes whose value over- or underflowed the storage format (wrapped or saturated).
     pub overflow_events: u64,
 }
 
 impl Counters {
-    /// Total buffer traffic in bytes (depth + stencil + colour, reads and writes).
+    /// Total buffer traffic in bytes (depth + stencil + colour, reads and writes, and the
+    /// hierarchical-Z reads).
     pub fn total_bytes(&self) -> u64 {
-        self.depth_read_bytes
+        self.hiz_read_bytes
+            + self.depth_read_bytes
             + self.depth_write_bytes
             + self.stencil_read_bytes
             + self.stencil_write_bytes
@@ -80,6 +87,7 @@ impl AddAssign for Counters {
         self.stencil_write_bytes += o.stencil_write_bytes;
         self.color_read_bytes += o.color_read_bytes;
         self.color_write_bytes += o.color_write_bytes;
+        self.hiz_read_bytes += o.hiz_read_bytes;
         self.overflow_events += o.overflow_events;
     }
 }

@@ -6,7 +6,7 @@
 //! [`fixed`] (sub-pixel snapping), [`setup`] (edge functions, fill rule, facing, depth plane),
 //! [`tiling`] and [`raster`] (tile traversal, parallel draw), [`depth`] and [`stencil`]
 //! (fixed-function tests and ops), [`buffers`] (typed, counted per-tile storage and
-//! hierarchical Z), [`vbuffer`] (the V-buffer formats of Paper III §4), [`pack4ub`] (8-bit values
+//! zmin/zmax), [`hiz`] (the hierarchical-Z unit's tile rejection), [`vbuffer`] (the V-buffer formats of Paper III §4), [`pack4ub`] (8-bit values
 //! packed into 32-bit float channels, Forest et al. 2006 §4.3), [`counters`], [`probe`] (what
 //! the passes did to one pixel),
 //! [`texture`] (texel addressing and filtering), [`shader_float`] (the fragment programs'
@@ -19,6 +19,7 @@ pub mod color;
 pub mod counters;
 pub mod depth;
 pub mod fixed;
+pub mod hiz;
 pub mod li_buffer;
 pub mod light_view;
 pub mod pack4ub;

@@ -35,6 +35,7 @@
 //! previous event's "after" ([`check_chains`]).
 
 use super::depth::{DepthFormat, DepthFunc};
+use super::setup::RasterTriangle;
 use super::tiling::Tiling;
 use serde::Serialize;
 use std::fmt;
@@ -588,6 +589,27 @@ impl PassProbe<'_> {
                 at: t.at,
             };
             tap.push(event(tap));
+        }
+    }
+
+    /// Record, at each watched sample of tile `t` that `tri` covers, that the triangle was
+    /// rejected for the whole tile before rasterization ([`super::hiz`]): `event` builds the
+    /// primitive's event, `why` says by what.
+    pub fn record_culled(
+        &self,
+        t: usize,
+        tri: &RasterTriangle,
+        why: &str,
+        event: impl Fn(Tap) -> ProbeEvent,
+    ) {
+        for x in self.targets.iter().filter(|x| x.tile == t) {
+            if tri.covers(x.at[0], x.at[1]) {
+                let tap = Tap {
+                    pass: self,
+                    at: x.at,
+                };
+                tap.push(event(tap).note(why));
+            }
         }
     }
 

@@ -100,6 +100,15 @@ pub struct FloatFormat {
     pub denormals: Denormals,
 }
 
+/// IEEE binary64, the `f64` precision (its arithmetic is plain f64; the format describes its
+/// rounding for error bounds such as [`super::hiz::plane_rejects_box`]'s).
+pub const F64: FloatFormat = FloatFormat {
+    mantissa_bits: 52,
+    min_exp: -1022,
+    max_exp: 1023,
+    denormals: Denormals::Kept,
+};
+
 /// IEEE binary32.
 pub const FP32: FloatFormat = FloatFormat {
     mantissa_bits: 23,
@@ -123,6 +132,18 @@ pub const FP16: FloatFormat = FloatFormat {
     max_exp: 15,
     denormals: Denormals::Kept,
 };
+
+impl ShaderPrecision {
+    /// The format this precision rounds to.
+    pub fn format(self) -> FloatFormat {
+        match self {
+            ShaderPrecision::F64 => F64,
+            ShaderPrecision::Fp32 => FP32,
+            ShaderPrecision::Fp24 => FP24,
+            ShaderPrecision::Fp16 => FP16,
+        }
+    }
+}
 
 impl FloatFormat {
     /// The largest finite value, `(2 − 2^−mantissa_bits)·2^max_exp`.

@@ -27,7 +27,7 @@ use crate::gpu::buffers::{alloc_tiles, StencilTile};
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::probe::Raw;
-use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
+use crate::gpu::raster::{bin, draw_probed};
 use crate::gpu::setup::CullMode;
 use crate::gpu::stencil::{StencilFace, StencilOp, StencilState};
 use crate::options::{option_names, option_table, OptionTable, OptionType};
@@ -184,6 +184,8 @@ pub fn stencil_shadow(
             (CullMode::Back, "/front-faces"),
         ],
     };
+    // The depth-test outcome whose stencil ops are all Keep (volume_stencil_state).
+    let idle = s.test == ShadowTest::ZFail;
     let tiling = &frame.tiling;
     let name = shadow_volume_pass(s.test);
     let mut stencil = alloc_tiles(tiling, |_, len| {
@@ -202,7 +204,17 @@ pub fn stencil_shadow(
             &tris,
             &bins,
             probe.as_ref(),
-            no_tile_culling,
+            |t, _, tri, c| {
+                let culled = frame.hiz_rejects_depth(t, tri, depth.func, idle, c);
+                if let (true, Some(probe), Some(parts)) = (culled, &probe, &parts) {
+                    probe.record_culled(t, tri, HIZ_CULLED, |tap| {
+                        let (kind, detail) = parts[tri.prim as usize].describe();
+                        tap.event()
+                            .primitive(kind, tri.prim, detail, Some(tri.front_facing))
+                    });
+                }
+                culled
+            },
             |t, st, tri, f, c, tap| {
                 let (pass, z) = frame.tiles[t].depth.test(&depth, &f, c);
                 c.depth_passed += pass as u64;
@@ -222,6 +234,11 @@ pub fn stencil_shadow(
     }
     (stencil, counters)
 }
+
+/// The probe's note for a triangle the hierarchical Z rejected for the probed pixel's tile
+/// ([`Frame::hiz_rejects_depth`]).
+pub const HIZ_CULLED: &str =
+    "culled for the tile by the hierarchical Z (zmin/zmax): no fragment could change a buffer";
 
 /// Row-major stencil values.
 pub fn stencil_row_major(frame: &Frame, tiles: &[StencilTile]) -> Vec<u8> {

@@ -100,7 +100,6 @@ use crate::gpu::shader_vec::SVec3;
 use crate::gpu::stencil::{StencilFace, StencilOp, StencilState};
 use crate::options::{option_names, option_table, OptionTable, OptionType};
 use crate::plan::{representative_light_points, BufferPlan, CountMode, MethodPlan};
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 /// Counting direction.
@@ -183,7 +182,12 @@ pub fn read_settings(frame: &Frame) -> Result<(RestructuredSettings, CountMode),
             wedge: o.wedges.settings(frame)?,
             test,
             passes: o.passes,
-            culling: o.culling,
+            // The hierarchical-Z unit off (`[options.gpu] hiz`), there is no zmin/zmax to read.
+            culling: if frame.gpu.hiz {
+                o.culling
+            } else {
+                Culling::Off
+            },
         },
         o.mode,
     ))
@@ -207,16 +211,18 @@ struct Ctx<'a> {
     front_is_quad: Vec<bool>,
     /// Index of the first umbra-only quad of a degenerate wedge in `tris`.
     umbra_quads_from: usize,
-    /// (tile, triangle) pairs whose tile zmin/zmax were tested (0 with culling off).
-    tile_tests: AtomicU64,
 }
 
 impl Ctx<'_> {
-    /// Count one tile zmin/zmax test (an integer sum: independent of thread scheduling).
-    fn count_tile_test(&self) {
-        if self.s.culling != Culling::Off {
-            self.tile_tests.fetch_add(1, Ordering::Relaxed);
-        }
+    /// Count one tile zmin/zmax test of tile `t` in `c` (`hiz_read_bytes`): the values the
+    /// culling mode reads, zmax, or zmin and zmax, in the depth format.
+    fn count_tile_test(&self, t: usize, c: &mut Counters) {
+        let values = match self.s.culling {
+            Culling::Off => 0,
+            Culling::Zmax => 1,
+            Culling::ZminZmax => 2,
+        };
+        c.hiz_read_bytes += values * self.frame.tiles[t].depth.format.bytes();
     }
 
     /// Umbra sign of a front-plane or cap fragment (per §3/§5): the LI amount it adds when its
@@ -406,7 +412,7 @@ fn li_pass<T: ShaderFloat>(
         |t, _, tri, c| {
             let roles = ctx.roles(tri);
             let (u, p) = culls(t, tri);
-            ctx.count_tile_test();
+            ctx.count_tile_test(t, c);
             c.tiles_culled_hiz += (umbra && roles.umbra && u) as u64;
             c.tiles_culled_hiz += (penumbra && roles.penumbra && p) as u64;
             if u && p {
@@ -482,14 +488,14 @@ fn raster_triangles(
     (rt, c)
 }
 
-/// Render the LI buffer of `pw-restructured` (tile-major); returns it with per-pass stats and
-/// the number of (tile, triangle) pairs whose tile zmin/zmax were read for a culling test. The
-/// penumbra fragment program runs in the frame's shader precision.
+/// Render the LI buffer of `pw-restructured` (tile-major); returns it with per-pass stats (the
+/// zmin/zmax reads of the culling tests in `hiz_read_bytes`). The penumbra fragment program
+/// runs in the frame's shader precision.
 pub fn render_li(
     frame: &Frame,
     set: &WedgeSet,
     s: &RestructuredSettings,
-) -> (Vec<LiTile>, Vec<PassStats>, u64) {
+) -> (Vec<LiTile>, Vec<PassStats>) {
     crate::with_shader_float!(frame.gpu.shader, T => render_li_with::<T>(frame, set, s))
 }
 
@@ -499,7 +505,7 @@ fn render_li_with<T: ShaderFloat>(
     frame: &Frame,
     set: &WedgeSet,
     s: &RestructuredSettings,
-) -> (Vec<LiTile>, Vec<PassStats>, u64) {
+) -> (Vec<LiTile>, Vec<PassStats>) {
     let mut tris = Vec::new();
     if s.test == WedgeTest::ZFail {
         tris.extend(cap_triangles(set, &frame.proj));
@@ -530,7 +536,6 @@ fn render_li_with<T: ShaderFloat>(
             .collect(),
         tris,
         s: *s,
-        tile_tests: AtomicU64::new(0),
     };
     let tiling = &frame.tiling;
     let mut tiles = alloc_tiles(tiling, |_, len| RTile {
@@ -606,8 +611,7 @@ fn render_li_with<T: ShaderFloat>(
             });
         }
     }
-    let tile_tests = ctx.tile_tests.load(Ordering::Relaxed);
-    (tiles.into_iter().map(|t| t.li).collect(), stats, tile_tests)
+    (tiles.into_iter().map(|t| t.li).collect(), stats)
 }
 
 /// One stencil pass of the three-pass umbra: DECR for front-facing, INCR for back-facing
@@ -639,7 +643,7 @@ fn stencil_pass(
         probe,
         |t, _, tri, c| {
             let culled = ctx.umbra_culled(t, tri);
-            ctx.count_tile_test();
+            ctx.count_tile_test(t, c);
             c.tiles_culled_hiz += culled as u64;
             if culled {
                 ctx.record_culled(probe, t, tri, "umbra");
@@ -670,7 +674,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         return super::light_average::run("pw-restructured", frame, |_, f| run(f));
     }
     let set = frame_wedges(frame, &s.wedge)?;
-    let (tiles, passes, _) = render_li(frame, &set, &s);
+    let (tiles, passes) = render_li(frame, &set, &s);
     let li = li_row_major(frame, &tiles);
     let mut names = vec![frame.pass.name.clone()];
     names.extend(passes.iter().map(|p| p.name.clone()));

@@ -64,8 +64,8 @@
 //! umbra counts of pass 1.
 
 use super::dump::{row_major, BufferDump, ElementFormat, EventKind, EventMap, VBufferDump};
-use super::hard_sv::stencil_dump;
 use super::hard_sv::{shadow_test, stencil_row_major, stencil_shadow, ShadowTest, StencilOverflow};
+use super::hard_sv::{stencil_dump, HIZ_CULLED};
 use super::hard_sv::{StencilShadowSettings, Submission};
 use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
@@ -75,8 +75,9 @@ use crate::geometry::silhouette::{light_facing, possible_silhouettes};
 use crate::geometry::ssv_wedge::{SsvWedge, WedgeLight};
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
+use crate::gpu::hiz::{InsideTestRounding, TileReceiverBounds};
 use crate::gpu::probe::{PrimitiveKind, Tap};
-use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
+use crate::gpu::raster::{bin, draw_probed};
 use crate::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::transform::ClipVertex;
@@ -275,6 +276,10 @@ impl CoverageSource<'_> {
     }
 }
 
+/// The probe's note for a wedge the hierarchical Z rejected for the probed pixel's tile.
+const WEDGE_CULLED: &str = "culled for the tile by the hierarchical Z: the wedge's inside test \
+     fails at every receiver of the tile (its receiver bounds), or the tile has none";
+
 /// The name of pass 1.
 const HARD_QUADS: &str = "ssv-hard-quads";
 
@@ -407,27 +412,51 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSett
     };
     let bins = bin(tiling, &tris);
     let probe = frame.probe_pass("ssv-wedges");
+    // The watched fragment's event, built only there.
+    let event = |tap: Tap, tri: &RasterTriangle| {
+        let k = owner[tri.prim as usize];
+        let (kind, how) = match edges[k as usize].wedge {
+            Some(_) => (PrimitiveKind::Wedge, "face"),
+            None => (PrimitiveKind::FullScreen, "full-screen"),
+        };
+        let detail = format!("of silhouette edge {k}, {how} triangle {}", tri.prim);
+        tap.event()
+            .primitive(kind, k, detail, Some(tri.front_facing))
+    };
+    let bounds = frame.gpu.hiz.then(|| frame.receiver_bounds());
+    let rounding = InsideTestRounding::new(T::PRECISION.format());
     pass2 += draw_probed(
         tiling,
         &mut vbuf,
         &tris,
         &bins,
         probe.as_ref(),
-        no_tile_culling,
+        |t, _, tri, c| {
+            let Some(bounds) = bounds else {
+                return false;
+            };
+            // The tile's receiver box against the wedge's inside test (crate::gpu::hiz); a
+            // full-screen wedge has no inside test, and only a tile without receivers
+            // rejects it.
+            c.hiz_read_bytes += TileReceiverBounds::READ_BYTES;
+            let culled = match bounds.tile(t) {
+                None => true,
+                Some(bx) => edges[owner[tri.prim as usize] as usize]
+                    .wedge
+                    .as_ref()
+                    .is_some_and(|w| w.rejects_box(bx, &rounding)),
+            };
+            c.tiles_culled_hiz += culled as u64;
+            if let (true, Some(probe)) = (culled, &probe) {
+                probe.record_culled(t, tri, WEDGE_CULLED, |tap| event(tap, tri));
+            }
+            culled
+        },
         |t, vb, tri, f, c, tap| {
             frame.tiles[t].depth.read(f.local, c);
             let k = owner[tri.prim as usize];
             let ew = &edges[k as usize];
-            // The watched fragment's event, built only there.
-            let event = |tap: Tap| {
-                let (kind, how) = match ew.wedge {
-                    Some(_) => (PrimitiveKind::Wedge, "face"),
-                    None => (PrimitiveKind::FullScreen, "full-screen"),
-                };
-                let detail = format!("of silhouette edge {k}, {how} triangle {}", tri.prim);
-                tap.event()
-                    .primitive(kind, k, detail, Some(tri.front_facing))
-            };
+            let event = |tap: Tap| event(tap, tri);
             let stop = |why: &str| {
                 if let Some(tap) = tap {
                     tap.push(event(tap).note(why));
@@ -581,7 +610,24 @@ fn hard_quads_pass<V: VBufferTile>(frame: &Frame, test: ShadowTest, vbuf: &mut [
         &tris,
         &bins,
         probe.as_ref(),
-        no_tile_culling,
+        |t, _, tri, c| {
+            // z-pass counts nothing where the test fails, z-fail nothing where it passes.
+            let idle = test == ShadowTest::ZFail;
+            let culled = frame.hiz_rejects_depth(t, tri, depth.func, idle, c);
+            if let (true, Some(probe)) = (culled, &probe) {
+                probe.record_culled(t, tri, HIZ_CULLED, |tap| {
+                    let e = tap.event();
+                    match &parts {
+                        Some(parts) => {
+                            let (kind, detail) = parts[tri.prim as usize].describe();
+                            e.primitive(kind, tri.prim, detail, Some(tri.front_facing))
+                        }
+                        None => e,
+                    }
+                });
+            }
+            culled
+        },
         |t, vb, tri, f, c, tap| {
             let (pass, z) = frame.tiles[t].depth.test(&depth, &f, c);
             c.depth_passed += pass as u64;

@@ -99,6 +99,7 @@
 use super::dump::{
     receiver_pixels, row_major, BufferDump, DumpValues, ElementFormat, EventKind, EventMap,
 };
+use super::hard_sv::HIZ_CULLED;
 use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, BACKGROUND};
@@ -113,7 +114,7 @@ use crate::gpu::buffers::{alloc_tiles, StencilTile};
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw};
-use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
+use crate::gpu::raster::{bin, draw_probed};
 use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::shader_float::{ShaderFloat, FP16};
 use crate::gpu::shader_vec::{SVec2, SVec3};
@@ -691,7 +692,25 @@ fn render_group<T: ShaderFloat>(
             &tris,
             &bins,
             probe.as_ref(),
-            no_tile_culling,
+            |t, _, tri, cnt| {
+                // The depth-test outcome on which the role's fragment does nothing: a quad
+                // counts on a pass (z-pass) or a fail (z-fail); a front face marks the stencil
+                // only where LESS passes; a back face shades only where GEQUAL passes. Faces of
+                // the other facing do nothing at all and are left to the fragment program.
+                let (func, idle) = match roles[tri.prim as usize] {
+                    Role::Quad => (less.func, zfail),
+                    Role::Mark(_) if tri.front_facing => (less.func, false),
+                    Role::Shade(_) | Role::ShadeTested(_) if !tri.front_facing => {
+                        (gequal.func, false)
+                    }
+                    _ => return false,
+                };
+                let culled = frame.hiz_rejects_depth(t, tri, func, idle, cnt);
+                if let (true, Some(probe)) = (culled, &probe) {
+                    probe.record_culled(t, tri, HIZ_CULLED, |tap| primitive(tap.event(), tri));
+                }
+                culled
+            },
             |t, st, tri, f, cnt, tap| match roles[tri.prim as usize] {
                 Role::Quad => {
                     let (pass, z) = frame.tiles[t].depth.test(&less, &f, cnt);

@@ -1,0 +1,209 @@
+//! The hierarchical-Z unit (`[options.gpu] hiz = on|off`, `docs/architecture.md`
+//! "Hierarchical Z"): what a pass may learn about a whole screen tile before it rasterizes a
+//! triangle there, so that it can reject the (tile, triangle) pair when no fragment of the
+//! triangle could change any buffer in that tile. Rejection never changes an output bit; it
+//! only removes work, which the counters show (`tiles_culled_hiz`, fewer fragments and depth
+//! reads) and prices (`hiz_read_bytes`).
+//!
+//! Two kinds of per-tile bounds:
+//! * **zmin/zmax of the scene depth** ([`DepthTile::zmin`](super::buffers::DepthTile),
+//!   [`DepthTile::depth_outcome`](super::buffers::DepthTile::depth_outcome)): when the
+//!   triangle's depth range lies wholly on one side of the tile's, every fragment has the same
+//!   depth-test outcome, and a pass whose fragments do nothing on that outcome skips the tile
+//!   (the hardware's hierarchical Z, Paper II §4 for Paper I's passes).
+//! * **Receiver bounds** ([`TileReceiverBounds`]): the box of the receiver points the tile's
+//!   fragment programs read (the world position a wedge's inside test and coverage take). A
+//!   wedge whose inside test fails at every point of that box — one of its planes rejects the
+//!   box ([`plane_rejects_box`]), in the fragment program's own arithmetic — shades nothing
+//!   there. This is the same reduction as zmin/zmax, taken over the position buffer instead of
+//!   the depth buffer (Paper IV §4.2 keeps positions in a texture); a tile without receivers
+//!   (all background) rejects every wedge.
+//!
+//! The receiver box is used rather than the tile's frustum between zmin and zmax because the
+//! receiver points are not always on the depth buffer's surface (`Frame::receivers` moves a
+//! point onto its triangle's plane where the depth format cannot hold it, and `ssv-optimized`
+//! may round positions to binary16): the box of the points actually read is the bound that
+//! holds for every fragment.
+
+use super::shader_float::FloatFormat;
+use super::tiling::Tiling;
+use glam::DVec3;
+
+/// Per screen tile, the axis-aligned box of the receiver points its fragment programs read
+/// (module doc), `None` for a tile with no receiver.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TileReceiverBounds {
+    boxes: Vec<Option<[DVec3; 2]>>,
+}
+
+impl TileReceiverBounds {
+    /// Bytes one read of a tile's bounds costs: six f32 (the receiver points are f32 or
+    /// narrower).
+    pub const READ_BYTES: u64 = 24;
+
+    /// The bounds of the points `point(x, y)` (the receiver of pixel (x, y), `None` for
+    /// background) over every tile of `tiling`.
+    pub fn new(tiling: &Tiling, point: impl Fn(u32, u32) -> Option<DVec3>) -> Self {
+        let boxes = (0..tiling.tile_count())
+            .map(|t| {
+                let r = tiling.rect(t);
+                let mut bounds: Option<[DVec3; 2]> = None;
+                for y in r.y0..r.y1 {
+                    for x in r.x0..r.x1 {
+                        if let Some(p) = point(x, y) {
+                            bounds = Some(match bounds {
+                                None => [p, p],
+                                Some([lo, hi]) => [lo.min(p), hi.max(p)],
+                            });
+                        }
+                    }
+                }
+                bounds
+            })
+            .collect();
+        TileReceiverBounds { boxes }
+    }
+
+    /// The box `[lo, hi]` of tile `t`'s receivers, `None` when it has none.
+    pub fn tile(&self, t: usize) -> Option<[DVec3; 2]> {
+        self.boxes[t]
+    }
+}
+
+/// The rounding margin [`plane_rejects_box`] allows for a fragment program's inside test in
+/// one format, computed once per pass.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InsideTestRounding {
+    /// Bound on the relative error of the evaluation, times its terms' size:
+    /// `8·(u + 2⁻⁵³)`.
+    relative: f64,
+    /// Bound on its absolute error from flushed or denormal results: `16·min_normal`.
+    absolute: f64,
+    /// Terms' size from which the program could overflow: `max_finite / 16`.
+    limit: f64,
+}
+
+impl InsideTestRounding {
+    /// The margin for programs computing in `format`.
+    pub fn new(format: FloatFormat) -> Self {
+        let u = libm::ldexp(1.0, -(format.mantissa_bits + 1));
+        InsideTestRounding {
+            relative: 8.0 * (u + libm::ldexp(1.0, -53)),
+            absolute: 16.0 * format.min_normal(),
+            limit: format.max_finite() / 16.0,
+        }
+    }
+}
+
+/// Whether the inside test `normal·(p − origin) ≥ 0`, evaluated by a fragment program in the
+/// format of `rounding` (inputs rounded to it, every operation rounded:
+/// [`super::shader_float`]), fails at every point `p` of the box `[lo, hi]`.
+///
+/// Conservative: the largest exact value over the box (at its corner furthest along the
+/// normal) must be below minus a bound on the rounding of the evaluation, `8·(u + 2⁻⁵³)·S +
+/// 16·min_normal` with `u` the format's unit roundoff and `S = Σ|nᵢ|·(max(|loᵢ|, |hiᵢ|) +
+/// |originᵢ|)` — the evaluation rounds p, origin, normal, the difference, the product and two
+/// sums, at most 5 relative errors per term (γ₅ < 8u), plus the same for the f64 evaluation
+/// here, plus a flushed or denormal result per operation. Where `S` comes near the format's
+/// largest finite value (the program could overflow), it never rejects.
+pub fn plane_rejects_box(
+    normal: DVec3,
+    origin: DVec3,
+    [lo, hi]: [DVec3; 2],
+    rounding: &InsideTestRounding,
+) -> bool {
+    let far = DVec3::select(normal.cmpge(DVec3::ZERO), hi, lo);
+    let largest = normal.dot(far - origin);
+    let scale = normal.abs().dot(lo.abs().max(hi.abs()) + origin.abs());
+    if scale.is_nan() || scale >= rounding.limit {
+        return false;
+    }
+    largest + rounding.relative * scale + rounding.absolute < 0.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::shader_float::{Fp16, Fp24, Fp32};
+    use crate::gpu::shader_float::{ShaderFloat, F64, FP16, FP24, FP32};
+    use crate::gpu::shader_vec::SVec3;
+
+    /// An inside test `(normal, origin, p)` in some precision.
+    type InsideTest = fn(DVec3, DVec3, DVec3) -> bool;
+
+    /// The inside test as the fragment programs compute it, in `T`.
+    fn inside<T: ShaderFloat>(n: DVec3, o: DVec3, p: DVec3) -> bool {
+        SVec3::<T>::from_f64(n).dot(SVec3::from_f64(p) - SVec3::from_f64(o)) >= T::zero()
+    }
+
+    /// A box the plane rejects is one where every point fails the shader's own test: checked
+    /// on a grid of points of boxes placed just beyond the plane, at every precision, and a
+    /// box straddling the plane is never rejected.
+    #[test]
+    fn a_rejected_box_fails_the_shader_test_everywhere() {
+        let n = DVec3::new(0.48, -0.6, 0.64);
+        let o = DVec3::new(3.25, -1.5, 7.0);
+        let mut rejected = [0; 4];
+        for k in 0..200 {
+            let gap = 1e-6 * libm::pow(1.2, k as f64);
+            let lo = o - n * (gap + 0.5) - DVec3::splat(0.25);
+            let hi = o - n * (gap + 0.5) + DVec3::splat(0.25);
+            // The box's farthest corner along n is 0.25·Σ|nᵢ| = 0.43 past its center.
+            let cases: [(FloatFormat, InsideTest); 4] = [
+                (F64, inside::<f64>),
+                (FP32, inside::<Fp32>),
+                (FP24, inside::<Fp24>),
+                (FP16, inside::<Fp16>),
+            ];
+            for (j, (format, test)) in cases.into_iter().enumerate() {
+                if !plane_rejects_box(n, o, [lo, hi], &InsideTestRounding::new(format)) {
+                    continue;
+                }
+                rejected[j] += 1;
+                for i in 0..=4 {
+                    for jj in 0..=4 {
+                        for kk in 0..=4 {
+                            let f = DVec3::new(i as f64, jj as f64, kk as f64) / 4.0;
+                            let p = lo + (hi - lo) * f;
+                            assert!(!test(n, o, p), "{format:?}: {p} inside, gap {gap}");
+                        }
+                    }
+                }
+            }
+            let straddling = [o - DVec3::splat(0.01), o + DVec3::splat(0.01)];
+            for format in [FP16, F64] {
+                let r = InsideTestRounding::new(format);
+                assert!(!plane_rejects_box(n, o, straddling, &r));
+            }
+        }
+        // Every precision rejects the far boxes, and the wider formats reject nearer ones.
+        assert!(rejected.iter().all(|&r| r > 0), "{rejected:?}");
+        assert!(
+            rejected[0] >= rejected[1] && rejected[1] >= rejected[2] && rejected[2] >= rejected[3]
+        );
+    }
+
+    /// Beyond the format's range the program may overflow: never rejected.
+    #[test]
+    fn boxes_beyond_the_format_range_are_kept() {
+        let n = DVec3::X;
+        let far = [DVec3::new(-1e6, 0.0, 0.0), DVec3::new(-9e5, 1.0, 1.0)];
+        let at = |format| plane_rejects_box(n, DVec3::ZERO, far, &InsideTestRounding::new(format));
+        assert!(!at(FP16));
+        assert!(at(FP32));
+    }
+
+    #[test]
+    fn bounds_cover_the_tile_receivers_and_skip_empty_tiles() {
+        let tiling = Tiling::new(12, 8, 8).unwrap();
+        let b = TileReceiverBounds::new(&tiling, |x, y| {
+            (x < 8 && (x + y) % 3 == 0).then(|| DVec3::new(x as f64, -(y as f64), 1.0))
+        });
+        // Tile 0 holds x, y ∈ 0..8; (7, 5) and (6, 6) are its receivers with the largest x, y.
+        assert_eq!(
+            b.tile(0),
+            Some([DVec3::new(0.0, -7.0, 1.0), DVec3::new(7.0, 0.0, 1.0)])
+        );
+        assert_eq!(b.tile(1), None);
+    }
+}
