@@ -25,7 +25,7 @@ pub struct Counters {
     pub tiles_visited: u64,
     /// (tile, triangle) pairs rejected by the hierarchical-Z unit before any fragment was
     /// made: a zmin/zmax test, or a wedge's planes against the tile's receiver bounds
-    /// ([`crate::frame::TileReceiverBounds`]).
+    /// ([`crate::gpu::hiz::TileReceiverBounds`]).
     pub tiles_culled_hiz: u64,
     /// Samples that passed the coverage test (fragments generated).
     pub fragments_rasterized: u64,
