@@ -242,6 +242,30 @@ pub struct BufferPlan {
 }
 
 impl BufferPlan {
+    /// The hierarchical-Z unit's per-tile zmin and zmax of the scene depth
+    /// ([`crate::gpu::hiz`]): two values in the depth format per tile, as whole bytes per
+    /// sample rounded up.
+    pub fn hiz_zmin_zmax(gpu: &crate::frame::GpuSettings) -> Self {
+        let tile_len = gpu.tile_size * gpu.tile_size;
+        Self {
+            name: format!("tile zmin/zmax (2 per {0}×{0} tile)", gpu.tile_size),
+            format: format!("{:?}", gpu.depth),
+            bytes_per_sample: (2 * gpu.depth.bytes() as u32).div_ceil(tile_len),
+        }
+    }
+
+    /// The hierarchical-Z unit's per-tile receiver bounds ([`crate::gpu::hiz::TileReceiverBounds`]):
+    /// six f32 per tile, as whole bytes per sample rounded up.
+    pub fn hiz_receiver_bounds(gpu: &crate::frame::GpuSettings) -> Self {
+        let tile_len = gpu.tile_size * gpu.tile_size;
+        Self {
+            name: format!("tile receiver bounds (6 per {0}×{0} tile)", gpu.tile_size),
+            format: "f32x6".into(),
+            bytes_per_sample: (crate::gpu::hiz::TileReceiverBounds::READ_BYTES as u32)
+                .div_ceil(tile_len),
+        }
+    }
+
     /// The frame's scene depth buffer, in the format the frame uses.
     pub fn depth(gpu: &crate::frame::GpuSettings) -> Self {
         Self {

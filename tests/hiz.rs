@@ -41,6 +41,21 @@ fn method_passes(run: &MethodRun) -> Counters {
     c
 }
 
+/// How many of the plan's buffers are the hierarchical-Z unit's ("tile zmin/zmax", "tile
+/// receiver bounds"), those of its per-light plans included (a method run once per light).
+fn hiz_buffers(run: &MethodRun) -> usize {
+    let plan = &run.output.stats.plan;
+    let per_light = plan["settings"]["per_light"]
+        .as_array()
+        .into_iter()
+        .flatten();
+    std::iter::once(plan)
+        .chain(per_light)
+        .flat_map(|p| p["buffers"].as_array().expect("plan.buffers"))
+        .filter(|b| b["name"].as_str().is_some_and(|n| n.starts_with("tile ")))
+        .count()
+}
+
 /// Scenes: z-pass on rectangle and sphere lights, the eye in shadow (z-fail), overlapping
 /// occluders, two lights, Paper I's scene and the D-buffer's disk.
 const SCENES: &[&str] = &[
@@ -84,6 +99,17 @@ fn hiz_on_and_off_give_the_same_bits_for_every_method() {
                 (c_off.tiles_culled_hiz, c_off.hiz_read_bytes),
                 (0, 0),
                 "{at}: off"
+            );
+            // A pass reads the unit's bounds only when the plan lists them, and a plan
+            // without the unit lists none.
+            assert!(
+                hiz_buffers(a) > 0 || c_on.hiz_read_bytes == 0,
+                "{at}: reads unlisted"
+            );
+            assert_eq!(
+                hiz_buffers(b),
+                0,
+                "{at}: plan lists HiZ buffers with hiz = off"
             );
         }
     }

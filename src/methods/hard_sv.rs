@@ -319,7 +319,10 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let plan = MethodPlan {
         method: "hard-sv".into(),
         passes: vec![frame.pass.name.clone(), name.into()],
-        buffers: vec![BufferPlan::depth(&frame.gpu), BufferPlan::stencil8()],
+        buffers: [BufferPlan::depth(&frame.gpu), BufferPlan::stencil8()]
+            .into_iter()
+            .chain(frame.gpu.hiz.then(|| BufferPlan::hiz_zmin_zmax(&frame.gpu)))
+            .collect(),
         settings: serde_json::json!({ "mode": options.mode.written(), "resolved": settings, "gpu": frame.gpu }),
     };
     let passes = vec![frame.pass.clone(), pass];

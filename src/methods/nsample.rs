@@ -243,7 +243,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             frame.pass.name.clone(),
             format!("{pass_name} ×{}", samples.len()),
         ],
-        buffers: vec![
+        buffers: [
             BufferPlan::depth(&frame.gpu),
             BufferPlan::stencil8(),
             BufferPlan {
@@ -251,7 +251,10 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
                 format: "f64x3".into(),
                 bytes_per_sample: 24,
             },
-        ],
+        ]
+        .into_iter()
+        .chain(frame.gpu.hiz.then(|| BufferPlan::hiz_zmin_zmax(&frame.gpu)))
+        .collect(),
         settings: serde_json::json!({ "n": samples.len(), "pattern": "centered", "mode": mode.written(), "resolved": settings, "colored": colored, "gpu": frame.gpu }),
     };
     let passes = vec![frame.pass.clone(), pass];

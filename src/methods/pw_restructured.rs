@@ -680,15 +680,8 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     names.extend(passes.iter().map(|p| p.name.clone()));
     let mut buffers = vec![BufferPlan::depth(&frame.gpu), li_buffer_plan(s.wedge.li)];
     if s.culling != Culling::Off {
-        // The depth tiles' zmin and zmax (Paper II §4), in the depth format: two values per
-        // tile, rounded up to whole bytes per sample.
-        let tile_len = frame.gpu.tile_size * frame.gpu.tile_size;
-        let per_tile = 2 * frame.gpu.depth.bytes() as u32;
-        buffers.push(BufferPlan {
-            name: format!("tile zmin/zmax (2 per {0}×{0} tile)", frame.gpu.tile_size),
-            format: format!("{:?}", frame.gpu.depth),
-            bytes_per_sample: per_tile.div_ceil(tile_len),
-        });
+        // The depth tiles' zmin and zmax (Paper II §4).
+        buffers.push(BufferPlan::hiz_zmin_zmax(&frame.gpu));
     }
     if s.passes == Passes::Three {
         buffers.push(BufferPlan {

@@ -692,6 +692,11 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         format: format!("{:?}", settings.vbuffer),
         bytes_per_sample: settings.vbuffer.bytes(),
     });
+    if frame.gpu.hiz {
+        // Pass 1 (hard quads or the 8-bit version's stencil) and the wedges.
+        buffers.push(BufferPlan::hiz_zmin_zmax(&frame.gpu));
+        buffers.push(BufferPlan::hiz_receiver_bounds(&frame.gpu));
+    }
     let plan = MethodPlan {
         method: "ssv".into(),
         passes: passes.iter().map(|p| p.name.clone()).collect(),

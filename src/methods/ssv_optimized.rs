@@ -1123,6 +1123,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             format: "RGB16F (world positions, Paper IV §4.2)".into(),
             bytes_per_sample: 6,
         }))
+        .chain(frame.gpu.hiz.then(|| BufferPlan::hiz_zmin_zmax(&frame.gpu)))
         .collect(),
         settings: serde_json::json!({ "resolved": s, "gpu": frame.gpu }),
     };
