@@ -96,6 +96,7 @@ use crate::options::{option_names, option_table, OptionTable, OptionType};
 use crate::plan::{BufferPlan, CountMode, MethodPlan};
 use crate::scene::LightShape;
 use glam::DVec3;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -425,6 +426,12 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSett
     };
     let bounds = frame.gpu.hiz.then(|| frame.receiver_bounds());
     let rounding = InsideTestRounding::new(T::PRECISION.format());
+    // Per tile, the last wedge the unit decided and its decision, `(edge + 1) << 1 | culled`
+    // (each tile is drawn by one thread, in submission order: the same decisions for any
+    // thread count).
+    let last_wedge: Vec<AtomicU64> = (0..tiling.tile_count())
+        .map(|_| AtomicU64::new(0))
+        .collect();
     pass2 += draw_probed(
         tiling,
         &mut vbuf,
@@ -437,14 +444,24 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSett
             };
             // The tile's receiver box against the wedge's inside test (crate::gpu::hiz); a
             // full-screen wedge has no inside test, and only a tile without receivers
-            // rejects it.
-            c.hiz_read_bytes += TileReceiverBounds::READ_BYTES;
-            let culled = match bounds.tile(t) {
-                None => true,
-                Some(bx) => edges[owner[tri.prim as usize] as usize]
-                    .wedge
-                    .as_ref()
-                    .is_some_and(|w| w.rejects_box(bx, &rounding)),
+            // rejects it. The unit keeps its last decision per tile: the consecutive faces of
+            // one wedge are decided (and the bounds read) once.
+            let k = owner[tri.prim as usize];
+            let key = (u64::from(k) + 1) << 1;
+            let last = last_wedge[t].load(Ordering::Relaxed);
+            let culled = if last & !1 == key {
+                last & 1 == 1
+            } else {
+                c.hiz_read_bytes += TileReceiverBounds::READ_BYTES;
+                let culled = match bounds.tile(t) {
+                    None => true,
+                    Some(bx) => edges[k as usize]
+                        .wedge
+                        .as_ref()
+                        .is_some_and(|w| w.rejects_box(bx, &rounding)),
+                };
+                last_wedge[t].store(key | culled as u64, Ordering::Relaxed);
+                culled
             };
             c.tiles_culled_hiz += culled as u64;
             if let (true, Some(probe)) = (culled, &probe) {
