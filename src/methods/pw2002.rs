@@ -21,7 +21,10 @@
 //!
 //! Options ([`Pw2002Options`]): `side-planes = compute|cancel` ([`SidePlanes`]: the §4
 //! pseudocode, default, or the §5 shortcut — 255 on front planes, 0 on back and side planes;
-//! pw2002 only), and, shared with `pw-restructured` ([`WedgeKeys`]), `li = 16|12|8` (bits),
+//! pw2002 only), `hiz = off|on` (the hierarchical-Z unit, [`crate::gpu::hiz`], rejects a wedge
+//! face for a tile when it lies at or behind every stored depth there: such fragments fail
+//! the depth test and add nothing; off by default because Paper I ran without it; needs
+//! `[options.gpu] hiz = on`; the same image either way), and, shared with `pw-restructured` ([`WedgeKeys`]), `li = 16|12|8` (bits),
 //! `overflow = wrap|saturate`, `falloff = linear|smoothstep`
 //! (s' = 3s² − 2s³, §4.2), `corner-wedges = on|off` (Fig. 7), `parallel-rule = on|off` (§8),
 //! `lights = shared|separate` ([`MultiLight`]: several lights in one LI buffer with amounts
@@ -43,6 +46,7 @@
 //! its wraps or saturations per pixel and the pixels the resolve clamps ([`li_dump`]).
 
 use super::dump::{li_values, row_major, BufferDump, ElementFormat, EventKind, EventMap};
+use super::hard_sv::HIZ_CULLED;
 use super::output::{MethodOutput, PassStats, Visibility};
 use super::Falloff;
 use crate::error::InputError;
@@ -55,7 +59,7 @@ use crate::gpu::buffers::alloc_tiles;
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::li_buffer::{li_clamped, li_visibility, LiFormat, LiOverflow, LiTile, LI_CLEAR};
 use crate::gpu::probe::{PrimitiveKind, ProbeEvent, Raw, Tap};
-use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
+use crate::gpu::raster::{bin, draw_probed};
 use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::shader_vec::SVec3;
@@ -100,6 +104,10 @@ pub struct WedgeSettings {
     pub smooth: bool,
     /// Values at entry and exit points (pw2002 only; Paper I §4 vs §5).
     pub side_planes: SidePlanes,
+    /// Whether the hierarchical-Z unit rejects wedge faces behind every receiver of a tile
+    /// (pw2002 only: `[options.pw2002] hiz`, with `[options.gpu] hiz` on; Paper I ran
+    /// without it).
+    pub hiz_culling: bool,
     /// Number of lights n (LI amounts scaled by 255/n, Paper I §7).
     pub lights: u32,
     /// Several lights in one LI buffer or one per light.
@@ -157,6 +165,7 @@ impl WedgeKeys {
             overflow: self.overflow,
             smooth: self.falloff == Falloff::Smoothstep,
             side_planes: SidePlanes::Compute,
+            hiz_culling: false,
             lights: lights.len() as u32,
             multi_light: self.lights,
             wedge: WedgeOptions {
@@ -174,6 +183,8 @@ option_table! {
         ..wedges: WedgeKeys,
         /// values at a wedge's entry and exit points: computed (Paper I §4) or 255/0 with side planes cancelling (§5)
         side_planes: SidePlanes = SidePlanes::Compute;
+        /// the hierarchical-Z unit's zmax rejection of wedge faces behind every receiver of a tile (needs [options.gpu] hiz = on; Paper I ran without it; the same image either way)
+        hiz: Switch = Switch::Off;
     }
 }
 
@@ -331,7 +342,21 @@ fn render_li_with<T: ShaderFloat>(
         &rt,
         &bins,
         probe.as_ref(),
-        no_tile_culling,
+        |t, _, tri, c| {
+            // A fragment failing the depth test does nothing (below).
+            let culled =
+                s.hiz_culling && frame.hiz_rejects_depth(t, tri, depth_state.func, false, c);
+            if let (true, Some(probe)) = (culled, &probe) {
+                probe.record_culled(t, tri, HIZ_CULLED, |tap| {
+                    let wt = &tris[tri.prim as usize];
+                    match (wt.wedge, wt.kind) {
+                        (Some(wi), Some(kind)) => wedge_primitive(tap.event(), set, wi, kind, tri),
+                        _ => tap.event(),
+                    }
+                });
+            }
+            culled
+        },
         |t, tile, tri, f, c, tap| {
             let depth = &frame.tiles[t].depth;
             let (pass, z) = depth.test(&depth_state, &f, c);
@@ -439,6 +464,7 @@ pub fn options(frame: &Frame) -> Result<WedgeSettings, InputError> {
     let o = Pw2002Options::read(frame.scene)?;
     Ok(WedgeSettings {
         side_planes: o.side_planes,
+        hiz_culling: o.hiz.is_on() && frame.gpu.hiz,
         ..o.wedges.settings(frame)?
     })
 }
@@ -463,7 +489,10 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let plan = MethodPlan {
         method: "pw2002".into(),
         passes: vec![frame.pass.name.clone(), "wedges".into()],
-        buffers: vec![BufferPlan::depth(&frame.gpu), li_buffer_plan(s.li)],
+        buffers: [BufferPlan::depth(&frame.gpu), li_buffer_plan(s.li)]
+            .into_iter()
+            .chain(s.hiz_culling.then(|| BufferPlan::hiz_zmin_zmax(&frame.gpu)))
+            .collect(),
         settings: serde_json::json!({
             "settings": s,
             "wedges": set.wedges.len(),
