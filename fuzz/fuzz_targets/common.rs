@@ -586,12 +586,12 @@ fn rect_condition(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
     let lp = l.local(p);
     let p_size = size(p, lp);
     let (mut terms, mut smallest) = (0.0f64, f64::INFINITY);
-    let mut projected = Vec::new();
-    for e in [e0, e1] {
+    let mut projected = [DVec2::ZERO; 2];
+    for (i, e) in [e0, e1].into_iter().enumerate() {
         let le = l.local(e);
         let s = le.x * lp.z - lp.x * le.z;
         let t = le.y * lp.z - lp.y * le.z;
-        projected.push(DVec2::new(s, t));
+        projected[i] = DVec2::new(s, t);
         terms = terms
             .max(size(e, le) * lp.z.abs() + p_size * le.z.abs())
             .max(lp.z.abs() + le.z.abs());
@@ -605,7 +605,7 @@ fn rect_condition(l: &RectLight, p: DVec3, e0: DVec3, e1: DVec3) -> f64 {
     // it runs through the center, the quad's region flips between the two half-lights (p
     // crosses the quad's plane as seen in the light's frame). Found by fuzzing: the
     // 1.5·10²⁶ light above, the line 10⁻²⁵ of the light from its center.
-    let [a, b] = [projected[0], projected[1]];
+    let [a, b] = projected;
     smallest = smallest.min(a.perp_dot(b).abs() / a.length().max(b.length()));
     let (l0, l1) = (l.local(e0), l.local(e1));
     // The edge's points at the light's plane (height 0) and at p's level, relative to the

@@ -113,13 +113,6 @@ impl DepthTile {
         e.depth(self.format, func, z, self.values[i], pass)
     }
 
-    /// Hierarchical-Z rejection for a LESS test against this tile: true when every sample of
-    /// the triangle is at or behind every stored sample (triangle zmin ≥ tile zmax), i.e. no
-    /// fragment of it can pass. Reads the tile's zmax (not counted as depth traffic: on-chip).
-    pub fn rejects_less(&self, tri: &RasterTriangle) -> bool {
-        self.depth_outcome(DepthFunc::Less, tri) == Some(false)
-    }
-
     /// The outcome every fragment of `tri` in this tile has under the depth test `func`, when
     /// the tile's zmin/zmax decide it for all of them ([`super::hiz`]): `Some(false)` when
     /// none can pass, `Some(true)` when all pass, `None` when it depends on the sample. A

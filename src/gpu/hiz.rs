@@ -29,6 +29,11 @@ use super::shader_float::FloatFormat;
 use super::tiling::Tiling;
 use glam::DVec3;
 
+/// The probe's note for a triangle the zmin/zmax test rejected for the probed pixel's tile
+/// (`Frame::hiz_rejects_depth`).
+pub const HIZ_CULLED: &str =
+    "culled for the tile by the hierarchical Z (zmin/zmax): no fragment could change a buffer";
+
 /// Per screen tile, the axis-aligned box of the receiver points its fragment programs read
 /// (module doc), `None` for a tile with no receiver.
 #[derive(Debug, Clone, PartialEq)]

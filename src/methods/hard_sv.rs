@@ -26,6 +26,7 @@ use crate::geometry::shadow_volume::{shadow_volume_parts, shadow_volume_triangle
 use crate::gpu::buffers::{alloc_tiles, StencilTile};
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
+use crate::gpu::hiz::HIZ_CULLED;
 use crate::gpu::probe::Raw;
 use crate::gpu::raster::{bin, draw_probed};
 use crate::gpu::setup::CullMode;
@@ -42,6 +43,15 @@ pub enum ShadowTest {
     ZPass,
     /// Count volume boundaries between the receiver and infinity (caps needed).
     ZFail,
+}
+
+impl ShadowTest {
+    /// The outcome of the LESS depth test on which a volume face counts nothing — z-pass counts
+    /// where it passes, z-fail where it fails — so a tile where every fragment has it can be
+    /// skipped ([`Frame::hiz_rejects_depth`]).
+    pub fn idle_outcome(self) -> bool {
+        self == ShadowTest::ZFail
+    }
 }
 
 /// Stencil overflow behaviour.
@@ -184,8 +194,6 @@ pub fn stencil_shadow(
             (CullMode::Back, "/front-faces"),
         ],
     };
-    // The depth-test outcome whose stencil ops are all Keep (volume_stencil_state).
-    let idle = s.test == ShadowTest::ZFail;
     let tiling = &frame.tiling;
     let name = shadow_volume_pass(s.test);
     let mut stencil = alloc_tiles(tiling, |_, len| {
@@ -205,7 +213,7 @@ pub fn stencil_shadow(
             &bins,
             probe.as_ref(),
             |t, _, tri, c| {
-                let culled = frame.hiz_rejects_depth(t, tri, depth.func, idle, c);
+                let culled = frame.hiz_rejects_depth(t, tri, depth.func, s.test.idle_outcome(), c);
                 if let (true, Some(probe), Some(parts)) = (culled, &probe, &parts) {
                     probe.record_culled(t, tri, HIZ_CULLED, |tap| {
                         let (kind, detail) = parts[tri.prim as usize].describe();
@@ -234,11 +242,6 @@ pub fn stencil_shadow(
     }
     (stencil, counters)
 }
-
-/// The probe's note for a triangle the hierarchical Z rejected for the probed pixel's tile
-/// ([`Frame::hiz_rejects_depth`]).
-pub const HIZ_CULLED: &str =
-    "culled for the tile by the hierarchical Z (zmin/zmax): no fragment could change a buffer";
 
 /// Row-major stencil values.
 pub fn stencil_row_major(frame: &Frame, tiles: &[StencilTile]) -> Vec<u8> {

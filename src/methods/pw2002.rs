@@ -46,7 +46,6 @@
 //! its wraps or saturations per pixel and the pixels the resolve clamps ([`li_dump`]).
 
 use super::dump::{li_values, row_major, BufferDump, ElementFormat, EventKind, EventMap};
-use super::hard_sv::HIZ_CULLED;
 use super::output::{MethodOutput, PassStats, Visibility};
 use super::Falloff;
 use crate::error::InputError;
@@ -57,6 +56,7 @@ use crate::geometry::penumbra_wedge::{
 };
 use crate::gpu::buffers::alloc_tiles;
 use crate::gpu::depth::{DepthFunc, DepthState};
+use crate::gpu::hiz::HIZ_CULLED;
 use crate::gpu::li_buffer::{li_clamped, li_visibility, LiFormat, LiOverflow, LiTile, LI_CLEAR};
 use crate::gpu::probe::{PrimitiveKind, ProbeEvent, Raw, Tap};
 use crate::gpu::raster::{bin, draw_probed};

@@ -259,13 +259,13 @@ impl Ctx<'_> {
         if self.s.culling == Culling::Off {
             return false;
         }
-        let d = &self.frame.tiles[t].depth;
-        match self.s.test {
-            // Every fragment at or behind every stored depth: none passes LESS.
-            WedgeTest::ZPass => d.rejects_less(tri),
-            // Every fragment in front of every stored depth: none fails LESS.
-            WedgeTest::ZFail => d.format.quantize(tri.z_range[1]) < d.zmin,
-        }
+        // z-pass adds nothing where LESS fails (every fragment at or behind every stored
+        // depth), z-fail nothing where it passes (every fragment in front of every one).
+        let idle = self.s.test == WedgeTest::ZFail;
+        self.frame.tiles[t]
+            .depth
+            .depth_outcome(DepthFunc::Less, tri)
+            == Some(idle)
     }
 
     /// Whether the penumbra contribution of `tri` is culled in tile `t` (§4).

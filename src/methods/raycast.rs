@@ -562,9 +562,11 @@ impl ShadowRayCaster {
         let origin = r.point.as_dvec3() + self.origin_offset * r.normal.as_dvec3();
         scratch.lit.clear();
         scratch.lit.resize(samples.len(), true);
-        let binned = samples.len() >= BINNED_MIN_SAMPLES
-            && self.trace_binned(origin, samples, quad, scratch);
-        if !self.nodes.is_empty() && !binned {
+        // Below the threshold, or where the shaft does not apply, each ray through the tree.
+        let binned = |scratch: &mut Scratch| {
+            samples.len() >= BINNED_MIN_SAMPLES && self.trace_binned(origin, samples, quad, scratch)
+        };
+        if !self.nodes.is_empty() && !binned(scratch) {
             self.trace_each(origin, samples, scratch);
         }
         // The receiver's own surface hides every sample at or below its tangent plane (module

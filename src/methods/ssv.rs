@@ -64,8 +64,8 @@
 //! umbra counts of pass 1.
 
 use super::dump::{row_major, BufferDump, ElementFormat, EventKind, EventMap, VBufferDump};
+use super::hard_sv::stencil_dump;
 use super::hard_sv::{shadow_test, stencil_row_major, stencil_shadow, ShadowTest, StencilOverflow};
-use super::hard_sv::{stencil_dump, HIZ_CULLED};
 use super::hard_sv::{StencilShadowSettings, Submission};
 use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
@@ -75,7 +75,7 @@ use crate::geometry::silhouette::{light_facing, possible_silhouettes};
 use crate::geometry::ssv_wedge::{SsvWedge, WedgeLight};
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
-use crate::gpu::hiz::{InsideTestRounding, TileReceiverBounds};
+use crate::gpu::hiz::{InsideTestRounding, TileReceiverBounds, HIZ_CULLED};
 use crate::gpu::probe::{PrimitiveKind, Tap};
 use crate::gpu::raster::{bin, draw_probed};
 use crate::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
@@ -628,9 +628,7 @@ fn hard_quads_pass<V: VBufferTile>(frame: &Frame, test: ShadowTest, vbuf: &mut [
         &bins,
         probe.as_ref(),
         |t, _, tri, c| {
-            // z-pass counts nothing where the test fails, z-fail nothing where it passes.
-            let idle = test == ShadowTest::ZFail;
-            let culled = frame.hiz_rejects_depth(t, tri, depth.func, idle, c);
+            let culled = frame.hiz_rejects_depth(t, tri, depth.func, test.idle_outcome(), c);
             if let (true, Some(probe)) = (culled, &probe) {
                 probe.record_culled(t, tri, HIZ_CULLED, |tap| {
                     let e = tap.event();

@@ -99,7 +99,6 @@
 use super::dump::{
     receiver_pixels, row_major, BufferDump, DumpValues, ElementFormat, EventKind, EventMap,
 };
-use super::hard_sv::HIZ_CULLED;
 use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, BACKGROUND};
@@ -113,6 +112,7 @@ use crate::geometry::tight_wedge::{
 use crate::gpu::buffers::{alloc_tiles, StencilTile};
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
+use crate::gpu::hiz::HIZ_CULLED;
 use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw};
 use crate::gpu::raster::{bin, draw_probed};
 use crate::gpu::setup::{CullMode, RasterTriangle};
