@@ -24,6 +24,34 @@ pub struct DepthTile {
     pub zmin: u32,
     /// Largest stored value over the tile's pixels inside the image.
     pub zmax: u32,
+    /// The smallest window depth that quantizes to `zmax` or more ([`first_quantized_at_least`]):
+    /// a fragment at or beyond it is behind every stored sample. Kept with `zmax` so that the
+    /// hierarchical-Z test compares the triangle's f32 depth range without quantizing it.
+    behind_from: f32,
+    /// The smallest window depth that quantizes to `zmin` or more: a fragment before it is in
+    /// front of every stored sample.
+    in_front_below: f32,
+}
+
+/// The smallest window depth in [0, 1] that `format` quantizes to `q` or more, `+∞` when none
+/// does: a binary search over the ordered bit patterns of the non-negative f32, exact because
+/// quantizing is monotone. For every finite `z ≥ 0` (a triangle's depth range is clamped to
+/// [0, 1]), `quantize(z) >= q` ⇔ `z >= first_quantized_at_least(q)`.
+fn first_quantized_at_least(format: DepthFormat, q: u32) -> f32 {
+    let (mut lo, mut hi) = (0u32, 1.0f32.to_bits());
+    if format.quantize(f32::from_bits(hi)) < q {
+        return f32::INFINITY;
+    }
+    // Invariant: quantize(hi) >= q, and quantize(b) < q for every bit pattern b < lo.
+    while lo < hi {
+        let mid = lo + (hi - lo) / 2;
+        if format.quantize(f32::from_bits(mid)) >= q {
+            hi = mid;
+        } else {
+            lo = mid + 1;
+        }
+    }
+    f32::from_bits(hi)
 }
 
 impl DepthTile {
@@ -41,6 +69,8 @@ impl DepthTile {
             values: vec![z; len],
             zmin: z,
             zmax: z,
+            behind_from: first_quantized_at_least(format, z),
+            in_front_below: first_quantized_at_least(format, z),
         }
     }
 
@@ -73,6 +103,8 @@ impl DepthTile {
         }
         self.zmin = lo;
         self.zmax = hi;
+        self.behind_from = first_quantized_at_least(self.format, hi);
+        self.in_front_below = first_quantized_at_least(self.format, lo);
     }
 
     /// The depth test of fragment `f` against this tile (reads the stored value, counted).
@@ -121,16 +153,14 @@ impl DepthTile {
     /// depth 0 is left undecided (a fragment depth of −0.0 quantizes out of order in D32F).
     /// Only `Less` and `GEqual` are decided; other functions give `None`.
     pub fn depth_outcome(&self, func: DepthFunc, tri: &RasterTriangle) -> Option<bool> {
-        if tri.z_range[0].is_nan() || tri.z_range[0] <= 0.0 {
+        let [near, far] = tri.z_range;
+        if near.is_nan() || far.is_nan() || near <= 0.0 {
             return None;
         }
-        let (near, far) = (
-            self.format.quantize(tri.z_range[0]),
-            self.format.quantize(tri.z_range[1]),
-        );
-        // Every fragment at or behind every stored sample / in front of every one.
-        let behind = near >= self.zmax;
-        let in_front = far < self.zmin;
+        // Every fragment at or behind every stored sample (quantize(near) >= zmax) / in front
+        // of every one (quantize(far) < zmin), decided on the unquantized depths.
+        let behind = near >= self.behind_from;
+        let in_front = far < self.in_front_below;
         match func {
             DepthFunc::Less if behind => Some(false),
             DepthFunc::Less if in_front => Some(true),
@@ -144,6 +174,43 @@ impl DepthTile {
     /// depth format; [`Counters::hiz_read_bytes`]).
     pub fn hiz_read_bytes(&self) -> u64 {
         2 * self.format.bytes()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The thresholds decide `quantize(z) >= q` exactly as quantizing does, for every format,
+    /// at and around every threshold and over a sweep of depths.
+    #[test]
+    fn thresholds_agree_with_quantizing() {
+        for format in [DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F] {
+            let stored: Vec<u32> = [0.0f32, 1e-30, 1e-7, 0.25, 0.5, 0.7071, 0.999_999, 1.0]
+                .iter()
+                .map(|&z| format.quantize(z))
+                .chain([format.far() + 1, 0])
+                .collect();
+            for &q in &stored {
+                let t = first_quantized_at_least(format, q);
+                let mut probes: Vec<f32> = (0..=1000).map(|k| k as f32 / 1000.0).collect();
+                if t.is_finite() {
+                    probes.extend([
+                        t,
+                        f32::from_bits(t.to_bits().saturating_sub(1)),
+                        f32::from_bits(t.to_bits() + 1),
+                    ]);
+                }
+                probes.extend([1.5, 1e-45]);
+                for z in probes {
+                    assert_eq!(
+                        format.quantize(z) >= q,
+                        z >= t,
+                        "{format:?} q {q} z {z:e} t {t:e}"
+                    );
+                }
+            }
+        }
     }
 }
 

@@ -26,25 +26,52 @@ pub struct Fragment {
     pub z: f32,
 }
 
-/// Per-tile lists of triangle indices, in submission order.
+/// Per-tile lists of triangle indices, in submission order, stored one after the other
+/// (compressed rows: tile t's list is `indices[starts[t]..starts[t + 1]]`), so that binning
+/// makes two allocations however many tiles and triangles there are.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Bins {
-    /// `tiles[t]` lists the triangles whose bounding box touches tile t.
-    pub tiles: Vec<Vec<u32>>,
+    /// Where each tile's list starts in `indices`, with the total length appended.
+    starts: Vec<u32>,
+    /// Every tile's triangle indices, tile after tile.
+    indices: Vec<u32>,
 }
 
-/// Bin triangles to tiles by bounding box.
+impl Bins {
+    /// The triangles whose bounding box touches tile `t`, in submission order.
+    pub fn tile(&self, t: usize) -> &[u32] {
+        &self.indices[self.starts[t] as usize..self.starts[t + 1] as usize]
+    }
+}
+
+/// The tiles triangle `t`'s bounding box touches, row by row.
+fn bbox_tiles(tiling: &Tiling, t: &RasterTriangle) -> impl Iterator<Item = usize> {
+    let [x0, y0, x1, y1] = t.bbox;
+    let (tile, tiles_x) = (tiling.tile, tiling.tiles_x);
+    (y0 / tile..=y1 / tile)
+        .flat_map(move |ty| (x0 / tile..=x1 / tile).map(move |tx| (ty * tiles_x + tx) as usize))
+}
+
+/// Bin triangles to tiles by bounding box (a counting sort: count per tile, then place).
 pub fn bin(tiling: &Tiling, tris: &[RasterTriangle]) -> Bins {
-    let mut tiles = vec![Vec::new(); tiling.tile_count()];
-    for (k, t) in tris.iter().enumerate() {
-        let [x0, y0, x1, y1] = t.bbox;
-        for ty in y0 / tiling.tile..=y1 / tiling.tile {
-            for tx in x0 / tiling.tile..=x1 / tiling.tile {
-                tiles[(ty * tiling.tiles_x + tx) as usize].push(k as u32);
-            }
+    let mut starts = vec![0u32; tiling.tile_count() + 1];
+    for t in tris {
+        for tile in bbox_tiles(tiling, t) {
+            starts[tile + 1] += 1;
         }
     }
-    Bins { tiles }
+    for k in 1..starts.len() {
+        starts[k] += starts[k - 1];
+    }
+    let mut next = starts.clone();
+    let mut indices = vec![0u32; *starts.last().expect("one entry per tile and the end") as usize];
+    for (k, t) in tris.iter().enumerate() {
+        for tile in bbox_tiles(tiling, t) {
+            indices[next[tile] as usize] = k as u32;
+            next[tile] += 1;
+        }
+    }
+    Bins { starts, indices }
 }
 
 /// How a triangle relates to a tile.
@@ -179,7 +206,7 @@ where
             let mut c = Counters::default();
             let rect = tiling.rect(t);
             let watched = probe.filter(|p| p.watches_tile(t));
-            for &k in &bins.tiles[t] {
+            for &k in bins.tile(t) {
                 let tri = &tris[k as usize];
                 if skip_tile(t, storage, tri, &mut c) {
                     continue;

@@ -251,6 +251,11 @@ pub fn setup_all_barycentric(
     setup_all_with(prims, tiling, cull, true)
 }
 
+/// Submitted triangles one parallel task sets up: large enough that a task's set-up is not
+/// lost in scheduling and allocation (one vector per task, not per triangle), small enough
+/// that two threads share a few thousand triangles evenly.
+const SETUP_CHUNK: usize = 256;
+
 fn setup_all_with(
     prims: &[[ClipVertex; 3]],
     tiling: &Tiling,
@@ -263,13 +268,17 @@ fn setup_all_with(
         height: tiling.height,
         barycentric,
     };
+    // Chunks of submitted triangles set up in parallel, each into one vector: concatenated
+    // in chunk order, the triangles keep submission order for any thread count.
     let parts: Vec<(Vec<RasterTriangle>, Counters)> = prims
-        .par_iter()
+        .par_chunks(SETUP_CHUNK)
         .enumerate()
-        .map(|(k, p)| {
-            let mut out = Vec::new();
+        .map(|(chunk, ps)| {
+            let mut out = Vec::with_capacity(ps.len());
             let mut c = Counters::default();
-            setup_with(p, k as u32, state, &mut out, &mut c);
+            for (k, p) in ps.iter().enumerate() {
+                setup_with(p, (chunk * SETUP_CHUNK + k) as u32, state, &mut out, &mut c);
+            }
             (out, c)
         })
         .collect();
