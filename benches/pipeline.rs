@@ -1,80 +1,146 @@
-//! Criterion benchmarks of the rendering pipeline on the built-in `cube-of-spheres` scene at
-//! 256×256:
+//! Criterion benchmarks of the rendering pipeline: every method of [`penumbra::methods::ALL`]
+//! at 256×256 and 512×512 on the built-in `cube-of-spheres` (4548 triangles) and on the
+//! heavier `forest-spheres` (20 532 triangles, Forest et al. 2006 Fig. 1), both under their
+//! rectangular light.
+//!
+//! Each scene and size is one benchmark group named `SCENE-SIZE` (`cube-of-spheres-256`,
+//! `cube-of-spheres-512`, `forest-spheres-256`, `forest-spheres-512`) with these functions:
 //!
 //! * `scene-depth`: the shared first pass of every frame ([`Frame::render`]: adjacency, the
 //!   depth pass and hierarchical Z);
 //! * `hard-sv/zpass`, `hard-sv/zfail`: one hard shadow-volume stencil pass from the light
 //!   center ([`stencil_shadow`]) against a frame rendered once up front;
-//! * `method/nsample-n16`: the `nsample` method with `n = 16` (16 stencil passes and their
-//!   accumulation) on that frame;
-//! * `method/raycast-samples16`: the `raycast` reference with `samples = 16` on that frame;
-//! * `method/ssv`, `method/wedge-blending-8bit`, `method/wedge-blending-f32`: the soft shadow
-//!   volumes of Paper III and penumbra-wedges blending (Forest et al. 2006, packed and
-//!   unpacked) side by side on that frame;
-//! * `method/hard-sv`, `method/ssv-optimized`: the remaining methods that take the rectangular
-//!   light, on that frame, so that every method of [`penumbra::methods::ALL`] is timed;
-//! * `method/pw2002`, `method/pw-restructured`, `method/penumbra-map`: the methods that take
-//!   only spherical lights, on `cube-of-spheres-sphere` (the same occluders under a sphere
-//!   light) at 256×256;
-//! * `method/dbuffer`: the D-buffer (CGI 2004), which takes only disk lights, on `disk-block`
-//!   at 256×256.
+//! * `raycast-samples16`: the `raycast` reference with `samples = 16`;
+//! * `nsample-n16`: the `nsample` method with `n = 16` (16 stencil passes and their
+//!   accumulation);
+//! * `hard-sv`, `ssv-optimized`, `ssv`: the methods that take the rectangular light as it is;
+//! * `wedge-blending-8bit`, `wedge-blending-f32`: penumbra-wedges blending (Forest et al.
+//!   2006), packed (the default) and unpacked (`packing = "f32"`);
+//! * `pw2002`, `pw-restructured`, `penumbra-map`: the methods that take only sphere lights, on
+//!   the same occluders, camera and size with the rectangle swapped for a sphere of radius the
+//!   rectangle's half extent at the same center (for `cube-of-spheres` that is the built-in
+//!   `cube-of-spheres-sphere`);
+//! * `dbuffer`: the D-buffer (CGI 2004), which takes only disk lights, on the same occluders
+//!   under a disk of that radius at the same center facing straight down onto the floor (the
+//!   construction of the built-in disk scenes, `disk_down` in `src/scene/builtin.rs`). Every
+//!   method runs on every scene here; none refuses one.
 //!
-//! The method benchmarks run [`penumbra::methods::run`] on a prebuilt frame, so they exclude
-//! the depth pass (measured on its own) and the shading of the image.
+//! `forest-spheres-256` also has `raycast-samples1024`: the reference with 1024 samples, the
+//! sample count the issue compares with 16 on that scene.
 //!
-//! Sample counts and measurement times are kept small so that `cargo bench --bench pipeline`
-//! finishes well within three minutes on a shared two-core machine. Run with
-//! `cargo bench --bench pipeline`; `cargo test` does not build or run this target. Criterion
-//! writes its HTML report to `target/criterion/report/index.html`.
+//! The method benchmarks run [`penumbra::methods::run`] on a prebuilt frame (the sphere- and
+//! disk-lit frames share the rect frame's scene pass, [`Frame::lit_by`]), so they exclude the
+//! depth pass (measured on its own) and the shading of the image.
+//!
+//! Run everything with `cargo bench --bench pipeline`; criterion's name filter runs a subset,
+//! e.g. `cargo bench --bench pipeline -- forest-spheres-256` (one group),
+//! `cargo bench --bench pipeline -- /ssv$` (`ssv` in every group) or
+//! `cargo bench --bench pipeline -- --list` (the names only). `cargo test` does not build or
+//! run this target. Criterion writes its HTML report to `target/criterion/report/index.html`.
+//!
+//! Budget: flat sampling, 10 samples, 2 s of measurement after 0.5 s of warm-up per
+//! benchmark (a benchmark whose iteration takes longer than 0.2 s runs 10 iterations, one per
+//! sample; criterion then warns that it could not complete 10 samples in 2 s, which is
+//! expected). The whole file took 410 s (about 7 minutes) on a shared two-core machine.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, SamplingMode};
+use glam::Vec3;
 use penumbra::frame::{Frame, GpuSettings};
 use penumbra::methods::hard_sv::{
     stencil_shadow, ShadowTest, StencilOverflow, StencilShadowSettings, Submission,
 };
-use penumbra::scene::{builtin, OptionValue, Scene};
+use penumbra::scene::{builtin, LightShape, OptionValue, Scene};
 use std::time::Duration;
 
-/// The benchmarked scene.
-const SCENE: &str = "cube-of-spheres";
-/// Image width and height in pixels.
-const SIZE: u32 = 256;
+/// The benchmarked built-in scenes, both under a rectangular light.
+const SCENES: &[&str] = &["cube-of-spheres", "forest-spheres"];
+/// Image widths (and heights) in pixels.
+const SIZES: &[u32] = &[256, 512];
 
-/// The methods timed on [`SCENE`] besides those with options of their own (`nsample`,
-/// `raycast`, `wedge-blending`), which take the rectangular light.
-const RECT_METHODS: &[&str] = &["hard-sv", "ssv-optimized", "ssv"];
-/// The methods that take only spherical lights, timed on [`SPHERE_SCENE`].
-const SPHERE_METHODS: &[&str] = &["pw2002", "pw-restructured", "penumbra-map"];
-/// [`SCENE`]'s occluders under a sphere light.
-const SPHERE_SCENE: &str = "cube-of-spheres-sphere";
-/// The methods that take only disk lights, timed on [`DISK_SCENE`].
-const DISK_METHODS: &[&str] = &["dbuffer"];
-/// The built-in scene of the D-buffer paper's Fig. 1/7.
-const DISK_SCENE: &str = "disk-block";
+/// How the frame of a benchmark is lit: the scene's rectangle, or its occluders under another
+/// light or with another option (index into the frames of [`variants`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Variant {
+    /// The scene as built in (rectangular light), `nsample.n = 16`, `raycast.samples = 16`.
+    Rect = 0,
+    /// [`Variant::Rect`] with `wedge-blending.packing = "f32"`.
+    RectUnpacked = 1,
+    /// The rectangle swapped for a sphere of radius its half extent, same center.
+    Sphere = 2,
+    /// The rectangle swapped for a downward-facing disk of radius its half extent.
+    Disk = 3,
+}
 
-/// The built-in scene `name` at [`SIZE`]×[`SIZE`].
-fn sized(name: &str) -> Scene {
+/// Every method benchmark of a group: (function name, method, the frame it runs on).
+const METHOD_BENCHES: &[(&str, &str, Variant)] = &[
+    ("raycast-samples16", "raycast", Variant::Rect),
+    ("nsample-n16", "nsample", Variant::Rect),
+    ("hard-sv", "hard-sv", Variant::Rect),
+    ("pw2002", "pw2002", Variant::Sphere),
+    ("pw-restructured", "pw-restructured", Variant::Sphere),
+    ("ssv-optimized", "ssv-optimized", Variant::Rect),
+    ("ssv", "ssv", Variant::Rect),
+    ("wedge-blending-8bit", "wedge-blending", Variant::Rect),
+    (
+        "wedge-blending-f32",
+        "wedge-blending",
+        Variant::RectUnpacked,
+    ),
+    ("penumbra-map", "penumbra-map", Variant::Sphere),
+    ("dbuffer", "dbuffer", Variant::Disk),
+];
+
+/// The scene and size whose group also times `raycast` at 1024 samples.
+const RAYCAST_1024_AT: (&str, u32) = ("forest-spheres", 256);
+
+/// The built-in scene `name` at `size`×`size` with `nsample.n = 16` and
+/// `raycast.samples = 16`.
+fn sized(name: &str, size: u32) -> Scene {
     let mut scene = builtin::load(name).expect("built-in scene");
-    scene.width = SIZE;
-    scene.height = SIZE;
+    scene.resize(Some(size), Some(size));
+    set_option(&mut scene, "nsample", "n", OptionValue::Int(16));
+    set_option(&mut scene, "raycast", "samples", OptionValue::Int(16));
     scene
 }
 
-/// `cube-of-spheres` at [`SIZE`]×[`SIZE`] with `nsample.n = 16` and `raycast.samples = 16`.
-fn scene() -> Scene {
-    let mut scene = sized(SCENE);
-    set_option(&mut scene, "nsample", "n", 16);
-    set_option(&mut scene, "raycast", "samples", 16);
-    scene
-}
-
-/// Sets the integer option `method.key = value` on `scene`.
-fn set_option(scene: &mut Scene, method: &str, key: &str, value: i64) {
+/// Sets the option `method.key = value` on `scene`.
+fn set_option(scene: &mut Scene, method: &str, key: &str, value: OptionValue) {
     scene
         .options
         .entry(method.to_string())
         .or_default()
-        .insert(key.to_string(), OptionValue::Int(value));
+        .insert(key.to_string(), value);
+}
+
+/// `scene` (one rectangular light) with that light's shape replaced by `shape(r)`, `r` the
+/// rectangle's half extent along `u`.
+fn relit(scene: &Scene, shape: impl Fn(f32) -> LightShape) -> Scene {
+    let mut out = scene.clone();
+    let LightShape::Rect { u, .. } = scene.light().shape else {
+        panic!("{} has no rectangular light", scene.source);
+    };
+    out.lights[0].shape = shape(u.length());
+    out
+}
+
+/// The scenes of [`Variant`], in its order, for the rect-lit `scene`.
+fn variants(scene: &Scene) -> Vec<Scene> {
+    let mut unpacked = scene.clone();
+    set_option(
+        &mut unpacked,
+        "wedge-blending",
+        "packing",
+        OptionValue::Str("f32".into()),
+    );
+    vec![
+        scene.clone(),
+        unpacked,
+        relit(scene, |radius| LightShape::Sphere { radius }),
+        relit(scene, |radius| LightShape::Disk {
+            radius,
+            normal: Vec3::NEG_Y,
+        }),
+    ]
 }
 
 /// Stencil settings for one hard-shadow pass with the given counting direction (wrap,
@@ -87,87 +153,80 @@ fn stencil_settings(test: ShadowTest) -> StencilShadowSettings {
     }
 }
 
-/// Registers every benchmark of this file.
-fn pipeline(c: &mut Criterion) {
-    let scene = scene();
+/// Checks that every method of [`penumbra::methods::ALL`] has a benchmark in
+/// [`METHOD_BENCHES`].
+fn check_every_method_timed() {
+    for method in penumbra::methods::ALL {
+        assert!(
+            METHOD_BENCHES.iter().any(|(_, m, _)| m == method),
+            "method {method} has no benchmark"
+        );
+    }
+}
 
-    c.bench_function("scene-depth", |b| {
+/// Registers every benchmark of one scene at one size: the group `SCENE-SIZE`.
+fn scene_at(c: &mut Criterion, name: &str, size: u32) {
+    let scene = sized(name, size);
+    let lit = variants(&scene);
+    let frame = Frame::render(&scene, GpuSettings::default()).expect("scene pass");
+    let frames: Vec<Frame> = lit.iter().map(|s| frame.lit_by(s)).collect();
+
+    // One method iteration takes tens to hundreds of milliseconds: flat sampling runs the same
+    // small number of iterations per sample instead of criterion's linear ramp, which would
+    // need 55 iterations for 10 samples.
+    let mut group = c.benchmark_group(format!("{name}-{size}"));
+    group.sampling_mode(SamplingMode::Flat);
+
+    group.bench_function("scene-depth", |b| {
         b.iter(|| Frame::render(black_box(&scene), GpuSettings::default()).expect("scene pass"))
     });
-
-    let frame = Frame::render(&scene, GpuSettings::default()).expect("scene pass");
     let center = scene.light().center;
-    for (name, test) in [
+    for (id, test) in [
         ("hard-sv/zpass", ShadowTest::ZPass),
         ("hard-sv/zfail", ShadowTest::ZFail),
     ] {
         let settings = stencil_settings(test);
-        c.bench_function(name, |b| {
+        group.bench_function(id, |b| {
             b.iter(|| stencil_shadow(black_box(&frame), black_box(center), &settings))
         });
     }
-
-    // One iteration of these takes a few hundred milliseconds: flat sampling runs the same
-    // small number of iterations per sample instead of criterion's linear ramp, which would
-    // need 55 iterations for 10 samples.
-    let mut group = c.benchmark_group("method");
-    group.sampling_mode(SamplingMode::Flat);
-    group.measurement_time(Duration::from_secs(5));
-    let named = [
-        ("nsample-n16", "nsample"),
-        ("raycast-samples16", "raycast"),
-        ("wedge-blending-8bit", "wedge-blending"),
-    ];
-    for method in penumbra::methods::ALL {
-        let timed = named.iter().any(|(_, m)| m == method)
-            || [RECT_METHODS, SPHERE_METHODS, DISK_METHODS]
-                .iter()
-                .any(|list| list.contains(method));
-        assert!(timed, "method {method} has no benchmark");
-    }
-    let plain = RECT_METHODS.iter().map(|m| (*m, *m));
-    for (name, method) in named.into_iter().chain(plain) {
-        group.bench_function(name, |b| {
-            b.iter(|| penumbra::methods::run(black_box(method), black_box(&frame)).expect(method))
+    for &(id, method, variant) in METHOD_BENCHES {
+        let frame = &frames[variant as usize];
+        group.bench_function(id, |b| {
+            b.iter(|| penumbra::methods::run(black_box(method), black_box(frame)).expect(method))
         });
     }
-    let mut unpacked = scene.clone();
-    unpacked
-        .options
-        .entry("wedge-blending".into())
-        .or_default()
-        .insert("packing".into(), OptionValue::Str("f32".into()));
-    let unpacked_frame = frame.lit_by(&unpacked);
-    group.bench_function("wedge-blending-f32", |b| {
-        b.iter(|| {
-            penumbra::methods::run("wedge-blending", black_box(&unpacked_frame))
-                .expect("wedge-blending")
-        })
-    });
-    for (scene_name, methods) in [(SPHERE_SCENE, SPHERE_METHODS), (DISK_SCENE, DISK_METHODS)] {
-        let scene = sized(scene_name);
-        let frame = Frame::render(&scene, GpuSettings::default()).expect("scene pass");
-        for method in methods {
-            group.bench_function(*method, |b| {
-                b.iter(|| {
-                    penumbra::methods::run(black_box(method), black_box(&frame)).expect(method)
-                })
-            });
-        }
+    if (name, size) == RAYCAST_1024_AT {
+        let mut many = scene.clone();
+        set_option(&mut many, "raycast", "samples", OptionValue::Int(1024));
+        let frame = frame.lit_by(&many);
+        group.bench_function("raycast-samples1024", |b| {
+            b.iter(|| penumbra::methods::run("raycast", black_box(&frame)).expect("raycast"))
+        });
     }
     group.finish();
 }
 
-/// Small samples and short measurement windows: the whole file runs in well under three
-/// minutes, at the price of wider confidence intervals. The HTML report
-/// (`target/criterion/report/index.html`) is drawn by plotters with the crate's embedded
-/// font.
+/// Registers every benchmark of this file: [`scene_at`] for every scene of [`SCENES`] at every
+/// size of [`SIZES`].
+fn pipeline(c: &mut Criterion) {
+    check_every_method_timed();
+    for name in SCENES {
+        for &size in SIZES {
+            scene_at(c, name, size);
+        }
+    }
+}
+
+/// Small samples and short measurement windows (module doc, "Budget"), at the price of wider
+/// confidence intervals. The HTML report (`target/criterion/report/index.html`) is drawn by
+/// plotters with the crate's embedded font.
 fn config() -> Criterion {
     penumbra::experiment::plotting::register_font().expect("the embedded font");
     Criterion::default()
         .sample_size(10)
         .warm_up_time(Duration::from_millis(500))
-        .measurement_time(Duration::from_secs(3))
+        .measurement_time(Duration::from_secs(2))
 }
 
 criterion_group! {
