@@ -9,6 +9,7 @@
 use crate::error::InputError;
 use crate::geometry::adjacency::{self, Adjacency};
 use crate::gpu::buffers::{alloc_tiles, DepthTile};
+use crate::gpu::counters::count;
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFormat, DepthFunc, DepthState};
 use crate::gpu::hiz::TileReceiverBounds;
@@ -395,9 +396,9 @@ impl<'s> Frame<'s> {
             return false;
         }
         let depth = &self.tiles[t].depth;
-        c.hiz_read_bytes += depth.hiz_read_bytes();
+        count!(c.hiz_read_bytes += depth.hiz_read_bytes());
         let culled = depth.depth_outcome(func, tri) == Some(idle);
-        c.tiles_culled_hiz += culled as u64;
+        count!(c.tiles_culled_hiz += culled as u64);
         culled
     }
 

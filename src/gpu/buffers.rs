@@ -4,6 +4,7 @@
 //!
 //! Storage is tile-major (see [`super::tiling`]): one value per sample of a T×T tile.
 
+use super::counters::count;
 use super::counters::Counters;
 use super::depth::{DepthFormat, DepthFunc, DepthState};
 use super::probe::{Overflow, ProbeEvent, Raw};
@@ -77,14 +78,14 @@ impl DepthTile {
     /// Read sample `i` (counted).
     #[inline]
     pub fn read(&self, i: usize, c: &mut Counters) -> u32 {
-        c.depth_read_bytes += self.format.bytes();
+        count!(c.depth_read_bytes += self.format.bytes());
         self.values[i]
     }
 
     /// Write sample `i` (counted).
     #[inline]
     pub fn write(&mut self, i: usize, v: u32, c: &mut Counters) {
-        c.depth_write_bytes += self.format.bytes();
+        count!(c.depth_write_bytes += self.format.bytes());
         self.values[i] = v;
     }
 
@@ -123,7 +124,7 @@ impl DepthTile {
     pub fn test_and_write(&mut self, state: &DepthState, f: &Fragment, c: &mut Counters) -> bool {
         let (pass, z) = self.test(state, f, c);
         if pass {
-            c.depth_passed += 1;
+            count!(c.depth_passed += 1);
             if state.write {
                 self.write(f.local, z, c);
             }
@@ -186,7 +187,7 @@ mod tests {
     #[test]
     fn thresholds_agree_with_quantizing() {
         for format in [DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F] {
-            let stored: Vec<u32> = [0.0f32, 1e-30, 1e-7, 0.25, 0.5, 0.7071, 0.999_999, 1.0]
+            let stored: Vec<u32> = [0.0f32, 1e-30, 1e-7, 0.25, 0.5, 0.7, 0.999_999, 1.0]
                 .iter()
                 .map(|&z| format.quantize(z))
                 .chain([format.far() + 1, 0])
@@ -273,7 +274,7 @@ impl StencilTile {
         c: &mut Counters,
     ) -> StencilUpdate {
         let face = state.face(front_facing);
-        c.stencil_read_bytes += 1;
+        count!(c.stencil_read_bytes += 1);
         let stored = self.values[f.local];
         let stencil_pass = face.func.test(face.reference, stored, face.read_mask);
         let mut update = StencilUpdate {
@@ -284,8 +285,8 @@ impl StencilTile {
             overflow: false,
         };
         if let Some((v, overflow)) = face.update(stored, stencil_pass, depth_pass) {
-            c.stencil_write_bytes += 1;
-            c.overflow_events += overflow as u64;
+            count!(c.stencil_write_bytes += 1);
+            count!(c.overflow_events += overflow as u64);
             record_overflow(&mut self.overflows, f.local, overflow as u32);
             self.values[f.local] = v;
             (update.after, update.overflow) = (v, overflow);

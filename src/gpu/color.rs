@@ -15,6 +15,7 @@
 //! one target can be filled by several draws that each own some of its channels.
 
 use super::buffers::{overflow_record, record_overflow};
+use super::counters::count;
 use super::counters::Counters;
 use super::probe::Overflow;
 use half::f16;
@@ -110,8 +111,8 @@ impl ColorTile {
     #[inline]
     pub fn write(&mut self, i: usize, v: f64, c: &mut Counters) {
         let (stored, overflow) = self.format.encode(v);
-        c.color_write_bytes += self.format.bytes();
-        c.overflow_events += overflow as u64;
+        count!(c.color_write_bytes += self.format.bytes());
+        count!(c.overflow_events += overflow as u64);
         record_overflow(&mut self.overflows, i, overflow as u32);
         self.values[i] = stored;
     }
@@ -163,8 +164,8 @@ impl RgbaTile {
         for ((value, on), slot) in v.iter().zip(mask.0).zip(&mut self.values[i]) {
             if on {
                 let (stored, overflow) = self.format.encode(*value);
-                c.color_write_bytes += self.format.bytes();
-                c.overflow_events += overflow as u64;
+                count!(c.color_write_bytes += self.format.bytes());
+                count!(c.overflow_events += overflow as u64);
                 record_overflow(&mut self.overflows, i, overflow as u32);
                 *slot = stored;
             }

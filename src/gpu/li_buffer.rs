@@ -19,6 +19,7 @@
 //! are counted as colour/LI read and write traffic.
 
 use super::buffers::{overflow_record, record_overflow};
+use super::counters::count;
 use super::counters::Counters;
 use super::probe::{Overflow, ProbeEvent, Raw};
 
@@ -149,11 +150,11 @@ impl LiTile {
     #[inline]
     pub fn add(&mut self, i: usize, delta: i32, c: &mut Counters) -> (i32, i32, bool) {
         let b = self.format.bytes();
-        c.color_read_bytes += b;
-        c.color_write_bytes += b;
+        count!(c.color_read_bytes += b);
+        count!(c.color_write_bytes += b);
         let before = self.values[i];
         let (v, overflowed) = li_add(self.format, self.overflow, before, delta);
-        c.overflow_events += overflowed as u64;
+        count!(c.overflow_events += overflowed as u64);
         record_overflow(&mut self.overflows, i, overflowed as u32);
         self.values[i] = v;
         (before, v, overflowed)

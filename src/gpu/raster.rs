@@ -7,6 +7,7 @@
 //! tile outside one edge is skipped, a tile inside all three is filled without per-sample
 //! tests (edge functions are linear, so corners bound the whole tile).
 
+use super::counters::count;
 use super::counters::Counters;
 use super::probe::{PassProbe, Tap};
 use super::setup::RasterTriangle;
@@ -215,8 +216,8 @@ where
                     let tap = watched.and_then(|p| p.tap(t, f.local));
                     fragment(t, storage, tri, f, &mut c, tap)
                 });
-                c.tiles_visited += visited as u64;
-                c.fragments_rasterized += n;
+                count!(c.tiles_visited += visited as u64);
+                count!(c.fragments_rasterized += n);
             }
             c
         })

@@ -22,6 +22,7 @@
 //! programs of this crate compute in f64. Triangles set up without them pay nothing.
 
 use super::clip::{clip_triangle, clip_triangle_barycentric, fully_inside};
+use super::counters::count;
 use super::counters::Counters;
 use super::fixed::Fixed8;
 use super::tiling::Tiling;
@@ -207,7 +208,7 @@ fn setup_with(
     out: &mut Vec<RasterTriangle>,
     counters: &mut Counters,
 ) {
-    counters.triangles_submitted += 1;
+    count!(counters.triangles_submitted += 1);
     let before = out.len();
     if fully_inside(tri) {
         let v = [0, 1, 2].map(|k| (tri[k], UNIT_BARYCENTRICS[k]));
@@ -225,9 +226,9 @@ fn setup_with(
         }
     }
     let made = (out.len() - before) as u64;
-    counters.triangles_rasterized += made;
+    count!(counters.triangles_rasterized += made);
     if made == 0 {
-        counters.triangles_dropped += 1;
+        count!(counters.triangles_dropped += 1);
     }
 }
 

@@ -21,6 +21,7 @@
 //! [`crate::light::lookup_tables::SplitTable`].
 
 use super::buffers::{overflow_record, record_overflow};
+use super::counters::count;
 use super::counters::Counters;
 use super::probe::{Overflow, ProbeEvent, Raw};
 
@@ -178,8 +179,8 @@ impl SplitVTile {
             SplitTarget::Add => (&mut self.add, &mut self.saturations[0]),
             SplitTarget::Sub => (&mut self.sub, &mut self.saturations[1]),
         };
-        c.color_read_bytes += 4;
-        c.color_write_bytes += 4;
+        count!(c.color_read_bytes += 4);
+        count!(c.color_write_bytes += 4);
         let dst = &mut buf[i];
         let before = *dst;
         let mut saturated = 0;
@@ -188,7 +189,7 @@ impl SplitVTile {
             dst[k] = v;
             saturated += sat as u64;
         }
-        c.overflow_events += saturated;
+        count!(c.overflow_events += saturated);
         record_overflow(record, i, saturated as u32);
         SplitBlend {
             target,

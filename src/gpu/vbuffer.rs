@@ -30,6 +30,7 @@
 //! only, which the method merges with its stencil umbra.
 
 use super::buffers::{overflow_record, record_overflow};
+use super::counters::count;
 use super::counters::Counters;
 use super::probe::{Overflow, ProbeEvent, Raw, Tap};
 use half::f16;
@@ -131,8 +132,8 @@ impl VBufferTile for VBufferF32Tile {
     }
     #[inline]
     fn add(&mut self, i: usize, delta: [f32; 3], c: &mut Counters) {
-        c.color_read_bytes += 4;
-        c.color_write_bytes += 4;
+        count!(c.color_read_bytes += 4);
+        count!(c.color_write_bytes += 4);
         self.values[i] += delta[0];
     }
     fn resolve(&self, i: usize) -> [f32; 3] {
@@ -162,10 +163,10 @@ impl VBufferTile for VBufferF16Tile {
     }
     #[inline]
     fn add(&mut self, i: usize, delta: [f32; 3], c: &mut Counters) {
-        c.color_read_bytes += 2;
-        c.color_write_bytes += 2;
+        count!(c.color_read_bytes += 2);
+        count!(c.color_write_bytes += 2);
         let v = f16::from_f32(self.values[i].to_f32() + delta[0]);
-        c.overflow_events += !v.is_finite() as u64;
+        count!(c.overflow_events += !v.is_finite() as u64);
         record_overflow(&mut self.overflows, i, !v.is_finite() as u32);
         self.values[i] = v;
     }
@@ -199,8 +200,8 @@ impl VBufferTile for VBufferRgbTile {
     }
     #[inline]
     fn add(&mut self, i: usize, delta: [f32; 3], c: &mut Counters) {
-        c.color_read_bytes += 12;
-        c.color_write_bytes += 12;
+        count!(c.color_read_bytes += 12);
+        count!(c.color_write_bytes += 12);
         for (v, d) in self.values[i].iter_mut().zip(delta) {
             *v += d;
         }
@@ -247,8 +248,8 @@ impl VBufferTile for VBuffer8Tile {
         if q == 0 {
             return;
         }
-        c.color_read_bytes += 4;
-        c.color_write_bytes += 4;
+        count!(c.color_read_bytes += 4);
+        count!(c.color_write_bytes += 4);
         let channel = if delta[0] > 0.0 {
             &mut self.add[i]
         } else {
@@ -258,7 +259,7 @@ impl VBufferTile for VBuffer8Tile {
             Some(s) => (s, false),
             None => (u8::MAX, true),
         };
-        c.overflow_events += overflow as u64;
+        count!(c.overflow_events += overflow as u64);
         *channel = sum;
         record_overflow(&mut self.overflows, i, overflow as u32);
     }

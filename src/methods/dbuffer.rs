@@ -139,6 +139,7 @@ use crate::frame::Frame;
 use crate::geometry::umbra_penumbra::{build_volumes, Disk, Extrusion, VolumeStats, VolumeVertex};
 use crate::gpu::buffers::{alloc_tiles, DepthTile};
 use crate::gpu::color::{ColorFormat, ColorMask, RgbaTile};
+use crate::gpu::counters::count;
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::DepthFunc;
 use crate::gpu::depth::{DepthFormat, DepthState, PolygonOffset};
@@ -544,7 +545,7 @@ fn draw_dbuffer(
                 let (depth, texel) = (tile.depth.values[f.local], texel_raw(&tile.color, f.local));
                 (depth, texel, c.overflow_events)
             });
-            c.fragments_shaded += 1;
+            count!(c.fragments_shaded += 1);
             let prim = tri.prim as usize;
             let v = input.values[prim];
             let at = |k: usize| {
@@ -877,14 +878,14 @@ fn screen_pass<T: ShaderFloat>(
                 return (1.0, None);
             };
             st.receivers += 1;
-            cn.fragments_shaded += 1;
+            count!(cn.fragments_shaded += 1);
             let Some([x, y, _]) = view.window(r.point) else {
                 st.behind_light += 1;
                 record(1.0, "behind the light: lit");
                 return (1.0, None);
             };
             let (tile, local) = view.nearest_texel(x, y);
-            cn.color_read_bytes += texel_bytes;
+            count!(cn.color_read_bytes += texel_bytes);
             let texel = dbuffer[tile].texel(local);
             let d = receiver_distance::<T>(r.point.as_dvec3(), c);
             let shade = screen_program(d, texel, s);

@@ -24,6 +24,7 @@ use crate::error::InputError;
 use crate::frame::{setup_all, Frame, BACKGROUND};
 use crate::geometry::shadow_volume::{shadow_volume_parts, shadow_volume_triangles, Capping};
 use crate::gpu::buffers::{alloc_tiles, StencilTile};
+use crate::gpu::counters::count;
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::hiz::HIZ_CULLED;
@@ -225,7 +226,7 @@ pub fn stencil_shadow(
             },
             |t, st, tri, f, c, tap| {
                 let (pass, z) = frame.tiles[t].depth.test(&depth, &f, c);
-                c.depth_passed += pass as u64;
+                count!(c.depth_passed += pass as u64);
                 let update = st.apply(&state, tri.front_facing, &f, pass, c);
                 if let (Some(tap), Some(parts)) = (tap, &parts) {
                     let (kind, detail) = parts[tri.prim as usize].describe();

@@ -122,6 +122,7 @@ use crate::geometry::penumbra_cones::{
 };
 use crate::gpu::buffers::{alloc_tiles, DepthTile};
 use crate::gpu::color::{ColorFormat, ColorTile};
+use crate::gpu::counters::count;
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFormat, DepthState, PolygonOffset};
 use crate::gpu::light_view::LightView;
@@ -536,7 +537,7 @@ pub fn render_penumbra_map_probed<T: ShaderFloat>(
                 depth,
                 stats: st,
             } = tile;
-            c.fragments_shaded += 1;
+            count!(c.fragments_shaded += 1);
             st.fragments += 1;
             let z_p = shadow_map[t].read(f.local, c);
             let triangle = &geometry.triangles[tri.prim as usize];
@@ -669,13 +670,13 @@ fn screen_pass<T: ShaderFloat>(
                 return 1.0;
             };
             st.receivers += 1;
-            c.fragments_shaded += 1;
+            count!(c.fragments_shaded += 1);
             let Some([x, y, z]) = view.window(r.point) else {
                 st.behind_light += 1;
                 record(event, 1.0, false, "behind the light: lit");
                 return 1.0;
             };
-            c.depth_read_bytes += depth_bytes;
+            count!(c.depth_read_bytes += depth_bytes);
             let z = match slopes.get(prims[i] as usize) {
                 Some(&(m, z_max)) => {
                     let amount = T::from_f64(s.offset.amount(view.depth, m, z_max));
@@ -699,7 +700,7 @@ fn screen_pass<T: ShaderFloat>(
                 record(event, 0.0, false, "behind the shadow map's surface: umbra");
                 return 0.0;
             }
-            c.color_read_bytes += taps * s.storage.bytes();
+            count!(c.color_read_bytes += taps * s.storage.bytes());
             let v = view.sample(x, y, s.filter, |t, l| penumbra_map[t].value(l) as f64);
             if !(0.0..=1.0).contains(&v) {
                 st.out_of_range += 1;

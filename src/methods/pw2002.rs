@@ -55,6 +55,7 @@ use crate::geometry::penumbra_wedge::{
     wedge_triangles, FaceKind, WedgeOptions, WedgeSet,
 };
 use crate::gpu::buffers::alloc_tiles;
+use crate::gpu::counters::count;
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::hiz::HIZ_CULLED;
 use crate::gpu::li_buffer::{li_clamped, li_visibility, LiFormat, LiOverflow, LiTile, LI_CLEAR};
@@ -376,8 +377,8 @@ fn render_li_with<T: ShaderFloat>(
                 }
                 return;
             }
-            c.depth_passed += 1;
-            c.fragments_shaded += 1;
+            count!(c.depth_passed += 1);
+            count!(c.fragments_shaded += 1);
             let wt = &tris[tri.prim as usize];
             let (Some(wi), Some(kind)) = (wt.wedge, wt.kind) else {
                 return;

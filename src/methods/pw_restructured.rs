@@ -89,6 +89,7 @@ use crate::geometry::penumbra_wedge::{
     wedge_triangles, FaceKind, ScreenWedge, WedgeSet, WedgeTriangle,
 };
 use crate::gpu::buffers::{alloc_tiles, StencilTile};
+use crate::gpu::counters::count;
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::DepthFunc;
 use crate::gpu::li_buffer::{LiTile, LI_CLEAR};
@@ -222,7 +223,7 @@ impl Ctx<'_> {
             Culling::Zmax => 1,
             Culling::ZminZmax => 2,
         };
-        c.hiz_read_bytes += values * self.frame.tiles[t].depth.format.bytes();
+        count!(c.hiz_read_bytes += values * self.frame.tiles[t].depth.format.bytes());
     }
 
     /// Umbra sign of a front-plane or cap fragment (per §3/§5): the LI amount it adds when its
@@ -413,8 +414,8 @@ fn li_pass<T: ShaderFloat>(
             let roles = ctx.roles(tri);
             let (u, p) = culls(t, tri);
             ctx.count_tile_test(t, c);
-            c.tiles_culled_hiz += (umbra && roles.umbra && u) as u64;
-            c.tiles_culled_hiz += (penumbra && roles.penumbra && p) as u64;
+            count!(c.tiles_culled_hiz += (umbra && roles.umbra && u) as u64);
+            count!(c.tiles_culled_hiz += (penumbra && roles.penumbra && p) as u64);
             if u && p {
                 ctx.record_culled(probe, t, tri, "umbra and penumbra");
             }
@@ -431,7 +432,7 @@ fn li_pass<T: ShaderFloat>(
             let stored = depth.read(f.local, c);
             let z = depth.format.quantize(f.z);
             let pass = z < stored;
-            c.depth_passed += pass as u64;
+            count!(c.depth_passed += pass as u64);
             let mut delta = 0;
             let mut umbra_delta = None;
             if !u_culled {
@@ -446,7 +447,7 @@ fn li_pass<T: ShaderFloat>(
             }
             let mut penumbra_delta = None;
             if !p_culled {
-                c.fragments_shaded += 1;
+                count!(c.fragments_shaded += 1);
                 let amount = ctx.penumbra_amount::<T>(tri, &f, stored, pass);
                 delta += amount;
                 penumbra_delta = Some(amount);
@@ -585,7 +586,7 @@ fn render_li_with<T: ShaderFloat>(
                 for (t, (tile, st)) in tiles.iter_mut().zip(&stencil).enumerate() {
                     let watched = probe.as_ref().filter(|p| p.watches_tile(t));
                     for (i, v) in st.values.iter().enumerate() {
-                        c.stencil_read_bytes += 1;
+                        count!(c.stencil_read_bytes += 1);
                         let d = mult * (*v as i32 - 128);
                         let added = (d != 0).then(|| tile.li.add(i, d, &mut c));
                         if let Some(tap) = watched.and_then(|p| p.tap(t, i)) {
@@ -644,7 +645,7 @@ fn stencil_pass(
         |t, _, tri, c| {
             let culled = ctx.umbra_culled(t, tri);
             ctx.count_tile_test(t, c);
-            c.tiles_culled_hiz += culled as u64;
+            count!(c.tiles_culled_hiz += culled as u64);
             if culled {
                 ctx.record_culled(probe, t, tri, "umbra");
             }
@@ -655,7 +656,7 @@ fn stencil_pass(
             let stored = depth.read(f.local, c);
             let z = depth.format.quantize(f.z);
             let pass = z < stored;
-            c.depth_passed += pass as u64;
+            count!(c.depth_passed += pass as u64);
             let update = st.apply(&state, tri.front_facing, &f, pass, c);
             if let Some(tap) = tap {
                 let e = ctx.primitive(tap.event(), tri);

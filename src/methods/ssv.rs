@@ -73,6 +73,7 @@ use crate::frame::{setup_all, Frame, Receiver, FULL_SCREEN};
 use crate::geometry::shadow_volume::{shadow_volume_parts, shadow_volume_triangles, Capping};
 use crate::geometry::silhouette::{light_facing, possible_silhouettes};
 use crate::geometry::ssv_wedge::{SsvWedge, WedgeLight};
+use crate::gpu::counters::count;
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::hiz::{InsideTestRounding, TileReceiverBounds, HIZ_CULLED};
@@ -452,7 +453,7 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSett
             let culled = if last & !1 == key {
                 last & 1 == 1
             } else {
-                c.hiz_read_bytes += TileReceiverBounds::READ_BYTES;
+                count!(c.hiz_read_bytes += TileReceiverBounds::READ_BYTES);
                 let culled = match bounds.tile(t) {
                     None => true,
                     Some(bx) => edges[k as usize]
@@ -463,7 +464,7 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSett
                 last_wedge[t].store(key | culled as u64, Ordering::Relaxed);
                 culled
             };
-            c.tiles_culled_hiz += culled as u64;
+            count!(c.tiles_culled_hiz += culled as u64);
             if let (true, Some(probe)) = (culled, &probe) {
                 probe.record_culled(t, tri, WEDGE_CULLED, |tap| event(tap, tri));
             }
@@ -490,7 +491,7 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSett
             {
                 return stop("receiver outside the wedge: discarded");
             }
-            c.fragments_shaded += 1;
+            count!(c.fragments_shaded += 1);
             let coverage = source.coverage::<T>(ew, p);
             add_probed(vb, f.local, coverage, c, tap, |tap| {
                 event(tap).value("coverage", coverage[0] as f64)
@@ -645,7 +646,7 @@ fn hard_quads_pass<V: VBufferTile>(frame: &Frame, test: ShadowTest, vbuf: &mut [
         },
         |t, vb, tri, f, c, tap| {
             let (pass, z) = frame.tiles[t].depth.test(&depth, &f, c);
-            c.depth_passed += pass as u64;
+            count!(c.depth_passed += pass as u64);
             // The watched fragment's event, built only there.
             let event = |tap: Tap| {
                 let e = tap.event();

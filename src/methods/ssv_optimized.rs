@@ -110,6 +110,7 @@ use crate::geometry::tight_wedge::{
     DEFAULT_SPHERE_SIDES,
 };
 use crate::gpu::buffers::{alloc_tiles, StencilTile};
+use crate::gpu::counters::count;
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::hiz::HIZ_CULLED;
@@ -623,7 +624,7 @@ fn render_group<T: ShaderFloat>(
             for t in tiles.iter_mut() {
                 t.stencil.values.fill(0);
             }
-            counters.stencil_write_bytes += frame.pixel_count() as u64;
+            count!(counters.stencil_write_bytes += frame.pixel_count() as u64);
             frame.probe_record("stencil-clear", |tap, _| {
                 tap.event().clear("stencil", Raw::U8(0))
             });
@@ -714,7 +715,7 @@ fn render_group<T: ShaderFloat>(
             |t, st, tri, f, cnt, tap| match roles[tri.prim as usize] {
                 Role::Quad => {
                     let (pass, z) = frame.tiles[t].depth.test(&less, &f, cnt);
-                    cnt.depth_passed += pass as u64;
+                    count!(cnt.depth_passed += pass as u64);
                     // z-pass: front faces passing decrement, back faces increment.
                     // z-fail: back faces failing decrement, front faces failing increment.
                     let target = match (zfail, pass, tri.front_facing) {
@@ -777,7 +778,7 @@ fn render_group<T: ShaderFloat>(
                         }
                     };
                     let stored = (!tested).then(|| {
-                        cnt.stencil_read_bytes += 1;
+                        count!(cnt.stencil_read_bytes += 1);
                         st.stencil.values[f.local]
                     });
                     let seen_stencil = |e: ProbeEvent| match stored {
@@ -799,7 +800,7 @@ fn render_group<T: ShaderFloat>(
                     if !pass {
                         return record(&|e| seen_depth(e).note("receiver behind the back face"));
                     }
-                    cnt.depth_passed += 1;
+                    count!(cnt.depth_passed += 1);
                     let Some(p) = receivers[t][f.local] else {
                         return record(&|e| seen_depth(e).note("background"));
                     };
@@ -808,7 +809,7 @@ fn render_group<T: ShaderFloat>(
                             seen_depth(e).note("receiver outside the half (shader test)")
                         });
                     }
-                    cnt.fragments_shaded += 1;
+                    count!(cnt.fragments_shaded += 1);
                     let target = job.target.unwrap_or_else(|| {
                         plane_split_target::<T::AtMostFp32>(light.center(), &job.edge, p)
                     });

@@ -140,6 +140,7 @@ use crate::geometry::tight_wedge::{
     bounding_planes, quad_inner_halfspace, wedge_clip_box, wedge_halves_and_planes,
 };
 use crate::gpu::buffers::{alloc_tiles, overflow_record, record_overflow, StencilTile};
+use crate::gpu::counters::count;
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::pack4ub::{FloatTarget, StoreEvents};
@@ -749,7 +750,7 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
             no_tile_culling,
             |t, tile, tri, f, cnt, tap| {
                 let (pass, z) = frame.tiles[t].depth.test(&less, &f, cnt);
-                cnt.depth_passed += pass as u64;
+                count!(cnt.depth_passed += pass as u64);
                 let update = tile
                     .stencil
                     .apply(&stencil_state, tri.front_facing, &f, pass, cnt);
@@ -776,7 +777,7 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
         passes[1].0 += on_dirty_tiles(&mut tiles, |t, tile, cnt| {
             let watched = probes[1].as_ref().filter(|p| p.watches_tile(t));
             tile_pixels(tiling, t, |i, _| {
-                cnt.stencil_read_bytes += 1;
+                count!(cnt.stencil_read_bytes += 1);
                 let count = tile.stencil.values[i] as i8 as i32;
                 if let Some(sum) = tile.stencil_sum.get_mut(i) {
                     *sum += count;
@@ -791,7 +792,7 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
                     clamps = c;
                     tile.silhouette[i] = px;
                     tile.counters.packing_clamps += clamps;
-                    cnt.color_write_bytes += sil_bytes;
+                    count!(cnt.color_write_bytes += sil_bytes);
                 }
                 if let Some(tap) = watched.and_then(|p| p.tap(t, i)) {
                     let e = silhouette_primitive(tap.event(), si).value("count", count as f64);
@@ -931,7 +932,7 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
                                 .note("depth test failed: the receiver is in front")
                         });
                     }
-                    cnt.depth_passed += 1;
+                    count!(cnt.depth_passed += 1);
                     (depth.values[f.local], Some(z))
                 };
                 let seen = |e: ProbeEvent| match test {
@@ -956,14 +957,14 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
                     tile.counters.rejected_quad_side += 1;
                     return record(&|e| seen(e).note("the other side of the hard quad (Fig. 8)"));
                 }
-                cnt.fragments_shaded += 1;
+                count!(cnt.fragments_shaded += 1);
                 tile.dirty = true;
                 let regions = edge_in_parts::<T>(&light, p, a, b);
                 if regions.iter().all(Option::is_none) {
                     tile.counters.missed_light += 1;
                     return record(&|e| seen(e).note("the edge reaches no part of the light"));
                 }
-                cnt.color_read_bytes += sil_bytes;
+                count!(cnt.color_read_bytes += sil_bytes);
                 let before = tile.silhouette[f.local];
                 let mut parts = storage.load(&before);
                 for (part, region) in parts.iter_mut().zip(&regions) {
@@ -978,7 +979,7 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
                 let (px, clamps) = storage.store(&parts, &mut tile.counters.stores);
                 tile.silhouette[f.local] = px;
                 tile.counters.packing_clamps += clamps;
-                cnt.color_write_bytes += sil_bytes;
+                count!(cnt.color_write_bytes += sil_bytes);
                 record(&|e| {
                     let areas = regions
                         .iter()
@@ -1008,7 +1009,7 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
         passes[3].0 += on_dirty_tiles(&mut tiles, |t, tile, cnt| {
             let watched = probes[3].as_ref().filter(|p| p.watches_tile(t));
             tile_pixels(tiling, t, |i, _| {
-                cnt.color_read_bytes += sil_bytes;
+                count!(cnt.color_read_bytes += sil_bytes);
                 let sp = storage.load(&tile.silhouette[i]);
                 let tap = watched.and_then(|p| p.tap(t, i));
                 if let Some(tap) = tap {
@@ -1023,7 +1024,7 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
                     tile.penumbrae[i] = tile.penumbrae[i].saturating_add(1);
                 }
                 tile.counters.blended_pixels += 1;
-                cnt.color_read_bytes += fin_bytes;
+                count!(cnt.color_read_bytes += fin_bytes);
                 let mut fp = storage.load(&tile.last[i]);
                 let mut eps = [0.0; PART_COUNT];
                 for (k, (f, sp)) in fp.iter_mut().zip(&sp).enumerate() {
@@ -1066,14 +1067,14 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
                 }
                 tile.last[i] = px;
                 tile.counters.packing_clamps += clamps;
-                cnt.color_write_bytes += fin_bytes;
+                count!(cnt.color_write_bytes += fin_bytes);
             });
             let r = tiling.rect(t);
             let pixels = ((r.x1 - r.x0) * (r.y1 - r.y0)) as u64;
             tile.silhouette.fill(cleared);
             tile.stencil.values.fill(0);
-            cnt.color_write_bytes += pixels * sil_bytes;
-            cnt.stencil_write_bytes += pixels;
+            count!(cnt.color_write_bytes += pixels * sil_bytes);
+            count!(cnt.stencil_write_bytes += pixels);
             tile.dirty = false;
             if let Some(p) = watched {
                 p.record(|tap| tap.event().clear("stencil", Raw::U8(0)));
@@ -1099,7 +1100,7 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
             if receivers[g].is_none() {
                 return;
             }
-            resolve.color_read_bytes += fin_bytes;
+            count!(resolve.color_read_bytes += fin_bytes);
             let parts = storage.load(&tile.last[i]);
             let sum = parts.iter().fold(T::AtMostFp32::zero(), |sum, p| {
                 sum + read::<T::AtMostFp32>(p.occlusion)
