@@ -73,6 +73,9 @@
 //!    each ray is tested only against the triangles of the cell its crossing point falls in
 //!    (plus those covering the whole grid), with the exact test above.
 //!
+//! 4. Each ray first tests the triangle that blocked the receiver's previous ray (the strata
+//!    run in order, so neighbouring samples are mostly blocked by the same triangle).
+//!
 //! Point lights, degenerate shafts (the origin in the light's plane) and sample counts below
 //! [`BINNED_MIN_SAMPLES`] (where the set-up costs more than it saves) trace each ray through
 //! the whole tree instead.
@@ -601,8 +604,22 @@ impl ShadowRayCaster {
     /// the binned path is tested against).
     fn trace_each(&self, origin: DVec3, samples: &[LightSample], scratch: &mut Scratch) {
         scratch.stack.resize(self.depth + 2, 0);
+        // The previous ray's blocker first, as in `trace_binned`.
+        let mut last_blocker: Option<u32> = None;
         for (s, lit) in samples.iter().zip(scratch.lit.iter_mut()) {
-            *lit = !self.blocked(origin, s.position.as_dvec3(), &mut scratch.stack);
+            let target = s.position.as_dvec3();
+            let d = target - origin;
+            let blocker = match last_blocker {
+                Some(ti)
+                    if d != DVec3::ZERO
+                        && self.triangles[ti as usize].blocks(origin, d, self.segment_start(d)) =>
+                {
+                    Some(ti)
+                }
+                _ => self.blocker(origin, target, &mut scratch.stack),
+            };
+            *lit = blocker.is_none();
+            last_blocker = blocker.or(last_blocker);
         }
     }
 
@@ -714,7 +731,11 @@ impl ShadowRayCaster {
                 }
             }
         }
-        // Each ray: the plane point it passes through gives its cell.
+        // Each ray: the plane point it passes through gives its cell. The triangle that
+        // blocked the previous ray is tested first: neighbouring samples (the strata run in
+        // order) are mostly blocked by the same one, and a ray is blocked if any triangle
+        // blocks it, so the order changes no answer.
+        let mut last_blocker: Option<u32> = None;
         for (s, lit) in samples.iter().zip(scratch.lit.iter_mut()) {
             let target = s.position.as_dvec3();
             let d = target - origin;
@@ -730,11 +751,18 @@ impl ShadowRayCaster {
             let c = cell_of(b, g) * g + cell_of(a, g);
             let cell = &scratch.cell_items
                 [scratch.cell_start[c] as usize..scratch.cell_start[c + 1] as usize];
-            *lit = !scratch
-                .global
-                .iter()
-                .chain(cell)
-                .any(|&ti| self.triangles[ti as usize].blocks(origin, d, t_start));
+            let blocks = |ti: u32| self.triangles[ti as usize].blocks(origin, d, t_start);
+            let blocker = match last_blocker {
+                Some(ti) if blocks(ti) => Some(ti),
+                _ => scratch
+                    .global
+                    .iter()
+                    .chain(cell)
+                    .copied()
+                    .find(|&ti| blocks(ti)),
+            };
+            *lit = blocker.is_none();
+            last_blocker = blocker.or(last_blocker);
         }
         true
     }
@@ -762,9 +790,14 @@ impl ShadowRayCaster {
     /// depth-first any-hit traversal of the whole tree, boxes clipped to `t ∈ [0, 1]`;
     /// `stack` holds at least the tree's depth + 1 entries.
     fn blocked(&self, origin: DVec3, target: DVec3, stack: &mut [u32]) -> bool {
+        self.blocker(origin, target, stack).is_some()
+    }
+
+    /// [`ShadowRayCaster::blocked`], naming the first blocking triangle found.
+    fn blocker(&self, origin: DVec3, target: DVec3, stack: &mut [u32]) -> Option<u32> {
         let d = target - origin;
         if d == DVec3::ZERO || self.nodes.is_empty() {
-            return false;
+            return None;
         }
         let t_start = self.segment_start(d);
         let o = origin.as_vec3();
@@ -777,23 +810,24 @@ impl ShadowRayCaster {
             let node = &self.nodes[at as usize];
             let t0 = (node.lo - o) * inv;
             let t1 = (node.hi - o) * inv;
-            // f32::min/max ignore a NaN operand (module doc, "Acceleration").
-            let near =
-                t0.x.min(t1.x)
-                    .max(t0.y.min(t1.y))
-                    .max(t0.z.min(t1.z))
-                    .max(0.0);
-            let far =
-                t0.x.max(t1.x)
-                    .min(t0.y.max(t1.y))
-                    .min(t0.z.max(t1.z))
-                    .min(1.0);
+            // Plain compare-and-select (one `minss`/`maxss` each; `f32::min`/`max` add a NaN
+            // check around every one, 20 % of the traversal): a NaN, from a ray parallel to a
+            // slab that lies exactly on a padded face (0·∞), may keep or reject the box, and
+            // either is right (module doc, "Acceleration").
+            let near = max_f32(
+                max_f32(min_f32(t0.x, t1.x), min_f32(t0.y, t1.y)),
+                max_f32(min_f32(t0.z, t1.z), 0.0),
+            );
+            let far = min_f32(
+                min_f32(max_f32(t0.x, t1.x), max_f32(t0.y, t1.y)),
+                min_f32(max_f32(t0.z, t1.z), 1.0),
+            );
             if near > far {
                 continue;
             }
             if node.leaf {
                 if self.triangles[node.index as usize].blocks(origin, d, t_start) {
-                    return true;
+                    return Some(node.index);
                 }
             } else {
                 stack[top] = node.index;
@@ -801,7 +835,27 @@ impl ShadowRayCaster {
                 top += 2;
             }
         }
-        false
+        None
+    }
+}
+
+/// `a < b ? a : b` (the second operand when either is NaN): one `minss`.
+#[inline]
+fn min_f32(a: f32, b: f32) -> f32 {
+    if a < b {
+        a
+    } else {
+        b
+    }
+}
+
+/// `a > b ? a : b` (the second operand when either is NaN): one `maxss`.
+#[inline]
+fn max_f32(a: f32, b: f32) -> f32 {
+    if a > b {
+        a
+    } else {
+        b
     }
 }
 
