@@ -45,34 +45,71 @@ impl Bins {
     }
 }
 
-/// The tiles triangle `t`'s bounding box touches, row by row.
-fn bbox_tiles(tiling: &Tiling, t: &RasterTriangle) -> impl Iterator<Item = usize> {
-    let [x0, y0, x1, y1] = t.bbox;
-    let (tile, tiles_x) = (tiling.tile, tiling.tiles_x);
-    (y0 / tile..=y1 / tile)
-        .flat_map(move |ty| (x0 / tile..=x1 / tile).map(move |tx| (ty * tiles_x + tx) as usize))
+/// Tile rows one parallel binning task covers ([`bin`]).
+const BIN_BAND_ROWS: u32 = 4;
+
+/// Bin triangles to tiles by bounding box: a counting sort (count per tile, then place) per
+/// band of [`BIN_BAND_ROWS`] tile rows, the bands in parallel, each scanning every triangle.
+/// Concatenated in band order the lists are the same for any thread count.
+pub fn bin(tiling: &Tiling, tris: &[RasterTriangle]) -> Bins {
+    let bands: Vec<(Vec<u32>, Vec<u32>)> = (0..tiling.tiles_y.div_ceil(BIN_BAND_ROWS))
+        .into_par_iter()
+        .map(|band| {
+            let rows = band * BIN_BAND_ROWS..((band + 1) * BIN_BAND_ROWS).min(tiling.tiles_y);
+            bin_band(tiling, tris, rows)
+        })
+        .collect();
+    let mut starts = Vec::with_capacity(tiling.tile_count() + 1);
+    let mut indices = Vec::with_capacity(bands.iter().map(|(_, i)| i.len()).sum());
+    for (band_starts, band_indices) in bands {
+        let base = indices.len() as u32;
+        starts.extend(
+            band_starts[..band_starts.len() - 1]
+                .iter()
+                .map(|s| base + s),
+        );
+        indices.extend(band_indices);
+    }
+    starts.push(indices.len() as u32);
+    Bins { starts, indices }
 }
 
-/// Bin triangles to tiles by bounding box (a counting sort: count per tile, then place).
-pub fn bin(tiling: &Tiling, tris: &[RasterTriangle]) -> Bins {
-    let mut starts = vec![0u32; tiling.tile_count() + 1];
+/// The bins of the tile rows `rows`: each tile's start in the band's indices (with the band's
+/// total appended), and the indices.
+fn bin_band(
+    tiling: &Tiling,
+    tris: &[RasterTriangle],
+    rows: std::ops::Range<u32>,
+) -> (Vec<u32>, Vec<u32>) {
+    let (tile, tiles_x) = (tiling.tile, tiling.tiles_x);
+    let first = (rows.start * tiles_x) as usize;
+    let tiles = ((rows.end - rows.start) * tiles_x) as usize;
+    // The band's tiles a triangle's box touches, row by row.
+    let touched = |t: &RasterTriangle| {
+        let [x0, y0, x1, y1] = t.bbox;
+        let (ty0, ty1) = ((y0 / tile).max(rows.start), (y1 / tile).min(rows.end - 1));
+        (ty0..=ty1).flat_map(move |ty| {
+            (x0 / tile..=x1 / tile).map(move |tx| (ty * tiles_x + tx) as usize - first)
+        })
+    };
+    let mut starts = vec![0u32; tiles + 1];
     for t in tris {
-        for tile in bbox_tiles(tiling, t) {
-            starts[tile + 1] += 1;
+        for k in touched(t) {
+            starts[k + 1] += 1;
         }
     }
     for k in 1..starts.len() {
         starts[k] += starts[k - 1];
     }
     let mut next = starts.clone();
-    let mut indices = vec![0u32; *starts.last().expect("one entry per tile and the end") as usize];
-    for (k, t) in tris.iter().enumerate() {
-        for tile in bbox_tiles(tiling, t) {
-            indices[next[tile] as usize] = k as u32;
-            next[tile] += 1;
+    let mut indices = vec![0u32; starts[tiles] as usize];
+    for (n, t) in tris.iter().enumerate() {
+        for k in touched(t) {
+            indices[next[k] as usize] = n as u32;
+            next[k] += 1;
         }
     }
-    Bins { starts, indices }
+    (starts, indices)
 }
 
 /// How a triangle relates to a tile.
