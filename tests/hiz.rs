@@ -123,7 +123,13 @@ fn hiz_rejects_tiles_in_the_passes_that_use_it() {
         runs("cube-of-spheres", "on"),
         runs("cube-of-spheres", "off"),
     );
-    for method in ["hard-sv", "nsample", "ssv", "ssv-optimized"] {
+    for method in [
+        "hard-sv",
+        "nsample",
+        "ssv",
+        "ssv-optimized",
+        "wedge-blending",
+    ] {
         let find =
             |rs: &[MethodRun]| method_passes(rs.iter().find(|r| r.method == method).expect("ran"));
         let (c_on, c_off) = (find(&on), find(&off));

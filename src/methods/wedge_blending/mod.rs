@@ -143,6 +143,7 @@ use crate::gpu::buffers::{alloc_tiles, overflow_record, record_overflow, Stencil
 use crate::gpu::counters::count;
 use crate::gpu::counters::Counters;
 use crate::gpu::depth::{DepthFunc, DepthState};
+use crate::gpu::hiz::HIZ_CULLED;
 use crate::gpu::pack4ub::{FloatTarget, StoreEvents};
 use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw};
 use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
@@ -747,7 +748,24 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
             &tris,
             &bins,
             probes[0].as_ref(),
-            no_tile_culling,
+            // The hierarchical-Z unit skips a tile where every fragment of the volume face
+            // would count nothing ([`Frame::hiz_rejects_depth`]); such a tile is not marked
+            // as drawn, and a tile the silhouette left alone is skipped by the later passes
+            // without changing the result (module doc, "Only where the silhouette was drawn").
+            |t, _, tri, cnt| {
+                let culled = frame.hiz_rejects_depth(t, tri, less.func, s.test.idle_outcome(), cnt);
+                if let (true, Some(probe)) = (culled, &probes[0]) {
+                    probe.record_culled(t, tri, HIZ_CULLED, |tap| {
+                        tap.event().primitive(
+                            PrimitiveKind::VolumeTriangle,
+                            tri.prim,
+                            format!("of silhouette {si}"),
+                            Some(tri.front_facing),
+                        )
+                    });
+                }
+                culled
+            },
             |t, tile, tri, f, cnt, tap| {
                 let (pass, z) = frame.tiles[t].depth.test(&less, &f, cnt);
                 count!(cnt.depth_passed += pass as u64);
@@ -1231,7 +1249,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             (st.silhouette_bytes(), st.final_bytes(), st.describe())
         }
     };
-    let buffers = vec![
+    let mut buffers = vec![
         BufferPlan::depth(&frame.gpu),
         BufferPlan::stencil8(),
         BufferPlan {
@@ -1245,6 +1263,9 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             bytes_per_sample: fin_bytes as u32,
         },
     ];
+    if frame.gpu.hiz {
+        buffers.push(BufferPlan::hiz_zmin_zmax(&frame.gpu));
+    }
     let footprint: u64 = buffers
         .iter()
         .map(|b| b.bytes_per_sample as u64 * frame.pixel_count() as u64)
