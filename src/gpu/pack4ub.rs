@@ -44,7 +44,9 @@ pub fn pk4ub(v: [f32; 4]) -> u32 {
 /// becomes 0 (the clamp of NV_fragment_program maps NaN to the lower bound).
 pub fn unorm8(c: f32) -> u8 {
     let c = if c.is_nan() { 0.0 } else { c.clamp(0.0, 1.0) };
-    (c * 255.0 + 0.5).floor() as u8
+    // `255·c + 0.5` lies in [0.5, 255.5], where the conversion's truncation is the floor (a
+    // libm `floorf` call on x86-64 without SSE4.1).
+    (c * 255.0 + 0.5) as u8
 }
 
 /// `UP4UB`: byte k of `bits` (k = 0 the lowest) divided by 255, in f32.
@@ -138,6 +140,18 @@ impl FloatTarget {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The truncating conversion is the formula's floor on a grid of 2²⁴ + 1 components over
+    /// [0, 1] and at every tie `(k + ½)/255`.
+    #[test]
+    fn unorm8_is_the_floor_formula() {
+        let floor_formula = |c: f32| (c * 255.0 + 0.5).floor() as u8;
+        let grid = (0..=1u32 << 24).map(|k| k as f32 / (1u32 << 24) as f32);
+        let ties = (0..255).map(|k| (k as f32 + 0.5) / 255.0);
+        for c in grid.chain(ties) {
+            assert_eq!(unorm8(c), floor_formula(c), "{c:e}");
+        }
+    }
     use proptest::prelude::*;
 
     #[test]

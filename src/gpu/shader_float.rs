@@ -159,6 +159,7 @@ impl FloatFormat {
     /// `x` rounded to this format (module doc): to nearest, ties to even, at the mantissa
     /// width; beyond the largest finite value ±∞; below the smallest normal on the denormal
     /// grid or flushed to ±0. NaN, infinities and zeros are returned as they are.
+    #[inline]
     pub fn round(&self, x: f64) -> f64 {
         if x == 0.0 || !x.is_finite() {
             return x;
