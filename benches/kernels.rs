@@ -44,6 +44,8 @@
 //! `cargo bench --bench kernels -- coverage/`. Criterion writes its HTML report to
 //! `target/criterion/report/index.html`. The file took 75 s on a shared two-core machine.
 
+mod common;
+
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use glam::{DVec2, DVec3};
 use penumbra::frame::{Frame, GpuSettings};
@@ -63,7 +65,6 @@ use penumbra::light::coverage_texture::{
 };
 use penumbra::methods::pw2002;
 use penumbra::scene::{builtin, LightShape, Scene};
-use std::time::Duration;
 
 /// The scene every kernel runs on.
 const SCENE: &str = "forest-spheres";
@@ -345,20 +346,9 @@ fn kernels(c: &mut Criterion) {
     wedges(c, &frame, &sphere_frame);
 }
 
-/// 10 samples of 2 s after 0.5 s of warm-up per benchmark (every kernel here takes
-/// milliseconds, so criterion's linear sampling has room for many iterations). The HTML report
-/// (`target/criterion/report/index.html`) is drawn by plotters with the crate's embedded font.
-fn config() -> Criterion {
-    penumbra::experiment::plotting::register_font().expect("the embedded font");
-    Criterion::default()
-        .sample_size(10)
-        .warm_up_time(Duration::from_millis(500))
-        .measurement_time(Duration::from_secs(2))
-}
-
 criterion_group! {
     name = benches;
-    config = config();
+    config = common::config();
     targets = kernels
 }
 criterion_main!(benches);

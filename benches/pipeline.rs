@@ -43,6 +43,8 @@
 //! sample; criterion then warns that it could not complete 10 samples in 2 s, which is
 //! expected). The whole file took 410 s (about 7 minutes) on a shared two-core machine.
 
+mod common;
+
 use criterion::{black_box, criterion_group, criterion_main, Criterion, SamplingMode};
 use glam::Vec3;
 use penumbra::frame::{Frame, GpuSettings};
@@ -50,7 +52,6 @@ use penumbra::methods::hard_sv::{
     stencil_shadow, ShadowTest, StencilOverflow, StencilShadowSettings, Submission,
 };
 use penumbra::scene::{builtin, LightShape, OptionValue, Scene};
-use std::time::Duration;
 
 /// The benchmarked built-in scenes, both under a rectangular light.
 const SCENES: &[&str] = &["cube-of-spheres", "forest-spheres"];
@@ -218,20 +219,9 @@ fn pipeline(c: &mut Criterion) {
     }
 }
 
-/// Small samples and short measurement windows (module doc, "Budget"), at the price of wider
-/// confidence intervals. The HTML report (`target/criterion/report/index.html`) is drawn by
-/// plotters with the crate's embedded font.
-fn config() -> Criterion {
-    penumbra::experiment::plotting::register_font().expect("the embedded font");
-    Criterion::default()
-        .sample_size(10)
-        .warm_up_time(Duration::from_millis(500))
-        .measurement_time(Duration::from_secs(2))
-}
-
 criterion_group! {
     name = benches;
-    config = config();
+    config = common::config();
     targets = pipeline
 }
 criterion_main!(benches);
