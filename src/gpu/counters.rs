@@ -5,7 +5,7 @@
 //! Every buffer access goes through the typed buffers in [`super::buffers`], which add to a
 //! tile-local `Counters`; tiles' counters are summed after a pass. Integer sums do not depend
 //! on the order tiles finish in, so counters are as deterministic as the images.
-//! Every count goes through [`count!`]. Counting is on in every normal build (the cargo
+//! Every count goes through the crate-private macro `count!`. Counting is on in every normal build (the cargo
 //! feature `counters`, a default feature): one integer add per access into a tile-local
 //! struct that lives in L1. Built with `--no-default-features`, every count compiles to
 //! nothing and every counter reads 0 — a build that exists only to measure what counting

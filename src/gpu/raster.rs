@@ -49,7 +49,7 @@ impl Bins {
 const BIN_BAND_ROWS: u32 = 4;
 
 /// Bin triangles to tiles by bounding box: a counting sort (count per tile, then place) per
-/// band of [`BIN_BAND_ROWS`] tile rows, the bands in parallel, each scanning every triangle.
+/// band of four tile rows, the bands in parallel, each scanning every triangle.
 /// Concatenated in band order the lists are the same for any thread count.
 pub fn bin(tiling: &Tiling, tris: &[RasterTriangle]) -> Bins {
     let bands: Vec<(Vec<u32>, Vec<u32>)> = (0..tiling.tiles_y.div_ceil(BIN_BAND_ROWS))
