@@ -4,8 +4,7 @@
 //!
 //! Storage is tile-major (see [`super::tiling`]): one value per sample of a T×T tile.
 
-use super::counters::count;
-use super::counters::Counters;
+use super::counters::{count, Counters};
 use super::depth::{DepthFormat, DepthFunc, DepthState};
 use super::probe::{Overflow, ProbeEvent, Raw};
 use super::raster::Fragment;
@@ -25,34 +24,14 @@ pub struct DepthTile {
     pub zmin: u32,
     /// Largest stored value over the tile's pixels inside the image.
     pub zmax: u32,
-    /// The smallest window depth that quantizes to `zmax` or more ([`first_quantized_at_least`]):
+    /// The smallest window depth that quantizes to `zmax` or more
+    /// ([`DepthFormat::first_quantized_at_least`]):
     /// a fragment at or beyond it is behind every stored sample. Kept with `zmax` so that the
     /// hierarchical-Z test compares the triangle's f32 depth range without quantizing it.
     behind_from: f32,
     /// The smallest window depth that quantizes to `zmin` or more: a fragment before it is in
     /// front of every stored sample.
     in_front_below: f32,
-}
-
-/// The smallest window depth in [0, 1] that `format` quantizes to `q` or more, `+∞` when none
-/// does: a binary search over the ordered bit patterns of the non-negative f32, exact because
-/// quantizing is monotone. For every finite `z ≥ 0` (a triangle's depth range is clamped to
-/// [0, 1]), `quantize(z) >= q` ⇔ `z >= first_quantized_at_least(q)`.
-fn first_quantized_at_least(format: DepthFormat, q: u32) -> f32 {
-    let (mut lo, mut hi) = (0u32, 1.0f32.to_bits());
-    if format.quantize(f32::from_bits(hi)) < q {
-        return f32::INFINITY;
-    }
-    // Invariant: quantize(hi) >= q, and quantize(b) < q for every bit pattern b < lo.
-    while lo < hi {
-        let mid = lo + (hi - lo) / 2;
-        if format.quantize(f32::from_bits(mid)) >= q {
-            hi = mid;
-        } else {
-            lo = mid + 1;
-        }
-    }
-    f32::from_bits(hi)
 }
 
 impl DepthTile {
@@ -65,13 +44,14 @@ impl DepthTile {
     /// fragment's depth is).
     pub fn cleared_to(format: DepthFormat, z_w: f32, len: usize) -> Self {
         let z = format.quantize(z_w);
+        let threshold = format.first_quantized_at_least(z);
         Self {
             format,
             values: vec![z; len],
             zmin: z,
             zmax: z,
-            behind_from: first_quantized_at_least(format, z),
-            in_front_below: first_quantized_at_least(format, z),
+            behind_from: threshold,
+            in_front_below: threshold,
         }
     }
 
@@ -104,8 +84,8 @@ impl DepthTile {
         }
         self.zmin = lo;
         self.zmax = hi;
-        self.behind_from = first_quantized_at_least(self.format, hi);
-        self.in_front_below = first_quantized_at_least(self.format, lo);
+        self.behind_from = self.format.first_quantized_at_least(hi);
+        self.in_front_below = self.format.first_quantized_at_least(lo);
     }
 
     /// The depth test of fragment `f` against this tile (reads the stored value, counted).
@@ -175,43 +155,6 @@ impl DepthTile {
     /// depth format; [`Counters::hiz_read_bytes`]).
     pub fn hiz_read_bytes(&self) -> u64 {
         2 * self.format.bytes()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The thresholds decide `quantize(z) >= q` exactly as quantizing does, for every format,
-    /// at and around every threshold and over a sweep of depths.
-    #[test]
-    fn thresholds_agree_with_quantizing() {
-        for format in [DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F] {
-            let stored: Vec<u32> = [0.0f32, 1e-30, 1e-7, 0.25, 0.5, 0.7, 0.999_999, 1.0]
-                .iter()
-                .map(|&z| format.quantize(z))
-                .chain([format.far() + 1, 0])
-                .collect();
-            for &q in &stored {
-                let t = first_quantized_at_least(format, q);
-                let mut probes: Vec<f32> = (0..=1000).map(|k| k as f32 / 1000.0).collect();
-                if t.is_finite() {
-                    probes.extend([
-                        t,
-                        f32::from_bits(t.to_bits().saturating_sub(1)),
-                        f32::from_bits(t.to_bits() + 1),
-                    ]);
-                }
-                probes.extend([1.5, 1e-45]);
-                for z in probes {
-                    assert_eq!(
-                        format.quantize(z) >= q,
-                        z >= t,
-                        "{format:?} q {q} z {z:e} t {t:e}"
-                    );
-                }
-            }
-        }
     }
 }
 

@@ -46,6 +46,42 @@ impl DepthFormat {
         }
     }
 
+    /// The smallest window depth in [0, 1] that quantizes to `q` or more, `+∞` when none does:
+    /// for every finite `z ≥ 0`, `quantize(z) >= q` ⇔ `z >= first_quantized_at_least(q)`
+    /// (quantizing is monotone over the ordered bit patterns of the non-negative f32). The
+    /// hierarchical-Z unit compares a triangle's f32 depth range with these thresholds instead
+    /// of quantizing it per tile ([`super::buffers::DepthTile::depth_outcome`]). A binary
+    /// search over the bit patterns between the window depths of `q − 1` and `q` (the whole
+    /// of [0, 1] where rounding put either on the wrong side): a few steps, not thirty.
+    pub fn first_quantized_at_least(self, q: u32) -> f32 {
+        let at = |bits: u32| self.quantize(f32::from_bits(bits));
+        let one = 1.0f32.to_bits();
+        if at(one) < q {
+            return f32::INFINITY;
+        }
+        if at(0) >= q {
+            return 0.0;
+        }
+        // q ≥ 1 here. Invariant: at(lo) < q ≤ at(hi).
+        let near = |code: u32| (self.to_window(code) as f32).to_bits().min(one);
+        let (mut lo, mut hi) = (near(q - 1), near(q));
+        if at(lo) >= q {
+            lo = 0;
+        }
+        if at(hi) < q {
+            hi = one;
+        }
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            if at(mid) >= q {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        f32::from_bits(hi)
+    }
+
     /// The stored value of the clear depth 1.0.
     pub fn far(self) -> u32 {
         self.quantize(1.0)
@@ -182,6 +218,65 @@ impl DepthState {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Each threshold is the first depth of its code: it quantizes to `q` or more and the f32
+    /// just below it to less — for every D16 code and every 97th D24 code.
+    #[test]
+    fn each_threshold_is_the_first_depth_of_its_code() {
+        let codes = [
+            (DepthFormat::D16, (0..=D16_MAX + 1).collect::<Vec<_>>()),
+            (DepthFormat::D24, (0..=D24_MAX + 1).step_by(97).collect()),
+        ];
+        for (format, codes) in codes {
+            for q in codes {
+                let t = format.first_quantized_at_least(q);
+                if q > format.far() {
+                    assert_eq!(t, f32::INFINITY, "{format:?} {q}");
+                    continue;
+                }
+                assert!(format.quantize(t) >= q, "{format:?} {q}: {t:e}");
+                if t > 0.0 {
+                    let below = f32::from_bits(t.to_bits() - 1);
+                    assert!(format.quantize(below) < q, "{format:?} {q}: {below:e}");
+                }
+            }
+        }
+    }
+
+    /// The thresholds decide `quantize(z) >= q` exactly as quantizing does, for every format,
+    /// at and around every threshold and over a sweep of depths.
+    #[test]
+    fn thresholds_agree_with_quantizing() {
+        for format in [DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F] {
+            let stored: Vec<u32> = [0.0f32, 1e-30, 1e-7, 0.25, 0.5, 0.7, 0.999_999, 1.0]
+                .iter()
+                .flat_map(|&z| {
+                    let q = format.quantize(z);
+                    [q.saturating_sub(1), q, q + 1]
+                })
+                .chain([format.far() + 1, 0, 1])
+                .collect();
+            for &q in &stored {
+                let t = format.first_quantized_at_least(q);
+                let mut probes: Vec<f32> = (0..=1000).map(|k| k as f32 / 1000.0).collect();
+                if t.is_finite() {
+                    probes.extend([
+                        t,
+                        f32::from_bits(t.to_bits().saturating_sub(1)),
+                        f32::from_bits(t.to_bits() + 1),
+                    ]);
+                }
+                probes.extend([1.5, 1e-45]);
+                for z in probes {
+                    assert_eq!(
+                        format.quantize(z) >= q,
+                        z >= t,
+                        "{format:?} q {q} z {z:e} t {t:e}"
+                    );
+                }
+            }
+        }
+    }
 
     #[test]
     fn d24_endpoints_and_rounding() {
