@@ -9,10 +9,9 @@
 use crate::error::InputError;
 use crate::geometry::adjacency::{self, Adjacency};
 use crate::gpu::buffers::{alloc_tiles, DepthTile};
-use crate::gpu::counters::count;
-use crate::gpu::counters::Counters;
+use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::{DepthFormat, DepthFunc, DepthState};
-use crate::gpu::hiz::TileReceiverBounds;
+use crate::gpu::hiz::{TileReceiverBounds, HIZ_CULLED};
 use crate::gpu::probe::{PassProbe, Probe, ProbeEvent, Tap};
 use crate::gpu::raster::{bin, draw, no_tile_culling};
 pub use crate::gpu::setup::setup_all;
@@ -383,14 +382,16 @@ impl<'s> Frame<'s> {
     /// writing it) and leaves every buffer alone for a fragment whose test outcome is `idle`
     /// (z-pass volume counting does nothing where the test fails: `idle = false`; z-fail
     /// nothing where it passes: `idle = true`). The zmin/zmax read and the rejection are
-    /// counted in `c`.
+    /// counted in `c`; a rejection is recorded at the watched samples of `probe` the triangle
+    /// covers, as `event` describes the primitive, with the note [`HIZ_CULLED`].
     pub fn hiz_rejects_depth(
         &self,
         t: usize,
         tri: &RasterTriangle,
-        func: DepthFunc,
-        idle: bool,
+        (func, idle): (DepthFunc, bool),
         c: &mut Counters,
+        probe: Option<&PassProbe>,
+        event: impl Fn(Tap) -> ProbeEvent,
     ) -> bool {
         if !self.gpu.hiz {
             return false;
@@ -399,6 +400,9 @@ impl<'s> Frame<'s> {
         count!(c.hiz_read_bytes += depth.hiz_read_bytes());
         let culled = depth.depth_outcome(func, tri) == Some(idle);
         count!(c.tiles_culled_hiz += culled as u64);
+        if let (true, Some(probe)) = (culled, probe) {
+            probe.record_culled(t, tri, HIZ_CULLED, event);
+        }
         culled
     }
 

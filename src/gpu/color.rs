@@ -15,8 +15,7 @@
 //! one target can be filled by several draws that each own some of its channels.
 
 use super::buffers::{overflow_record, record_overflow};
-use super::counters::count;
-use super::counters::Counters;
+use super::counters::{count, Counters};
 use super::probe::Overflow;
 use half::f16;
 

@@ -5,14 +5,15 @@
 //! Every buffer access goes through the typed buffers in [`super::buffers`], which add to a
 //! tile-local `Counters`; tiles' counters are summed after a pass. Integer sums do not depend
 //! on the order tiles finish in, so counters are as deterministic as the images.
-//! Every count goes through the crate-private macro `count!`. Counting is on in every normal build (the cargo
-//! feature `counters`, a default feature): one integer add per access into a tile-local
-//! struct that lives in L1. Built with `--no-default-features`, every count compiles to
+//! Every count goes through the crate-private macro `count!`. Counting is on in every normal
+//! build (the cargo feature `counters`, a default feature): one integer add per access into a
+//! tile-local struct that lives in L1. Built with `--no-default-features`, every count compiles to
 //! nothing and every counter reads 0 — a build that exists only to measure what counting
 //! costs (`docs/architecture.md` "Counters"); its goldens, tests and traffic columns are
 //! meaningless.
 
 use serde::Serialize;
+use std::ops::AddAssign;
 
 /// Adds to a counter: `count!(c.depth_read_bytes += n)`. With the cargo feature `counters`
 /// off the statement is type-checked but never runs (module doc).
@@ -24,7 +25,6 @@ macro_rules! count {
     };
 }
 pub(crate) use count;
-use std::ops::AddAssign;
 
 /// Counters of one pass (or of a whole frame, once summed). Bytes are counted at the
 /// storage size of the emulated format (D24 = 3 bytes, stencil = 1, LI16 = 2, …).

@@ -19,8 +19,7 @@
 //! are counted as colour/LI read and write traffic.
 
 use super::buffers::{overflow_record, record_overflow};
-use super::counters::count;
-use super::counters::Counters;
+use super::counters::{count, Counters};
 use super::probe::{Overflow, ProbeEvent, Raw};
 
 /// Storage format of the LI buffer.

@@ -7,8 +7,7 @@
 //! tile outside one edge is skipped, a tile inside all three is filled without per-sample
 //! tests (edge functions are linear, so corners bound the whole tile).
 
-use super::counters::count;
-use super::counters::Counters;
+use super::counters::{count, Counters};
 use super::probe::{PassProbe, Tap};
 use super::setup::RasterTriangle;
 use super::tiling::{TileRect, Tiling};

@@ -22,8 +22,7 @@
 //! programs of this crate compute in f64. Triangles set up without them pay nothing.
 
 use super::clip::{clip_triangle, clip_triangle_barycentric, fully_inside};
-use super::counters::count;
-use super::counters::Counters;
+use super::counters::{count, Counters};
 use super::fixed::Fixed8;
 use super::tiling::Tiling;
 use super::transform::{viewport, ClipVertex};

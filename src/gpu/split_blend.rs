@@ -21,8 +21,7 @@
 //! [`crate::light::lookup_tables::SplitTable`].
 
 use super::buffers::{overflow_record, record_overflow};
-use super::counters::count;
-use super::counters::Counters;
+use super::counters::{count, Counters};
 use super::probe::{Overflow, ProbeEvent, Raw};
 
 /// The channel layout of a split value: how many upper bits of each 8-bit channel are reserved

@@ -30,8 +30,7 @@
 //! only, which the method merges with its stencil umbra.
 
 use super::buffers::{overflow_record, record_overflow};
-use super::counters::count;
-use super::counters::Counters;
+use super::counters::{count, Counters};
 use super::probe::{Overflow, ProbeEvent, Raw, Tap};
 use half::f16;
 

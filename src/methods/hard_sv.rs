@@ -24,10 +24,8 @@ use crate::error::InputError;
 use crate::frame::{setup_all, Frame, BACKGROUND};
 use crate::geometry::shadow_volume::{shadow_volume_parts, shadow_volume_triangles, Capping};
 use crate::gpu::buffers::{alloc_tiles, StencilTile};
-use crate::gpu::counters::count;
-use crate::gpu::counters::Counters;
+use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::{DepthFunc, DepthState};
-use crate::gpu::hiz::HIZ_CULLED;
 use crate::gpu::probe::Raw;
 use crate::gpu::raster::{bin, draw_probed};
 use crate::gpu::setup::CullMode;
@@ -214,15 +212,15 @@ pub fn stencil_shadow(
             &bins,
             probe.as_ref(),
             |t, _, tri, c| {
-                let culled = frame.hiz_rejects_depth(t, tri, depth.func, s.test.idle_outcome(), c);
-                if let (true, Some(probe), Some(parts)) = (culled, &probe, &parts) {
-                    probe.record_culled(t, tri, HIZ_CULLED, |tap| {
+                let idle = (depth.func, s.test.idle_outcome());
+                frame.hiz_rejects_depth(t, tri, idle, c, probe.as_ref(), |tap| match &parts {
+                    Some(parts) => {
                         let (kind, detail) = parts[tri.prim as usize].describe();
                         tap.event()
                             .primitive(kind, tri.prim, detail, Some(tri.front_facing))
-                    });
-                }
-                culled
+                    }
+                    None => tap.event(),
+                })
             },
             |t, st, tri, f, c, tap| {
                 let (pass, z) = frame.tiles[t].depth.test(&depth, &f, c);

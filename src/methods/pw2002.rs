@@ -57,7 +57,6 @@ use crate::geometry::penumbra_wedge::{
 use crate::gpu::buffers::alloc_tiles;
 use crate::gpu::counters::count;
 use crate::gpu::depth::{DepthFunc, DepthState};
-use crate::gpu::hiz::HIZ_CULLED;
 use crate::gpu::li_buffer::{li_clamped, li_visibility, LiFormat, LiOverflow, LiTile, LI_CLEAR};
 use crate::gpu::probe::{PrimitiveKind, ProbeEvent, Raw, Tap};
 use crate::gpu::raster::{bin, draw_probed};
@@ -345,18 +344,23 @@ fn render_li_with<T: ShaderFloat>(
         probe.as_ref(),
         |t, _, tri, c| {
             // A fragment failing the depth test does nothing (below).
-            let culled =
-                s.hiz_culling && frame.hiz_rejects_depth(t, tri, depth_state.func, false, c);
-            if let (true, Some(probe)) = (culled, &probe) {
-                probe.record_culled(t, tri, HIZ_CULLED, |tap| {
-                    let wt = &tris[tri.prim as usize];
-                    match (wt.wedge, wt.kind) {
-                        (Some(wi), Some(kind)) => wedge_primitive(tap.event(), set, wi, kind, tri),
-                        _ => tap.event(),
-                    }
-                });
-            }
-            culled
+            s.hiz_culling
+                && frame.hiz_rejects_depth(
+                    t,
+                    tri,
+                    (depth_state.func, false),
+                    c,
+                    probe.as_ref(),
+                    |tap| {
+                        let wt = &tris[tri.prim as usize];
+                        match (wt.wedge, wt.kind) {
+                            (Some(wi), Some(kind)) => {
+                                wedge_primitive(tap.event(), set, wi, kind, tri)
+                            }
+                            _ => tap.event(),
+                        }
+                    },
+                )
         },
         |t, tile, tri, f, c, tap| {
             let depth = &frame.tiles[t].depth;

@@ -89,8 +89,7 @@ use crate::geometry::penumbra_wedge::{
     wedge_triangles, FaceKind, ScreenWedge, WedgeSet, WedgeTriangle,
 };
 use crate::gpu::buffers::{alloc_tiles, StencilTile};
-use crate::gpu::counters::count;
-use crate::gpu::counters::Counters;
+use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::DepthFunc;
 use crate::gpu::li_buffer::{LiTile, LI_CLEAR};
 use crate::gpu::probe::{PassProbe, PrimitiveKind, ProbeEvent, Raw};

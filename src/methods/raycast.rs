@@ -604,22 +604,14 @@ impl ShadowRayCaster {
     /// the binned path is tested against).
     fn trace_each(&self, origin: DVec3, samples: &[LightSample], scratch: &mut Scratch) {
         scratch.stack.resize(self.depth + 2, 0);
-        // The previous ray's blocker first, as in `trace_binned`.
         let mut last_blocker: Option<u32> = None;
         for (s, lit) in samples.iter().zip(scratch.lit.iter_mut()) {
             let target = s.position.as_dvec3();
             let d = target - origin;
-            let blocker = match last_blocker {
-                Some(ti)
-                    if d != DVec3::ZERO
-                        && self.triangles[ti as usize].blocks(origin, d, self.segment_start(d)) =>
-                {
-                    Some(ti)
-                }
-                _ => self.blocker(origin, target, &mut scratch.stack),
-            };
-            *lit = blocker.is_none();
-            last_blocker = blocker.or(last_blocker);
+            let blocks =
+                |ti: u32| self.triangles[ti as usize].blocks(origin, d, self.segment_start(d));
+            let search = || self.blocker(origin, target, &mut scratch.stack);
+            *lit = !blocked_after(&mut last_blocker, blocks, search);
         }
     }
 
@@ -731,10 +723,7 @@ impl ShadowRayCaster {
                 }
             }
         }
-        // Each ray: the plane point it passes through gives its cell. The triangle that
-        // blocked the previous ray is tested first: neighbouring samples (the strata run in
-        // order) are mostly blocked by the same one, and a ray is blocked if any triangle
-        // blocks it, so the order changes no answer.
+        // Each ray: the plane point it passes through gives its cell.
         let mut last_blocker: Option<u32> = None;
         for (s, lit) in samples.iter().zip(scratch.lit.iter_mut()) {
             let target = s.position.as_dvec3();
@@ -752,17 +741,15 @@ impl ShadowRayCaster {
             let cell = &scratch.cell_items
                 [scratch.cell_start[c] as usize..scratch.cell_start[c + 1] as usize];
             let blocks = |ti: u32| self.triangles[ti as usize].blocks(origin, d, t_start);
-            let blocker = match last_blocker {
-                Some(ti) if blocks(ti) => Some(ti),
-                _ => scratch
+            let search = || {
+                scratch
                     .global
                     .iter()
                     .chain(cell)
                     .copied()
-                    .find(|&ti| blocks(ti)),
+                    .find(|&ti| blocks(ti))
             };
-            *lit = blocker.is_none();
-            last_blocker = blocker.or(last_blocker);
+            *lit = !blocked_after(&mut last_blocker, blocks, search);
         }
         true
     }
@@ -837,6 +824,23 @@ impl ShadowRayCaster {
         }
         None
     }
+}
+
+/// Whether a ray is blocked, testing first `last`, the triangle that blocked the receiver's
+/// previous ray (module doc, "Acceleration", 4: neighbouring samples are mostly blocked by the
+/// same triangle; a ray is blocked if any triangle blocks it, so the order changes no answer),
+/// then what `search` finds; `last` becomes this ray's blocker when it has one.
+fn blocked_after(
+    last: &mut Option<u32>,
+    blocks: impl Fn(u32) -> bool,
+    search: impl FnOnce() -> Option<u32>,
+) -> bool {
+    let blocker = match *last {
+        Some(ti) if blocks(ti) => Some(ti),
+        _ => search(),
+    };
+    *last = blocker.or(*last);
+    blocker.is_some()
 }
 
 /// `a < b ? a : b` (the second operand when either is NaN): one `minss`.

@@ -73,10 +73,9 @@ use crate::frame::{setup_all, Frame, Receiver, FULL_SCREEN};
 use crate::geometry::shadow_volume::{shadow_volume_parts, shadow_volume_triangles, Capping};
 use crate::geometry::silhouette::{light_facing, possible_silhouettes};
 use crate::geometry::ssv_wedge::{SsvWedge, WedgeLight};
-use crate::gpu::counters::count;
-use crate::gpu::counters::Counters;
+use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::{DepthFunc, DepthState};
-use crate::gpu::hiz::{InsideTestRounding, TileReceiverBounds, HIZ_CULLED};
+use crate::gpu::hiz::{InsideTestRounding, TileReceiverBounds};
 use crate::gpu::probe::{PrimitiveKind, Tap};
 use crate::gpu::raster::{bin, draw_probed};
 use crate::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
@@ -629,20 +628,15 @@ fn hard_quads_pass<V: VBufferTile>(frame: &Frame, test: ShadowTest, vbuf: &mut [
         &bins,
         probe.as_ref(),
         |t, _, tri, c| {
-            let culled = frame.hiz_rejects_depth(t, tri, depth.func, test.idle_outcome(), c);
-            if let (true, Some(probe)) = (culled, &probe) {
-                probe.record_culled(t, tri, HIZ_CULLED, |tap| {
-                    let e = tap.event();
-                    match &parts {
-                        Some(parts) => {
-                            let (kind, detail) = parts[tri.prim as usize].describe();
-                            e.primitive(kind, tri.prim, detail, Some(tri.front_facing))
-                        }
-                        None => e,
-                    }
-                });
-            }
-            culled
+            let idle = (depth.func, test.idle_outcome());
+            frame.hiz_rejects_depth(t, tri, idle, c, probe.as_ref(), |tap| match &parts {
+                Some(parts) => {
+                    let (kind, detail) = parts[tri.prim as usize].describe();
+                    tap.event()
+                        .primitive(kind, tri.prim, detail, Some(tri.front_facing))
+                }
+                None => tap.event(),
+            })
         },
         |t, vb, tri, f, c, tap| {
             let (pass, z) = frame.tiles[t].depth.test(&depth, &f, c);

@@ -110,10 +110,8 @@ use crate::geometry::tight_wedge::{
     DEFAULT_SPHERE_SIDES,
 };
 use crate::gpu::buffers::{alloc_tiles, StencilTile};
-use crate::gpu::counters::count;
-use crate::gpu::counters::Counters;
+use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::{DepthFunc, DepthState};
-use crate::gpu::hiz::HIZ_CULLED;
 use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw};
 use crate::gpu::raster::{bin, draw_probed};
 use crate::gpu::setup::{CullMode, RasterTriangle};
@@ -706,11 +704,9 @@ fn render_group<T: ShaderFloat>(
                     }
                     _ => return false,
                 };
-                let culled = frame.hiz_rejects_depth(t, tri, func, idle, cnt);
-                if let (true, Some(probe)) = (culled, &probe) {
-                    probe.record_culled(t, tri, HIZ_CULLED, |tap| primitive(tap.event(), tri));
-                }
-                culled
+                frame.hiz_rejects_depth(t, tri, (func, idle), cnt, probe.as_ref(), |tap| {
+                    primitive(tap.event(), tri)
+                })
             },
             |t, st, tri, f, cnt, tap| match roles[tri.prim as usize] {
                 Role::Quad => {

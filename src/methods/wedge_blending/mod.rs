@@ -140,10 +140,8 @@ use crate::geometry::tight_wedge::{
     bounding_planes, quad_inner_halfspace, wedge_clip_box, wedge_halves_and_planes,
 };
 use crate::gpu::buffers::{alloc_tiles, overflow_record, record_overflow, StencilTile};
-use crate::gpu::counters::count;
-use crate::gpu::counters::Counters;
+use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::{DepthFunc, DepthState};
-use crate::gpu::hiz::HIZ_CULLED;
 use crate::gpu::pack4ub::{FloatTarget, StoreEvents};
 use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw};
 use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
@@ -753,18 +751,15 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
             // as drawn, and a tile the silhouette left alone is skipped by the later passes
             // without changing the result (module doc, "Only where the silhouette was drawn").
             |t, _, tri, cnt| {
-                let culled = frame.hiz_rejects_depth(t, tri, less.func, s.test.idle_outcome(), cnt);
-                if let (true, Some(probe)) = (culled, &probes[0]) {
-                    probe.record_culled(t, tri, HIZ_CULLED, |tap| {
-                        tap.event().primitive(
-                            PrimitiveKind::VolumeTriangle,
-                            tri.prim,
-                            format!("of silhouette {si}"),
-                            Some(tri.front_facing),
-                        )
-                    });
-                }
-                culled
+                let idle = (less.func, s.test.idle_outcome());
+                frame.hiz_rejects_depth(t, tri, idle, cnt, probes[0].as_ref(), |tap| {
+                    tap.event().primitive(
+                        PrimitiveKind::VolumeTriangle,
+                        tri.prim,
+                        format!("of silhouette {si}"),
+                        Some(tri.front_facing),
+                    )
+                })
             },
             |t, tile, tri, f, cnt, tap| {
                 let (pass, z) = frame.tiles[t].depth.test(&less, &f, cnt);
