@@ -13,7 +13,8 @@
 
 use super::adjacency::Adjacency;
 use super::silhouette::{away_from_light, light_facing, possible_silhouettes};
-use crate::gpu::probe::PrimitiveKind;
+use crate::gpu::probe::{PrimitiveKind, ProbeEvent};
+use crate::gpu::setup::RasterTriangle;
 use crate::gpu::transform::{ClipVertex, Projection};
 use crate::scene::Mesh;
 use glam::Vec3;
@@ -69,6 +70,23 @@ pub enum VolumePart {
         /// The mesh's triangle.
         triangle: usize,
     },
+}
+
+/// The probe event `e` naming the volume triangle `tri` ([`VolumePart::describe`] of its
+/// primitive in `parts`, the parts of the submitted volume; `None` when no probe asked for
+/// them, and `e` is returned as it is).
+pub fn volume_event(
+    e: ProbeEvent,
+    parts: Option<&[VolumePart]>,
+    tri: &RasterTriangle,
+) -> ProbeEvent {
+    match parts {
+        Some(parts) => {
+            let (kind, detail) = parts[tri.prim as usize].describe();
+            e.primitive(kind, tri.prim, detail, Some(tri.front_facing))
+        }
+        None => e,
+    }
 }
 
 impl VolumePart {

@@ -22,7 +22,9 @@ use super::dump::{row_major, BufferDump, DumpValues, ElementFormat, EventKind, E
 use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, BACKGROUND};
-use crate::geometry::shadow_volume::{shadow_volume_parts, shadow_volume_triangles, Capping};
+use crate::geometry::shadow_volume::{
+    shadow_volume_parts, shadow_volume_triangles, volume_event, Capping,
+};
 use crate::gpu::buffers::{alloc_tiles, StencilTile};
 use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::{DepthFunc, DepthState};
@@ -213,24 +215,16 @@ pub fn stencil_shadow(
             probe.as_ref(),
             |t, _, tri, c| {
                 let idle = (depth.func, s.test.idle_outcome());
-                frame.hiz_rejects_depth(t, tri, idle, c, probe.as_ref(), |tap| match &parts {
-                    Some(parts) => {
-                        let (kind, detail) = parts[tri.prim as usize].describe();
-                        tap.event()
-                            .primitive(kind, tri.prim, detail, Some(tri.front_facing))
-                    }
-                    None => tap.event(),
+                frame.hiz_rejects_depth(t, tri, idle, c, probe.as_ref(), |tap| {
+                    volume_event(tap.event(), parts.as_deref(), tri)
                 })
             },
             |t, st, tri, f, c, tap| {
                 let (pass, z) = frame.tiles[t].depth.test(&depth, &f, c);
                 count!(c.depth_passed += pass as u64);
                 let update = st.apply(&state, tri.front_facing, &f, pass, c);
-                if let (Some(tap), Some(parts)) = (tap, &parts) {
-                    let (kind, detail) = parts[tri.prim as usize].describe();
-                    let e = tap
-                        .event()
-                        .primitive(kind, tri.prim, detail, Some(tri.front_facing));
+                if let Some(tap) = tap {
+                    let e = volume_event(tap.event(), parts.as_deref(), tri);
                     let e = frame.tiles[t]
                         .depth
                         .record_test(e, depth.func, f.local, z, pass);

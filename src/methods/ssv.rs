@@ -70,7 +70,9 @@ use super::hard_sv::{StencilShadowSettings, Submission};
 use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, Receiver, FULL_SCREEN};
-use crate::geometry::shadow_volume::{shadow_volume_parts, shadow_volume_triangles, Capping};
+use crate::geometry::shadow_volume::{
+    shadow_volume_parts, shadow_volume_triangles, volume_event, Capping,
+};
 use crate::geometry::silhouette::{light_facing, possible_silhouettes};
 use crate::geometry::ssv_wedge::{SsvWedge, WedgeLight};
 use crate::gpu::counters::{count, Counters};
@@ -629,13 +631,8 @@ fn hard_quads_pass<V: VBufferTile>(frame: &Frame, test: ShadowTest, vbuf: &mut [
         probe.as_ref(),
         |t, _, tri, c| {
             let idle = (depth.func, test.idle_outcome());
-            frame.hiz_rejects_depth(t, tri, idle, c, probe.as_ref(), |tap| match &parts {
-                Some(parts) => {
-                    let (kind, detail) = parts[tri.prim as usize].describe();
-                    tap.event()
-                        .primitive(kind, tri.prim, detail, Some(tri.front_facing))
-                }
-                None => tap.event(),
+            frame.hiz_rejects_depth(t, tri, idle, c, probe.as_ref(), |tap| {
+                volume_event(tap.event(), parts.as_deref(), tri)
             })
         },
         |t, vb, tri, f, c, tap| {
@@ -643,14 +640,7 @@ fn hard_quads_pass<V: VBufferTile>(frame: &Frame, test: ShadowTest, vbuf: &mut [
             count!(c.depth_passed += pass as u64);
             // The watched fragment's event, built only there.
             let event = |tap: Tap| {
-                let e = tap.event();
-                let e = match &parts {
-                    Some(parts) => {
-                        let (kind, detail) = parts[tri.prim as usize].describe();
-                        e.primitive(kind, tri.prim, detail, Some(tri.front_facing))
-                    }
-                    None => e,
-                };
+                let e = volume_event(tap.event(), parts.as_deref(), tri);
                 frame.tiles[t]
                     .depth
                     .record_test(e, depth.func, f.local, z, pass)
