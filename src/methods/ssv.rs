@@ -88,8 +88,8 @@ use crate::gpu::vbuffer::{
     VBufferTile,
 };
 use crate::light::coverage::{
-    shader_edge_coverage, shader_projected_edge_in_light, shader_quad_side,
-    shader_sphere_edge_coverage,
+    shader_projected_edge_in_light, shader_quad_side, shader_sphere_edge_coverage,
+    EdgeCoverageProgram,
 };
 use crate::light::coverage_texture::{
     coverage_texture, CoverageFilter, CoverageTexture, CoverageTextureKey, DEFAULT_N, MAX_N, MIN_N,
@@ -245,18 +245,21 @@ struct EdgeWedge {
 }
 
 /// Everything pass 2 needs per fragment.
-struct CoverageSource<'a> {
+struct CoverageSource<'a, T> {
     light: WedgeLight,
+    /// Under a rectangle with exact coverage, the fragment program of each edge's coverage
+    /// with its per-edge terms computed once (indexed as the edges), else empty.
+    programs: Vec<EdgeCoverageProgram<T>>,
     mode: CoverageMode,
     texture: Option<Arc<CoverageTexture>>,
     receivers: &'a [Option<Receiver>],
     width: u32,
 }
 
-impl CoverageSource<'_> {
-    /// The signed per-channel coverage of edge `w` at `p` (module doc), computed in the shader
-    /// precision `T` (module doc, "Shader precision").
-    fn coverage<T: ShaderFloat>(&self, w: &EdgeWedge, p: DVec3) -> [f32; 3] {
+impl<T: ShaderFloat> CoverageSource<'_, T> {
+    /// The signed per-channel coverage of edge `k`, `w`, at `p` (module doc), computed in the
+    /// shader precision `T` (module doc, "Shader precision").
+    fn coverage(&self, k: usize, w: &EdgeWedge, p: DVec3) -> [f32; 3] {
         let light = match self.light {
             WedgeLight::Rect(light) => light,
             WedgeLight::Sphere { center, radius } => {
@@ -274,7 +277,7 @@ impl CoverageSource<'_> {
                 t.lookup(a.to_f64(), b.to_f64(), filter)
                     .map(|v| (s * T::from_f64(v)).to_f64() as f32)
             }
-            _ => [shader_edge_coverage::<T>(&light, p, w.e0, w.e1).to_f64() as f32; 3],
+            _ => [self.programs[k].at(p).to_f64() as f32; 3],
         }
     }
 }
@@ -406,8 +409,16 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSett
             _ => CoverageTextureKey::uniform(n),
         })),
     };
+    let programs = match (light, settings.coverage) {
+        (WedgeLight::Rect(rect), CoverageMode::Exact) => edges
+            .iter()
+            .map(|w| EdgeCoverageProgram::<T>::new(&rect, w.e0, w.e1))
+            .collect(),
+        _ => Vec::new(),
+    };
     let source = CoverageSource {
         light,
+        programs,
         mode: settings.coverage,
         texture,
         receivers,
@@ -493,7 +504,7 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSett
                 return stop("receiver outside the wedge: discarded");
             }
             count!(c.fragments_shaded += 1);
-            let coverage = source.coverage::<T>(ew, p);
+            let coverage = source.coverage(k as usize, ew, p);
             add_probed(vb, f.local, coverage, c, tap, |tap| {
                 event(tap).value("coverage", coverage[0] as f64)
             });
