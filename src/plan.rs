@@ -292,11 +292,15 @@ impl BufferPlan {
     }
 
     /// The hierarchical-Z unit's per-tile receiver bounds ([`crate::gpu::hiz::TileReceiverBounds`]):
-    /// six f32 per tile, as whole bytes per sample rounded up.
+    /// six f32 per tile and per block of tiles, as whole bytes per sample rounded up.
     pub fn hiz_receiver_bounds(gpu: &crate::frame::GpuSettings) -> Self {
         let tile_len = gpu.tile_size * gpu.tile_size;
         Self {
-            name: format!("tile receiver bounds (6 per {0}×{0} tile)", gpu.tile_size),
+            name: format!(
+                "tile receiver bounds (6 per {0}×{0} tile and per {1}×{1} tiles)",
+                gpu.tile_size,
+                crate::gpu::hiz::BLOCK_TILES
+            ),
             format: "f32x6".into(),
             bytes_per_sample: (crate::gpu::hiz::TileReceiverBounds::READ_BYTES as u32)
                 .div_ceil(tile_len),

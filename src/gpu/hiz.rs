@@ -17,7 +17,8 @@
 //!   box ([`plane_rejects_box`]), in the fragment program's own arithmetic — shades nothing
 //!   there. This is the same reduction as zmin/zmax, taken over the position buffer instead of
 //!   the depth buffer (Paper IV §4.2 keeps positions in a texture); a tile without receivers
-//!   (all background) rejects every wedge.
+//!   (all background) rejects every wedge. A coarse level over blocks of [`BLOCK_TILES`]²
+//!   tiles is read first ([`TileReceiverBounds::kept_tiles`]).
 //!
 //! The receiver box is used rather than the tile's frustum between zmin and zmax because the
 //! receiver points are not always on the depth buffer's surface (`Frame::receivers` moves a
@@ -25,6 +26,7 @@
 //! may round positions to binary16): the box of the points actually read is the bound that
 //! holds for every fragment.
 
+use super::counters::{count, Counters};
 use super::shader_float::FloatFormat;
 use super::tiling::Tiling;
 use glam::DVec3;
@@ -35,43 +37,109 @@ pub const HIZ_CULLED: &str =
     "culled for the tile by the hierarchical Z (zmin/zmax): no fragment could change a buffer";
 
 /// Per screen tile, the axis-aligned box of the receiver points its fragment programs read
-/// (module doc), `None` for a tile with no receiver.
+/// (module doc), `None` for a tile with no receiver; and the same per block of
+/// [`BLOCK_TILES`]² tiles, the union of its tiles' boxes: the coarse level of a two-level
+/// pyramid, which [`TileReceiverBounds::kept_tiles`] reads first.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TileReceiverBounds {
     boxes: Vec<Option<[DVec3; 2]>>,
+    blocks: Vec<Option<[DVec3; 2]>>,
+    tiles_x: u32,
+    blocks_x: u32,
+}
+
+/// Tiles per side of a block of [`TileReceiverBounds`]' coarse level (4×4 tiles, 32×32
+/// pixels with the default 8×8 tile).
+pub const BLOCK_TILES: u32 = 4;
+
+/// The union of two optional boxes.
+fn union(a: Option<[DVec3; 2]>, b: Option<[DVec3; 2]>) -> Option<[DVec3; 2]> {
+    match (a, b) {
+        (Some([lo, hi]), Some([l, h])) => Some([lo.min(l), hi.max(h)]),
+        (a, None) => a,
+        (None, b) => b,
+    }
 }
 
 impl TileReceiverBounds {
-    /// Bytes one read of a tile's bounds costs: six f32 (the receiver points are f32 or
-    /// narrower).
+    /// Bytes one read of a tile's (or a block's) bounds costs: six f32 (the receiver points
+    /// are f32 or narrower).
     pub const READ_BYTES: u64 = 24;
 
     /// The bounds of the points `point(x, y)` (the receiver of pixel (x, y), `None` for
-    /// background) over every tile of `tiling`.
+    /// background) over every tile of `tiling`, and over its blocks.
     pub fn new(tiling: &Tiling, point: impl Fn(u32, u32) -> Option<DVec3>) -> Self {
-        let boxes = (0..tiling.tile_count())
+        let boxes: Vec<Option<[DVec3; 2]>> = (0..tiling.tile_count())
             .map(|t| {
                 let r = tiling.rect(t);
-                let mut bounds: Option<[DVec3; 2]> = None;
+                let mut bounds = None;
                 for y in r.y0..r.y1 {
                     for x in r.x0..r.x1 {
-                        if let Some(p) = point(x, y) {
-                            bounds = Some(match bounds {
-                                None => [p, p],
-                                Some([lo, hi]) => [lo.min(p), hi.max(p)],
-                            });
-                        }
+                        bounds = union(bounds, point(x, y).map(|p| [p, p]));
                     }
                 }
                 bounds
             })
             .collect();
-        TileReceiverBounds { boxes }
+        let blocks_x = tiling.tiles_x.div_ceil(BLOCK_TILES);
+        let mut blocks = vec![None; (blocks_x * tiling.tiles_y.div_ceil(BLOCK_TILES)) as usize];
+        for (t, b) in boxes.iter().enumerate() {
+            let (tx, ty) = (t as u32 % tiling.tiles_x, t as u32 / tiling.tiles_x);
+            let k = ((ty / BLOCK_TILES) * blocks_x + tx / BLOCK_TILES) as usize;
+            blocks[k] = union(blocks[k], *b);
+        }
+        TileReceiverBounds {
+            boxes,
+            blocks,
+            tiles_x: tiling.tiles_x,
+            blocks_x,
+        }
     }
 
     /// The box `[lo, hi]` of tile `t`'s receivers, `None` when it has none.
     pub fn tile(&self, t: usize) -> Option<[DVec3; 2]> {
         self.boxes[t]
+    }
+
+    /// The tiles of the rectangle of tiles `[tx0, tx1] × [ty0, ty1]` (inclusive) where a
+    /// primitive whose inside test `rejects` a box may shade a receiver, in increasing index:
+    /// each block the rectangle meets is read once and, where its box is rejected or empty,
+    /// so are all its tiles; otherwise each of its tiles in the rectangle is read and kept
+    /// unless its own box is rejected or empty. A tile inside a rejected block's box would be
+    /// rejected by itself too when `rejects` is monotone (a box rejected has every box inside
+    /// it rejected, as [`plane_rejects_box`]'s are): the kept tiles are those a per-tile test
+    /// keeps, found with fewer reads. Each read is counted in `c`
+    /// ([`TileReceiverBounds::READ_BYTES`]).
+    pub fn kept_tiles(
+        &self,
+        [tx0, ty0, tx1, ty1]: [u32; 4],
+        rejects: impl Fn([DVec3; 2]) -> bool,
+        c: &mut Counters,
+    ) -> Vec<u32> {
+        let (bx0, bx1) = (tx0 / BLOCK_TILES, tx1 / BLOCK_TILES);
+        let mut block_kept = vec![false; (bx1 - bx0 + 1) as usize];
+        let mut kept = Vec::new();
+        for ty in ty0..=ty1 {
+            if ty == ty0 || ty % BLOCK_TILES == 0 {
+                let by = ty / BLOCK_TILES;
+                for (bx, k) in (bx0..=bx1).zip(&mut block_kept) {
+                    count!(c.hiz_read_bytes += Self::READ_BYTES);
+                    *k = self.blocks[(by * self.blocks_x + bx) as usize]
+                        .is_some_and(|b| !rejects(b));
+                }
+            }
+            for tx in tx0..=tx1 {
+                if !block_kept[(tx / BLOCK_TILES - bx0) as usize] {
+                    continue;
+                }
+                let t = ty * self.tiles_x + tx;
+                count!(c.hiz_read_bytes += Self::READ_BYTES);
+                if self.boxes[t as usize].is_some_and(|b| !rejects(b)) {
+                    kept.push(t);
+                }
+            }
+        }
+        kept
     }
 }
 
@@ -196,6 +264,39 @@ mod tests {
         let at = |format| plane_rejects_box(n, DVec3::ZERO, far, &InsideTestRounding::new(format));
         assert!(!at(FP16));
         assert!(at(FP32));
+    }
+
+    /// The two-level decision keeps exactly the tiles the per-tile test keeps, in increasing
+    /// order, and reads fewer bounds where whole blocks are rejected.
+    #[test]
+    fn kept_tiles_are_the_tiles_the_per_tile_test_keeps() {
+        let tiling = Tiling::new(100, 72, 8).unwrap();
+        // Receivers on a tilted floor, none in a hole.
+        let b = TileReceiverBounds::new(&tiling, |x, y| {
+            let hole = (30..50).contains(&x) && (10..40).contains(&y);
+            (!hole).then(|| DVec3::new(x as f64, 0.1 * y as f64, y as f64))
+        });
+        let rounding = InsideTestRounding::new(FP32);
+        for (n, o) in [
+            (DVec3::new(1.0, 0.0, 0.0), DVec3::new(60.5, 0.0, 0.0)),
+            (DVec3::new(-0.6, 0.0, 0.8), DVec3::new(20.0, 0.0, 30.0)),
+            (DVec3::new(0.0, 1.0, 0.0), DVec3::new(0.0, -1.0, 0.0)),
+        ] {
+            let rejects = |bx: [DVec3; 2]| plane_rejects_box(n, o, bx, &rounding);
+            for rect in [[0, 0, 12, 8], [3, 1, 9, 6], [5, 5, 5, 5]] {
+                let mut c = Counters::default();
+                let kept = b.kept_tiles(rect, rejects, &mut c);
+                let want: Vec<u32> = (0..tiling.tile_count() as u32)
+                    .filter(|&t| tiling.tile_in_rect(t as usize, rect))
+                    .filter(|&t| b.tile(t as usize).is_some_and(|bx| !rejects(bx)))
+                    .collect();
+                assert_eq!(kept, want, "plane {n} through {o}, tiles {rect:?}");
+                let per_tile = tiling.rect_tile_count(rect) as u64 * TileReceiverBounds::READ_BYTES;
+                if rect == [0, 0, 12, 8] && n.x == 1.0 {
+                    assert!(c.hiz_read_bytes < per_tile, "{} reads", c.hiz_read_bytes);
+                }
+            }
+        }
     }
 
     #[test]

@@ -51,11 +51,40 @@ const BIN_BAND_ROWS: u32 = 4;
 /// band of four tile rows, the bands in parallel, each scanning every triangle.
 /// Concatenated in band order the lists are the same for any thread count.
 pub fn bin(tiling: &Tiling, tris: &[RasterTriangle]) -> Bins {
+    bin_to(tiling, tris.len(), |k, rows| {
+        bbox_tiles(tiling, &tris[k], rows)
+    })
+}
+
+/// The tiles of the tile rows `rows` that triangle `t`'s bounding box touches, in increasing
+/// index.
+pub fn bbox_tiles(
+    tiling: &Tiling,
+    t: &RasterTriangle,
+    rows: std::ops::Range<u32>,
+) -> impl Iterator<Item = usize> {
+    let (tile, tiles_x) = (tiling.tile, tiling.tiles_x);
+    let [x0, y0, x1, y1] = t.bbox;
+    let ty = (y0 / tile).max(rows.start)..(y1 / tile + 1).min(rows.end);
+    ty.flat_map(move |ty| (x0 / tile..=x1 / tile).map(move |tx| (ty * tiles_x + tx) as usize))
+}
+
+/// Bin `count` primitives: primitive `k` goes to the tiles `tiles(k, rows)` names among the
+/// tile rows `rows`, in increasing index (a primitive's bounding-box tiles for [`bin`], fewer
+/// where a pass has already rejected some). The same counting sort and bands as [`bin`].
+pub fn bin_to<I>(
+    tiling: &Tiling,
+    count: usize,
+    tiles: impl Fn(usize, std::ops::Range<u32>) -> I + Sync,
+) -> Bins
+where
+    I: Iterator<Item = usize>,
+{
     let bands: Vec<(Vec<u32>, Vec<u32>)> = (0..tiling.tiles_y.div_ceil(BIN_BAND_ROWS))
         .into_par_iter()
         .map(|band| {
             let rows = band * BIN_BAND_ROWS..((band + 1) * BIN_BAND_ROWS).min(tiling.tiles_y);
-            bin_band(tiling, tris, rows)
+            bin_band(tiling, count, |k| tiles(k, rows.clone()), rows.clone())
         })
         .collect();
     let mut starts = Vec::with_capacity(tiling.tile_count() + 1);
@@ -74,27 +103,22 @@ pub fn bin(tiling: &Tiling, tris: &[RasterTriangle]) -> Bins {
 }
 
 /// The bins of the tile rows `rows`: each tile's start in the band's indices (with the band's
-/// total appended), and the indices.
-fn bin_band(
+/// total appended), and the indices. `touched(k)` names primitive k's tiles in the band.
+fn bin_band<I>(
     tiling: &Tiling,
-    tris: &[RasterTriangle],
+    count: usize,
+    touched: impl Fn(usize) -> I,
     rows: std::ops::Range<u32>,
-) -> (Vec<u32>, Vec<u32>) {
-    let (tile, tiles_x) = (tiling.tile, tiling.tiles_x);
-    let first = (rows.start * tiles_x) as usize;
-    let tiles = ((rows.end - rows.start) * tiles_x) as usize;
-    // The band's tiles a triangle's box touches, row by row.
-    let touched = |t: &RasterTriangle| {
-        let [x0, y0, x1, y1] = t.bbox;
-        let (ty0, ty1) = ((y0 / tile).max(rows.start), (y1 / tile).min(rows.end - 1));
-        (ty0..=ty1).flat_map(move |ty| {
-            (x0 / tile..=x1 / tile).map(move |tx| (ty * tiles_x + tx) as usize - first)
-        })
-    };
+) -> (Vec<u32>, Vec<u32>)
+where
+    I: Iterator<Item = usize>,
+{
+    let first = (rows.start * tiling.tiles_x) as usize;
+    let tiles = ((rows.end - rows.start) * tiling.tiles_x) as usize;
     let mut starts = vec![0u32; tiles + 1];
-    for t in tris {
-        for k in touched(t) {
-            starts[k + 1] += 1;
+    for k in 0..count {
+        for t in touched(k) {
+            starts[t - first + 1] += 1;
         }
     }
     for k in 1..starts.len() {
@@ -102,10 +126,10 @@ fn bin_band(
     }
     let mut next = starts.clone();
     let mut indices = vec![0u32; starts[tiles] as usize];
-    for (n, t) in tris.iter().enumerate() {
-        for k in touched(t) {
-            indices[next[k] as usize] = n as u32;
-            next[k] += 1;
+    for k in 0..count {
+        for t in touched(k) {
+            indices[next[t - first] as usize] = k as u32;
+            next[t - first] += 1;
         }
     }
     (starts, indices)

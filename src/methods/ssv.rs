@@ -77,9 +77,9 @@ use crate::geometry::silhouette::{light_facing, possible_silhouettes};
 use crate::geometry::ssv_wedge::{SsvWedge, WedgeLight};
 use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::{DepthFunc, DepthState};
-use crate::gpu::hiz::{InsideTestRounding, TileReceiverBounds};
+use crate::gpu::hiz::InsideTestRounding;
 use crate::gpu::probe::{PrimitiveKind, Tap};
-use crate::gpu::raster::{bin, draw_probed};
+use crate::gpu::raster::{bin, bin_to, draw_probed};
 use crate::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::transform::ClipVertex;
@@ -98,7 +98,7 @@ use crate::options::{option_names, option_table, OptionTable, OptionType};
 use crate::plan::{BufferPlan, CountMode, MethodPlan};
 use crate::scene::LightShape;
 use glam::DVec3;
-use std::sync::atomic::{AtomicU64, Ordering};
+use rayon::prelude::*;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -424,7 +424,6 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSett
         receivers,
         width: scene.width,
     };
-    let bins = bin(tiling, &tris);
     let probe = frame.probe_pass("ssv-wedges");
     // The watched fragment's event, built only there.
     let event = |tap: Tap, tri: &RasterTriangle| {
@@ -437,14 +436,48 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSett
         tap.event()
             .primitive(kind, k, detail, Some(tri.front_facing))
     };
-    let bounds = frame.gpu.hiz.then(|| frame.receiver_bounds());
-    let rounding = InsideTestRounding::new(T::PRECISION.format());
-    // Per tile, the last wedge the unit decided and its decision, `(edge + 1) << 1 | culled`
-    // (each tile is drawn by one thread, in submission order: the same decisions for any
-    // thread count).
-    let last_wedge: Vec<AtomicU64> = (0..tiling.tile_count())
-        .map(|_| AtomicU64::new(0))
-        .collect();
+    // The hierarchical-Z unit's decision per wedge: the tiles where it may shade.
+    let kept = frame.gpu.hiz.then(|| {
+        let rounding = InsideTestRounding::new(T::PRECISION.format());
+        let (kept, c) = wedge_kept_tiles(frame, &edges, &owner, &tris, &rounding);
+        pass2 += c;
+        kept
+    });
+    let is_kept = |kept: &[Vec<u32>], t: usize, tri: &RasterTriangle| {
+        kept[owner[tri.prim as usize] as usize]
+            .binary_search(&(t as u32))
+            .is_ok()
+    };
+    // Each face is binned only to its wedge's kept tiles, and the (tile, face) pairs left out
+    // are counted as culled. With a probe, every face is binned by its box and rejected tile
+    // by tile, in submission order, so that the watched samples record the rejection where
+    // it happens (the same pairs, the same counts).
+    let bins = match (&kept, &probe) {
+        (Some(kept), None) => {
+            for tri in &tris {
+                let rect = tiling.tiles_of_box(tri.bbox);
+                let inside = kept[owner[tri.prim as usize] as usize]
+                    .iter()
+                    .filter(|&&t| tiling.tile_in_rect(t as usize, rect))
+                    .count();
+                count!(pass2.tiles_culled_hiz += (tiling.rect_tile_count(rect) - inside) as u64);
+            }
+            bin_to(tiling, tris.len(), |i, rows| {
+                let tri = &tris[i];
+                let rect = tiling.tiles_of_box(tri.bbox);
+                let list = &kept[owner[tri.prim as usize] as usize];
+                let (first, end) = (rows.start * tiling.tiles_x, rows.end * tiling.tiles_x);
+                let from = list.partition_point(|&t| t < first);
+                let to = list.partition_point(|&t| t < end);
+                list[from..to]
+                    .iter()
+                    .map(|&t| t as usize)
+                    .filter(move |&t| tiling.tile_in_rect(t, rect))
+            })
+        }
+        _ => bin(tiling, &tris),
+    };
+    let binned_kept = probe.is_none();
     pass2 += draw_probed(
         tiling,
         &mut vbuf,
@@ -452,30 +485,13 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSett
         &bins,
         probe.as_ref(),
         |t, _, tri, c| {
-            let Some(bounds) = bounds else {
+            let Some(kept) = &kept else {
                 return false;
             };
-            // The tile's receiver box against the wedge's inside test (crate::gpu::hiz); a
-            // full-screen wedge has no inside test, and only a tile without receivers
-            // rejects it. The unit keeps its last decision per tile: the consecutive faces of
-            // one wedge are decided (and the bounds read) once.
-            let k = owner[tri.prim as usize];
-            let key = (u64::from(k) + 1) << 1;
-            let last = last_wedge[t].load(Ordering::Relaxed);
-            let culled = if last & !1 == key {
-                last & 1 == 1
-            } else {
-                count!(c.hiz_read_bytes += TileReceiverBounds::READ_BYTES);
-                let culled = match bounds.tile(t) {
-                    None => true,
-                    Some(bx) => edges[k as usize]
-                        .wedge
-                        .as_ref()
-                        .is_some_and(|w| w.rejects_box(bx, &rounding)),
-                };
-                last_wedge[t].store(key | culled as u64, Ordering::Relaxed);
-                culled
-            };
+            if binned_kept {
+                return false;
+            }
+            let culled = !is_kept(kept, t, tri);
             count!(c.tiles_culled_hiz += culled as u64);
             if let (true, Some(probe)) = (culled, &probe) {
                 probe.record_culled(t, tri, WEDGE_CULLED, |tap| event(tap, tri));
@@ -588,6 +604,55 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSett
         seconds: [pass1_seconds, t2.elapsed().as_secs_f64()],
         dumps,
     }
+}
+
+/// The hierarchical-Z unit's decision for every wedge (`crate::gpu::hiz`, "Receiver
+/// bounds"): the tiles, among those its faces' boxes touch, where its inside test may pass at
+/// some receiver ([`crate::gpu::hiz::TileReceiverBounds::kept_tiles`]: one of the wedge's planes rejects the
+/// receiver box of a block or a tile, or it has no receivers; a full-screen wedge has no
+/// inside test and is rejected only where there are no receivers). The wedges are decided in
+/// parallel, each on its own; the reads are counted in the returned counters.
+fn wedge_kept_tiles(
+    frame: &Frame,
+    edges: &[EdgeWedge],
+    owner: &[u32],
+    tris: &[RasterTriangle],
+    rounding: &InsideTestRounding,
+) -> (Vec<Vec<u32>>, Counters) {
+    let tiling = &frame.tiling;
+    let mut rects: Vec<Option<[u32; 4]>> = vec![None; edges.len()];
+    for tri in tris {
+        let [x0, y0, x1, y1] = tiling.tiles_of_box(tri.bbox);
+        let r = &mut rects[owner[tri.prim as usize] as usize];
+        *r = Some(match *r {
+            None => [x0, y0, x1, y1],
+            Some([a, b, c, d]) => [a.min(x0), b.min(y0), c.max(x1), d.max(y1)],
+        });
+    }
+    let bounds = frame.receiver_bounds();
+    let per_wedge: Vec<(Vec<u32>, Counters)> = rects
+        .par_iter()
+        .zip(edges)
+        .map(|(rect, ew)| {
+            let mut c = Counters::default();
+            let rejects = |b: [DVec3; 2]| {
+                ew.wedge
+                    .as_ref()
+                    .is_some_and(|w| w.rejects_box(b, rounding))
+            };
+            let kept = rect.map_or_else(Vec::new, |r| bounds.kept_tiles(r, rejects, &mut c));
+            (kept, c)
+        })
+        .collect();
+    let mut total = Counters::default();
+    let kept = per_wedge
+        .into_iter()
+        .map(|(kept, c)| {
+            total += c;
+            kept
+        })
+        .collect();
+    (kept, total)
 }
 
 /// The possible silhouette edges of every mesh from the light center, in the submission order
