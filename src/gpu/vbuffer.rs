@@ -69,7 +69,7 @@ impl VBufferFormat {
 }
 
 /// A V-buffer's per-tile storage (module doc).
-pub trait VBufferTile: Send {
+pub trait VBufferTile: Send + Sync {
     /// The format this storage implements.
     const FORMAT: VBufferFormat;
     /// A tile of `len` pixels, cleared (1.0 for the float formats, 0 in both channels for the

@@ -527,27 +527,21 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSett
         },
     );
 
-    // Resolve.
-    let flat: Vec<[f32; 3]> = vbuf
-        .iter()
-        .flat_map(|t| (0..tiling.tile_len()).map(move |i| t.resolve(i)))
-        .collect();
-    let values = tiling.to_row_major(&flat);
-    let mut clamped = vec![false; values.len()];
-    let rgb: Vec<[f32; 3]> = values
-        .iter()
-        .zip(&mut clamped)
-        .enumerate()
-        .map(|(i, (v, c))| {
+    // Resolve: pixels in parallel, each on its own (the same bits for any thread count).
+    let (rgb, clamped): (Vec<[f32; 3]>, Vec<bool>) = (0..receivers.len())
+        .into_par_iter()
+        .map(|i| {
             if receivers[i].is_none() {
-                return [1.0; 3];
+                return ([1.0; 3], false);
             }
+            let [x, y] = [i as u32 % tiling.width, i as u32 / tiling.width];
+            let v = vbuf[tiling.tile_of(x, y)].resolve(tiling.local(x, y));
             let umbra = stencil.as_ref().map_or(0.0, |s| 1.0 - s[i] as f32);
             let unclamped = v.map(|x| x + umbra);
-            *c = unclamped.iter().any(|x| !(0.0..=1.0).contains(x));
-            unclamped.map(|x| x.clamp(0.0, 1.0))
+            let clamped = unclamped.iter().any(|x| !(0.0..=1.0).contains(x));
+            (unclamped.map(|x| x.clamp(0.0, 1.0)), clamped)
         })
-        .collect();
+        .unzip();
     let clamped_pixels = clamped.iter().filter(|&&c| c).count() as u64;
     if frame.dump_buffers {
         let overflows = || row_major(tiling, &vbuf, |t| t.overflows());
