@@ -238,6 +238,17 @@ pub fn setup_all(
     cull: CullMode,
     tiling: &Tiling,
 ) -> (Vec<RasterTriangle>, Counters) {
+    setup_all_with(prims, tiling, |_| cull, false)
+}
+
+/// [`setup_all`] with a face culling per submitted triangle, `cull(k)` for `prims[k]`: one
+/// submission of several draw calls that cull differently (a half-wedge's front faces, then
+/// its back faces), in their order.
+pub fn setup_all_culled(
+    prims: &[[ClipVertex; 3]],
+    cull: impl Fn(usize) -> CullMode + Sync,
+    tiling: &Tiling,
+) -> (Vec<RasterTriangle>, Counters) {
     setup_all_with(prims, tiling, cull, false)
 }
 
@@ -248,7 +259,7 @@ pub fn setup_all_barycentric(
     cull: CullMode,
     tiling: &Tiling,
 ) -> (Vec<RasterTriangle>, Counters) {
-    setup_all_with(prims, tiling, cull, true)
+    setup_all_with(prims, tiling, |_| cull, true)
 }
 
 /// Submitted triangles one parallel task sets up: large enough that a task's set-up is not
@@ -259,11 +270,11 @@ const SETUP_CHUNK: usize = 256;
 fn setup_all_with(
     prims: &[[ClipVertex; 3]],
     tiling: &Tiling,
-    cull: CullMode,
+    cull: impl Fn(usize) -> CullMode + Sync,
     barycentric: bool,
 ) -> (Vec<RasterTriangle>, Counters) {
-    let state = SetupState {
-        cull,
+    let state = |k: usize| SetupState {
+        cull: cull(k),
         width: tiling.width,
         height: tiling.height,
         barycentric,
@@ -277,7 +288,8 @@ fn setup_all_with(
             let mut out = Vec::with_capacity(ps.len());
             let mut c = Counters::default();
             for (k, p) in ps.iter().enumerate() {
-                setup_with(p, (chunk * SETUP_CHUNK + k) as u32, state, &mut out, &mut c);
+                let k = chunk * SETUP_CHUNK + k;
+                setup_with(p, k as u32, state(k), &mut out, &mut c);
             }
             (out, c)
         })

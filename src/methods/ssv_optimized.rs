@@ -101,7 +101,7 @@ use super::dump::{
 };
 use super::output::{MethodOutput, PassStats, Visibility};
 use crate::error::InputError;
-use crate::frame::{setup_all, Frame, BACKGROUND};
+use crate::frame::{Frame, BACKGROUND};
 use crate::geometry::loops::silhouette_loops;
 use crate::geometry::shadow_volume::{shadow_volume_triangles, silhouette_quad, Capping};
 use crate::geometry::silhouette::{light_facing, possible_silhouettes};
@@ -114,6 +114,7 @@ use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw};
 use crate::gpu::raster::{bin, draw_probed};
+use crate::gpu::setup::setup_all_culled;
 use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::shader_float::{ShaderFloat, FP16};
 use crate::gpu::shader_vec::{SVec2, SVec3};
@@ -653,7 +654,17 @@ fn render_group<T: ShaderFloat>(
                 prims.extend(tris);
             }
         }
-        let (tris, c_setup) = setup_all(&prims, CullMode::None, tiling);
+        // Each half is two draw calls (§4.4): its front faces with back faces culled, then
+        // its back faces with front faces culled; the quads draw both facings.
+        let (tris, c_setup) = setup_all_culled(
+            &prims,
+            |k| match roles[k] {
+                Role::Quad => CullMode::None,
+                Role::Mark(_) => CullMode::Back,
+                Role::Shade(_) | Role::ShadeTested(_) => CullMode::Front,
+            },
+            tiling,
+        );
         counters += c_setup;
         let bins = bin(tiling, &tris);
         let less = DepthState {
@@ -694,15 +705,11 @@ fn render_group<T: ShaderFloat>(
             |t, _, tri, cnt| {
                 // The depth-test outcome on which the role's fragment does nothing: a quad
                 // counts on a pass (z-pass) or a fail (z-fail); a front face marks the stencil
-                // only where LESS passes; a back face shades only where GEQUAL passes. Faces of
-                // the other facing do nothing at all and are left to the fragment program.
+                // only where LESS passes; a back face shades only where GEQUAL passes.
                 let (func, idle) = match roles[tri.prim as usize] {
                     Role::Quad => (less.func, zfail),
-                    Role::Mark(_) if tri.front_facing => (less.func, false),
-                    Role::Shade(_) | Role::ShadeTested(_) if !tri.front_facing => {
-                        (gequal.func, false)
-                    }
-                    _ => return false,
+                    Role::Mark(_) => (less.func, false),
+                    Role::Shade(_) | Role::ShadeTested(_) => (gequal.func, false),
                 };
                 frame.hiz_rejects_depth(t, tri, (func, idle), cnt, probe.as_ref(), |tap| {
                     primitive(tap.event(), tri)
@@ -732,9 +739,6 @@ fn render_group<T: ShaderFloat>(
                     }
                 }
                 Role::Mark(h) => {
-                    if !tri.front_facing {
-                        return;
-                    }
                     let job = &jobs[h as usize];
                     let (pass, z) = frame.tiles[t].depth.test(&less, &f, cnt);
                     let face = StencilFace {
@@ -761,9 +765,6 @@ fn render_group<T: ShaderFloat>(
                     }
                 }
                 Role::Shade(h) | Role::ShadeTested(h) => {
-                    if tri.front_facing {
-                        return;
-                    }
                     let job = &jobs[h as usize];
                     let tested = matches!(roles[tri.prim as usize], Role::ShadeTested(_));
                     // The watched fragment's event, built only there: what it saw up to
