@@ -291,6 +291,17 @@ impl BufferPlan {
         }
     }
 
+    /// The hierarchical-Z unit's per-tile stencil summary (`ssv-optimized`: the last half
+    /// that marked the tile, [`crate::gpu::hiz`]): one byte per tile, as whole bytes per
+    /// sample rounded up.
+    pub fn hiz_stencil_summary(gpu: &crate::frame::GpuSettings) -> Self {
+        Self {
+            name: format!("tile stencil summary (1 per {0}×{0} tile)", gpu.tile_size),
+            format: "u8".into(),
+            bytes_per_sample: 1u32.div_ceil(gpu.tile_size * gpu.tile_size),
+        }
+    }
+
     /// The hierarchical-Z unit's per-tile receiver bounds ([`crate::gpu::hiz::TileReceiverBounds`]):
     /// six f32 per tile and per block of tiles, as whole bytes per sample rounded up.
     pub fn hiz_receiver_bounds(gpu: &crate::frame::GpuSettings) -> Self {

@@ -509,7 +509,21 @@ struct HalfJob {
 struct OptTile {
     v: SplitVTile,
     stencil: StencilTile,
+    /// The hierarchical-Z unit's stencil summary of the tile ([`STENCIL_CULLED`]): 1 + the
+    /// index of the last half whose front faces wrote its reference into a sample of the tile
+    /// since the last stencil clear, 0 for none.
+    marked: u32,
 }
+
+/// The probe's note for a half's back face rejected for the probed pixel's tile by the
+/// hierarchical-Z unit's stencil summary. Within one stencil clear each half has its own
+/// reference and only its front faces write it, drawn just before its back faces: a tile
+/// where they wrote no sample holds the reference nowhere, so every back-face fragment there
+/// would fail the stencil test and do nothing (the summary is the tile's last marking half,
+/// one read per (tile, face), counted as one byte of `hiz_read_bytes`; keeping it is not
+/// counted, as the zmin/zmax reduction is not).
+const STENCIL_CULLED: &str = "culled for the tile by the hierarchical Z (stencil summary): \
+     the half's front faces marked no sample of the tile, so none holds its reference";
 
 /// Halves per stencil clear (references 1…255).
 const HALVES_PER_CLEAR: usize = 255;
@@ -556,6 +570,7 @@ fn render_group<T: ShaderFloat>(
     let mut tiles = alloc_tiles(tiling, |_, len| OptTile {
         v: SplitVTile::cleared(full, len).recording(frame.dump_buffers),
         stencil: StencilTile::cleared(0, len),
+        marked: 0,
     });
     frame.probe_record("clear", |tap, _| {
         tap.event().clear("v-add", Raw::Rgba8(full))
@@ -622,6 +637,7 @@ fn render_group<T: ShaderFloat>(
             // Clear the stencil for the next 255 references (counted as written bytes).
             for t in tiles.iter_mut() {
                 t.stencil.values.fill(0);
+                t.marked = 0;
             }
             count!(counters.stencil_write_bytes += frame.pixel_count() as u64);
             frame.probe_record("stencil-clear", |tap, _| {
@@ -702,7 +718,19 @@ fn render_group<T: ShaderFloat>(
             &tris,
             &bins,
             probe.as_ref(),
-            |t, _, tri, cnt| {
+            |t, st, tri, cnt| {
+                if let (true, Role::Shade(h)) = (frame.gpu.hiz, roles[tri.prim as usize]) {
+                    count!(cnt.hiz_read_bytes += 1);
+                    if st.marked != h + 1 {
+                        count!(cnt.tiles_culled_hiz += 1);
+                        if let Some(probe) = &probe {
+                            probe.record_culled(t, tri, STENCIL_CULLED, |tap| {
+                                primitive(tap.event(), tri)
+                            });
+                        }
+                        return true;
+                    }
+                }
                 // The depth-test outcome on which the role's fragment does nothing: a quad
                 // counts on a pass (z-pass) or a fail (z-fail); a front face marks the stencil
                 // only where LESS passes; a back face shades only where GEQUAL passes.
@@ -755,6 +783,9 @@ fn render_group<T: ShaderFloat>(
                         back: face,
                     };
                     let update = st.stencil.apply(&state, true, &f, pass, cnt);
+                    if pass {
+                        st.marked = h + 1;
+                    }
                     if let Some(tap) = tap {
                         let e = primitive(tap.event(), tri);
                         let e = frame.tiles[t]
@@ -1122,6 +1153,12 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             bytes_per_sample: 6,
         }))
         .chain(frame.gpu.hiz.then(|| BufferPlan::hiz_zmin_zmax(&frame.gpu)))
+        .chain(
+            frame
+                .gpu
+                .hiz
+                .then(|| BufferPlan::hiz_stencil_summary(&frame.gpu)),
+        )
         .collect(),
         settings: serde_json::json!({ "resolved": s, "gpu": frame.gpu }),
     };
