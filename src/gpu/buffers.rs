@@ -19,10 +19,14 @@ pub struct DepthTile {
     pub format: DepthFormat,
     /// Stored values (see [`DepthFormat::quantize`]).
     pub values: Vec<u32>,
-    /// Smallest stored value over the tile's pixels inside the image (valid after
-    /// [`DepthTile::build_hiz`]).
+    /// Smallest stored value over the tile's pixels inside the image: built by
+    /// [`DepthTile::build_hiz`] and kept exact by every depth write of
+    /// [`DepthTile::test_and_write`] under `Less` (such writes only lower values).
     pub zmin: u32,
-    /// Largest stored value over the tile's pixels inside the image.
+    /// Largest stored value over the tile's pixels inside the image: built by
+    /// [`DepthTile::build_hiz`]; during a pass that writes under `Less`, an upper bound that
+    /// [`DepthTile::early_z_rejects`] tightens when it must and [`DepthTile::finish_hiz`]
+    /// makes exact again.
     pub zmax: u32,
     /// The smallest window depth that quantizes to `zmax` or more
     /// ([`DepthFormat::first_quantized_at_least`]):
@@ -30,8 +34,12 @@ pub struct DepthTile {
     /// hierarchical-Z test compares the triangle's f32 depth range without quantizing it.
     behind_from: f32,
     /// The smallest window depth that quantizes to `zmin` or more: a fragment before it is in
-    /// front of every stored sample.
+    /// front of every stored sample (computed with the bounds, not kept by the writes).
     in_front_below: f32,
+    /// How many samples hold `zmax` (the tile's pixels inside the image, or every sample of a
+    /// tile cleared without its rectangle, [`DepthTile::cleared`]); 0 once `Less` writes
+    /// have replaced every one of them, `zmax` then being only an upper bound.
+    at_zmax: u32,
 }
 
 impl DepthTile {
@@ -52,6 +60,18 @@ impl DepthTile {
             zmax: z,
             behind_from: threshold,
             in_front_below: threshold,
+            at_zmax: len as u32,
+        }
+    }
+
+    /// Tile `t` of `tiling` cleared to depth 1.0, its bounds over its pixels inside the image
+    /// (what [`DepthTile::build_hiz`] would give, without reading it): the start of a pass
+    /// with early Z ([`DepthTile::early_z_rejects`]).
+    pub fn cleared_in(format: DepthFormat, tiling: &Tiling, t: usize) -> Self {
+        let r = tiling.rect(t);
+        Self {
+            at_zmax: (r.x1 - r.x0) * (r.y1 - r.y0),
+            ..Self::cleared(format, tiling.tile_len())
         }
     }
 
@@ -70,42 +90,110 @@ impl DepthTile {
     }
 
     /// Compute zmin/zmax over the pixels of tile `t` that lie inside the image (Paper II §4:
-    /// built once after the scene pass; wedges and shadow volumes never write depth).
+    /// built once after the scene pass; wedges and shadow volumes never write depth), with
+    /// both thresholds.
     pub fn build_hiz(&mut self, tiling: &Tiling, t: usize) {
+        self.zmin = self.scan(tiling, t);
+        self.in_front_below = self.format.first_quantized_at_least(self.zmin);
+    }
+
+    /// Set zmax to the largest stored value over the pixels of tile `t` inside the image,
+    /// with the count of those holding it and its threshold (uncounted: the unit's own
+    /// reduction); returns the smallest.
+    fn scan(&mut self, tiling: &Tiling, t: usize) -> u32 {
         let r = tiling.rect(t);
-        let mut lo = u32::MAX;
-        let mut hi = 0;
-        for y in r.y0..r.y1 {
-            for x in r.x0..r.x1 {
-                let v = self.values[tiling.local(x, y)];
+        let width = (r.x1 - r.x0) as usize;
+        let rows = (r.y0..r.y1).map(|y| tiling.local(r.x0, y));
+        let (mut lo, mut hi) = (u32::MAX, 0);
+        for start in rows.clone() {
+            for &v in &self.values[start..start + width] {
                 lo = lo.min(v);
                 hi = hi.max(v);
             }
         }
-        self.zmin = lo;
-        self.zmax = hi;
-        self.behind_from = self.format.first_quantized_at_least(hi);
-        self.in_front_below = self.format.first_quantized_at_least(lo);
+        let at_hi = rows.map(|start| {
+            let row = &self.values[start..start + width];
+            row.iter().filter(|&&v| v == hi).count() as u32
+        });
+        self.at_zmax = at_hi.sum();
+        if hi != self.zmax {
+            self.zmax = hi;
+            self.behind_from = self.format.first_quantized_at_least(hi);
+        }
+        lo
+    }
+
+    /// Early Z, in a pass that tests `Less` and writes depth into tiles started with
+    /// [`DepthTile::cleared_in`] (module [`super::hiz`], "Early Z"), asked before each
+    /// triangle the pass draws in tile `t` of `tiling`: whether every fragment of a triangle
+    /// whose fragment depths are all `near` or more (the depths it is tested with) fails the
+    /// test at every sample — what [`DepthTile::depth_outcome`] decides as `Some(false)` for
+    /// `Less` — so that it need not be drawn there.
+    ///
+    /// The writes keep zmin exact and zmax an upper bound with the count of the samples that
+    /// hold it ([`DepthTile::test_and_write`]). When zmax does not reject the triangle but no
+    /// sample holds it any more, it is made exact again by a reduction over the tile — unless
+    /// the triangle is in front of every sample (quantized `near` below zmin), which no bound
+    /// could reject. The zmax read (one value) and the rejection are counted in `c`; the
+    /// reduction is not, as [`DepthTile::build_hiz`]'s is not.
+    pub fn early_z_rejects(
+        &mut self,
+        tiling: &Tiling,
+        t: usize,
+        near: f32,
+        c: &mut Counters,
+    ) -> bool {
+        count!(c.hiz_read_bytes += self.format.bytes());
+        let mut culled = self.behind(near);
+        if !culled && self.at_zmax == 0 && self.format.quantize(near) >= self.zmin {
+            self.scan(tiling, t);
+            culled = self.behind(near);
+        }
+        count!(c.tiles_culled_hiz += culled as u64);
+        culled
+    }
+
+    /// The end of a pass with early Z ([`DepthTile::early_z_rejects`]) on tile `t` of
+    /// `tiling`: zmax made exact where no sample holds it any more, and both thresholds
+    /// computed — what [`DepthTile::build_hiz`] gives.
+    pub fn finish_hiz(&mut self, tiling: &Tiling, t: usize) {
+        if self.at_zmax == 0 {
+            self.scan(tiling, t);
+        }
+        self.in_front_below = self.format.first_quantized_at_least(self.zmin);
     }
 
     /// The depth test of fragment `f` against this tile (reads the stored value, counted).
     /// Returns (passed, quantized fragment depth).
     #[inline]
     pub fn test(&self, state: &DepthState, f: &Fragment, c: &mut Counters) -> (bool, u32) {
+        let (pass, z, _) = self.test_read(state, f, c);
+        (pass, z)
+    }
+
+    /// [`DepthTile::test`], also returning the stored value it read.
+    #[inline]
+    fn test_read(&self, state: &DepthState, f: &Fragment, c: &mut Counters) -> (bool, u32, u32) {
         let z = self.format.quantize(f.z);
         let stored = self.read(f.local, c);
-        (state.func.test(z, stored), z)
+        (state.func.test(z, stored), z, stored)
     }
 
     /// The depth test of fragment `f` followed, when it passes and `state.write` is set, by the
     /// write of its quantized depth (all counted, `depth_passed` included). Returns whether it
-    /// passed.
+    /// passed. A write under `Less` keeps the tile's bounds: zmin exact, zmax an upper bound
+    /// with the count of the samples holding it ([`DepthTile::early_z_rejects`]).
     #[inline]
     pub fn test_and_write(&mut self, state: &DepthState, f: &Fragment, c: &mut Counters) -> bool {
-        let (pass, z) = self.test(state, f, c);
+        let (pass, z, stored) = self.test_read(state, f, c);
         if pass {
             count!(c.depth_passed += 1);
             if state.write {
+                if state.func == DepthFunc::Less {
+                    // z < stored ≤ zmax: the sample no longer holds zmax if it did.
+                    self.zmin = self.zmin.min(z);
+                    self.at_zmax -= (stored == self.zmax) as u32;
+                }
                 self.write(f.local, z, c);
             }
         }
@@ -140,7 +228,7 @@ impl DepthTile {
         }
         // Every fragment at or behind every stored sample (quantize(near) >= zmax) / in front
         // of every one (quantize(far) < zmin), decided on the unquantized depths.
-        let behind = near >= self.behind_from;
+        let behind = self.behind(near);
         let in_front = far < self.in_front_below;
         match func {
             DepthFunc::Less if behind => Some(false),
@@ -149,6 +237,13 @@ impl DepthTile {
             DepthFunc::GEqual if in_front => Some(false),
             _ => None,
         }
+    }
+
+    /// Whether every fragment at window depth `near` or beyond quantizes to `zmax` or more:
+    /// at or behind every stored sample. Undecided (false) for a `near` that is not positive
+    /// ([`DepthTile::depth_outcome`]).
+    fn behind(&self, near: f32) -> bool {
+        near > 0.0 && near >= self.behind_from
     }
 
     /// Bytes one hierarchical-Z read of this tile's zmin and zmax costs (two values in the

@@ -20,6 +20,11 @@
 //!   (all background) rejects every wedge. A coarse level over blocks of [`BLOCK_TILES`]²
 //!   tiles is read first ([`TileReceiverBounds::kept_tiles`]).
 //!
+//! **Early Z** ([`DepthTile::early_z_rejects`](super::buffers::DepthTile::early_z_rejects)):
+//! in the scene pass, which writes depth under LESS, the same zmax rejects a triangle at or
+//! behind it before traversal; the writes keep the bounds as they lower the depths
+//! (`docs/architecture.md`, "Hierarchical Z").
+//!
 //! The receiver box is used rather than the tile's frustum between zmin and zmax because the
 //! receiver points are not always on the depth buffer's surface (`Frame::receivers` moves a
 //! point onto its triangle's plane where the depth format cannot hold it, and `ssv-optimized`

@@ -216,7 +216,9 @@ pub fn rasterize_in_tile(
 /// Run `fragment` for every covered sample of every triangle, tiles in parallel, triangles in
 /// submission order within a tile. `tiles[t]` is the method's per-tile storage for tile t.
 /// `skip_tile(t, storage, tri)` may reject a (tile, triangle) pair before traversal (used for
-/// hierarchical-Z culling; count the rejection in the counters it is given).
+/// hierarchical-Z culling; count the rejection in the counters it is given). It gets the
+/// tile's storage mutably, so that a pass writing depth can bring the tile's bounds up to date
+/// before it decides (early Z in a pass that writes depth).
 /// Returns the counters summed over tiles.
 pub fn draw<T, S, F>(
     tiling: &Tiling,
@@ -228,7 +230,7 @@ pub fn draw<T, S, F>(
 ) -> Counters
 where
     T: Send,
-    S: Fn(usize, &T, &RasterTriangle, &mut Counters) -> bool + Sync,
+    S: Fn(usize, &mut T, &RasterTriangle, &mut Counters) -> bool + Sync,
     F: Fn(usize, &mut T, &RasterTriangle, Fragment, &mut Counters) + Sync,
 {
     draw_probed(
@@ -256,7 +258,7 @@ pub fn draw_probed<T, S, F>(
 ) -> Counters
 where
     T: Send,
-    S: Fn(usize, &T, &RasterTriangle, &mut Counters) -> bool + Sync,
+    S: Fn(usize, &mut T, &RasterTriangle, &mut Counters) -> bool + Sync,
     F: Fn(usize, &mut T, &RasterTriangle, Fragment, &mut Counters, Option<Tap>) + Sync,
 {
     assert_eq!(tiles.len(), tiling.tile_count());
@@ -269,7 +271,7 @@ where
             let watched = probe.filter(|p| p.watches_tile(t));
             for &k in bins.tile(t) {
                 let tri = &tris[k as usize];
-                if skip_tile(t, storage, tri, &mut c) {
+                if skip_tile(t, &mut *storage, tri, &mut c) {
                     continue;
                 }
                 let (visited, n) = rasterize_in_tile(tiling, tri, &rect, |f| {
@@ -288,6 +290,6 @@ where
 }
 
 /// A `skip_tile` that never skips.
-pub fn no_tile_culling<T>(_: usize, _: &T, _: &RasterTriangle, _: &mut Counters) -> bool {
+pub fn no_tile_culling<T>(_: usize, _: &mut T, _: &RasterTriangle, _: &mut Counters) -> bool {
     false
 }
