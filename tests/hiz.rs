@@ -181,3 +181,34 @@ fn pw2002_rejects_tiles_only_when_asked() {
         assert_eq!(c_on.depth_passed, c_off.depth_passed, "{scene}");
     }
 }
+
+/// `wedge-blending`'s half-wedge pass skips depth-tested faces where LESS fails at every
+/// sample of a tile: fewer fragments there, and the same image (checked above).
+#[test]
+fn wedge_blending_half_wedges_use_the_unit() {
+    let (on, off) = (
+        runs("cube-of-spheres", "on"),
+        runs("cube-of-spheres", "off"),
+    );
+    let pass = |rs: &[MethodRun]| {
+        let run = rs
+            .iter()
+            .find(|r| r.method == "wedge-blending")
+            .expect("ran");
+        run.output
+            .stats
+            .passes
+            .iter()
+            .find(|p| p.name == "wb-half-wedges")
+            .expect("half-wedge pass")
+            .counters
+    };
+    let (c_on, c_off) = (pass(&on), pass(&off));
+    assert!(c_on.tiles_culled_hiz > 0, "nothing rejected");
+    assert!(c_on.fragments_rasterized < c_off.fragments_rasterized);
+    assert_eq!(c_on.fragments_shaded, c_off.fragments_shaded);
+    assert_eq!(
+        c_on.tiles_visited + c_on.tiles_culled_hiz,
+        c_off.tiles_visited
+    );
+}

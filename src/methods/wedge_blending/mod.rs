@@ -143,8 +143,8 @@ use crate::gpu::buffers::{alloc_tiles, overflow_record, record_overflow, Stencil
 use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::pack4ub::{FloatTarget, StoreEvents};
-use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw};
-use crate::gpu::raster::{bin, draw_probed, no_tile_culling};
+use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw, Tap};
+use crate::gpu::raster::{bin, draw_probed};
 use crate::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::tiling::Tiling;
@@ -355,7 +355,8 @@ pub struct BlendingCounters {
     pub half_wedges: u64,
     /// Half-wedges drawn as a full-screen quad.
     pub half_wedges_full_screen: u64,
-    /// Half-wedge fragments rejected by the depth test (Fig. 8).
+    /// Half-wedge fragments rejected by the depth test (Fig. 8). With the hierarchical Z on,
+    /// the fragments of faces it skipped in a tile are not rasterized and not counted.
     pub rejected_depth: u64,
     /// Rejected by the outside bounding planes in viewport space (Fig. 7).
     pub rejected_outside_planes: u64,
@@ -646,6 +647,26 @@ pub fn render(frame: &Frame, s: &Settings) -> Result<BlendingRender, InputError>
     )
 }
 
+/// A probe event naming the half-wedge (or full-screen quad) of job `job` (index `k`) of
+/// silhouette `si` whose triangle `tri` the watched fragment belongs to.
+fn half_wedge_event(
+    tap: Tap,
+    job: &HalfJob,
+    k: u32,
+    tri: &RasterTriangle,
+    si: usize,
+) -> ProbeEvent {
+    let half = if job.inner { "inner" } else { "outer" };
+    let detail = format!("{half} half of edge {} of silhouette {si}", job.edge);
+    let kind = if job.full_screen {
+        PrimitiveKind::FullScreen
+    } else {
+        PrimitiveKind::HalfWedge
+    };
+    tap.event()
+        .primitive(kind, k, detail, Some(tri.front_facing))
+}
+
 /// Visit the pixels of tile `t` inside the image: (tile-local index, row-major index).
 fn tile_pixels(tiling: &Tiling, t: usize, mut visit: impl FnMut(usize, usize)) {
     let r = tiling.rect(t);
@@ -911,7 +932,25 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
             &tris,
             &bins,
             probes[2].as_ref(),
-            no_tile_culling,
+            // The hierarchical-Z unit skips a depth-tested face in a tile where LESS fails at
+            // every sample ([`Frame::hiz_rejects_depth`], idle outcome `false`): there the
+            // fragment program below returns at the depth test, having counted the fragment
+            // in `rejected_depth` and written no buffer — neither the silhouette vBuffer nor
+            // the tile's `dirty` flag, which only a shaded fragment sets. Faces drawn without
+            // the depth test (the face in the hard quad's plane, full-screen quads) are never
+            // skipped: their fragments do not depend on the scene depth's outcome.
+            |t, _, tri, cnt| {
+                let role = roles[tri.prim as usize];
+                role.depth_tested
+                    && frame.hiz_rejects_depth(
+                        t,
+                        tri,
+                        (less.func, false),
+                        cnt,
+                        probes[2].as_ref(),
+                        |tap| half_wedge_event(tap, &jobs[role.job as usize], role.job, tri, si),
+                    )
+            },
             |t, tile, tri, f, cnt, tap| {
                 let role = roles[tri.prim as usize];
                 let job = &jobs[role.job as usize];
@@ -920,17 +959,7 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
                 // stopped.
                 let record = |build: &dyn Fn(ProbeEvent) -> ProbeEvent| {
                     if let Some(tap) = tap {
-                        let half = if job.inner { "inner" } else { "outer" };
-                        let detail = format!("{half} half of edge {} of silhouette {si}", job.edge);
-                        let kind = if job.full_screen {
-                            PrimitiveKind::FullScreen
-                        } else {
-                            PrimitiveKind::HalfWedge
-                        };
-                        let e =
-                            tap.event()
-                                .primitive(kind, role.job, detail, Some(tri.front_facing));
-                        tap.push(build(e));
+                        tap.push(build(half_wedge_event(tap, job, role.job, tri, si)));
                     }
                 };
                 let (stored, test) = if !role.depth_tested {
