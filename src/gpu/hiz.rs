@@ -57,6 +57,11 @@ pub struct TileReceiverBounds {
 /// pixels with the default 8×8 tile).
 pub const BLOCK_TILES: u32 = 4;
 
+/// The index of the block holding tile `(tx, ty)` in a row of `blocks_x` blocks.
+fn block_index(blocks_x: u32, tx: u32, ty: u32) -> usize {
+    ((ty / BLOCK_TILES) * blocks_x + tx / BLOCK_TILES) as usize
+}
+
 /// The union of two optional boxes.
 fn union(a: Option<[DVec3; 2]>, b: Option<[DVec3; 2]>) -> Option<[DVec3; 2]> {
     match (a, b) {
@@ -89,8 +94,11 @@ impl TileReceiverBounds {
         let blocks_x = tiling.tiles_x.div_ceil(BLOCK_TILES);
         let mut blocks = vec![None; (blocks_x * tiling.tiles_y.div_ceil(BLOCK_TILES)) as usize];
         for (t, b) in boxes.iter().enumerate() {
-            let (tx, ty) = (t as u32 % tiling.tiles_x, t as u32 / tiling.tiles_x);
-            let k = ((ty / BLOCK_TILES) * blocks_x + tx / BLOCK_TILES) as usize;
+            let k = block_index(
+                blocks_x,
+                t as u32 % tiling.tiles_x,
+                t as u32 / tiling.tiles_x,
+            );
             blocks[k] = union(blocks[k], *b);
         }
         TileReceiverBounds {
@@ -126,10 +134,9 @@ impl TileReceiverBounds {
         let mut kept = Vec::new();
         for ty in ty0..=ty1 {
             if ty == ty0 || ty % BLOCK_TILES == 0 {
-                let by = ty / BLOCK_TILES;
                 for (bx, k) in (bx0..=bx1).zip(&mut block_kept) {
                     count!(c.hiz_read_bytes += Self::READ_BYTES);
-                    *k = self.blocks[(by * self.blocks_x + bx) as usize]
+                    *k = self.blocks[block_index(self.blocks_x, bx * BLOCK_TILES, ty)]
                         .is_some_and(|b| !rejects(b));
                 }
             }

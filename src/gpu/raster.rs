@@ -58,15 +58,15 @@ pub fn bin(tiling: &Tiling, tris: &[RasterTriangle]) -> Bins {
 
 /// The tiles of the tile rows `rows` that triangle `t`'s bounding box touches, in increasing
 /// index.
-pub fn bbox_tiles(
+fn bbox_tiles(
     tiling: &Tiling,
     t: &RasterTriangle,
     rows: std::ops::Range<u32>,
 ) -> impl Iterator<Item = usize> {
-    let (tile, tiles_x) = (tiling.tile, tiling.tiles_x);
-    let [x0, y0, x1, y1] = t.bbox;
-    let ty = (y0 / tile).max(rows.start)..(y1 / tile + 1).min(rows.end);
-    ty.flat_map(move |ty| (x0 / tile..=x1 / tile).map(move |tx| (ty * tiles_x + tx) as usize))
+    let tiles_x = tiling.tiles_x;
+    let [tx0, ty0, tx1, ty1] = tiling.tiles_of_box(t.bbox);
+    let ty = ty0.max(rows.start)..(ty1 + 1).min(rows.end);
+    ty.flat_map(move |ty| (tx0..=tx1).map(move |tx| (ty * tiles_x + tx) as usize))
 }
 
 /// Bin `count` primitives: primitive `k` goes to the tiles `tiles(k, rows)` names among the
