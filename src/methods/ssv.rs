@@ -79,7 +79,7 @@ use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::hiz::InsideTestRounding;
 use crate::gpu::probe::{PrimitiveKind, Tap};
-use crate::gpu::raster::{bin, bin_to, draw_probed};
+use crate::gpu::raster::{bin, bin_to, draw_probed, touched_tile_count, touches_tile};
 use crate::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::transform::ClipVertex;
@@ -449,22 +449,20 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSett
             .is_ok()
     };
     // Each face is binned only to its wedge's kept tiles, and the (tile, face) pairs left out
-    // are counted as culled. With a probe, every face is binned by its box and rejected tile
+    // are counted as culled. With a probe, every face is binned to the tiles it touches and rejected tile
     // by tile, in submission order, so that the watched samples record the rejection where
     // it happens (the same pairs, the same counts).
     let bins = match (&kept, &probe) {
         (Some(kept), None) => {
             for tri in &tris {
-                let rect = tiling.tiles_of_box(tri.bbox);
                 let inside = kept[owner[tri.prim as usize] as usize]
                     .iter()
-                    .filter(|&&t| tiling.tile_in_rect(t as usize, rect))
+                    .filter(|&&t| touches_tile(tiling, tri, t as usize))
                     .count();
-                count!(pass2.tiles_culled_hiz += (tiling.rect_tile_count(rect) - inside) as u64);
+                count!(pass2.tiles_culled_hiz += (touched_tile_count(tiling, tri) - inside) as u64);
             }
             bin_to(tiling, tris.len(), |i, rows| {
                 let tri = &tris[i];
-                let rect = tiling.tiles_of_box(tri.bbox);
                 let list = &kept[owner[tri.prim as usize] as usize];
                 let (first, end) = (rows.start * tiling.tiles_x, rows.end * tiling.tiles_x);
                 let from = list.partition_point(|&t| t < first);
@@ -472,7 +470,7 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSett
                 list[from..to]
                     .iter()
                     .map(|&t| t as usize)
-                    .filter(move |&t| tiling.tile_in_rect(t, rect))
+                    .filter(move |&t| touches_tile(tiling, tri, t))
             })
         }
         _ => bin(tiling, &tris),
