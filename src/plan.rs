@@ -283,11 +283,25 @@ impl BufferPlan {
     /// ([`crate::gpu::hiz`]): two values in the depth format per tile, as whole bytes per
     /// sample rounded up.
     pub fn hiz_zmin_zmax(gpu: &crate::frame::GpuSettings) -> Self {
-        let tile_len = gpu.tile_size * gpu.tile_size;
+        Self::zmin_zmax("", gpu.depth, gpu.tile_size)
+    }
+
+    /// [`BufferPlan::hiz_zmin_zmax`] of a depth target seen from the light (`target`, e.g.
+    /// "shadow map": its early Z, [`crate::gpu::light_view::LightView::render_depth_probed`]),
+    /// in its `depth` format and `tile_size`.
+    pub fn hiz_zmin_zmax_of(
+        target: &str,
+        depth: crate::gpu::depth::DepthFormat,
+        tile_size: u32,
+    ) -> Self {
+        Self::zmin_zmax(&format!(" of the {target}"), depth, tile_size)
+    }
+
+    fn zmin_zmax(of: &str, depth: crate::gpu::depth::DepthFormat, tile_size: u32) -> Self {
         Self {
-            name: format!("tile zmin/zmax (2 per {0}×{0} tile)", gpu.tile_size),
-            format: format!("{:?}", gpu.depth),
-            bytes_per_sample: (2 * gpu.depth.bytes() as u32).div_ceil(tile_len),
+            name: format!("tile zmin/zmax{of} (2 per {tile_size}×{tile_size} tile)"),
+            format: format!("{depth:?}"),
+            bytes_per_sample: (2 * depth.bytes() as u32).div_ceil(tile_size * tile_size),
         }
     }
 

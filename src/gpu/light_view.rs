@@ -53,7 +53,7 @@ use super::buffers::{alloc_tiles, DepthTile};
 use super::counters::Counters;
 use super::depth::{DepthFormat, DepthState, PolygonOffset};
 use super::probe::{Overflow, PassProbe, PrimitiveKind, Raw};
-use super::raster::{bin, draw_probed, no_tile_culling, Fragment};
+use super::raster::{bin, draw_probed, Fragment};
 use super::setup::{setup_all, CullMode};
 use super::texture::{nearest, sample_2d, Filter, Wrap};
 use super::tiling::Tiling;
@@ -348,24 +348,33 @@ impl LightView {
     }
 
     /// Render the depth of every mesh of `scene` that casts shadows (receiver-only meshes
-    /// cast none) from the light with polygon `offset` (module doc, "The shadow map"): the
-    /// tile-major depth target and the pass counters.
+    /// cast none) from the light with polygon `offset` (module doc, "The shadow map"), with
+    /// early Z: the tile-major depth target and the pass counters.
     pub fn render_depth(&self, scene: &Scene, offset: PolygonOffset) -> (Vec<DepthTile>, Counters) {
-        self.render_depth_probed(scene, offset, None)
+        self.render_depth_probed(scene, offset, true, None)
     }
 
-    /// [`LightView::render_depth`] recording the clear and every fragment at the texels
-    /// `probe` watches ([`super::probe`]).
+    /// [`LightView::render_depth`] with the hierarchical-Z unit on or off (`hiz`, early Z as
+    /// in the scene pass: [`crate::gpu::hiz`]), recording the clear and every fragment at the
+    /// texels `probe` watches ([`super::probe`]). A triangle whose offset depth is at or
+    /// behind a tile's zmax at its nearest vertex fails LESS at every texel there and is not
+    /// drawn in it: the offset adds one amount per triangle and rounds, which keeps the order
+    /// of depths, so the nearest vertex's offset depth bounds its fragments' (a triangle
+    /// reaching in front of the near plane, nearest depth clamped to 0, is never rejected).
+    /// The same bits on and off (unit test).
     pub fn render_depth_probed(
         &self,
         scene: &Scene,
         offset: PolygonOffset,
+        hiz: bool,
         probe: Option<&PassProbe>,
     ) -> (Vec<DepthTile>, Counters) {
         let prims = self.scene_triangles(scene, true);
         let (tris, mut counters) = setup_all(&prims, CullMode::Back, &self.tiling);
         let bins = bin(&self.tiling, &tris);
-        let mut tiles = alloc_tiles(&self.tiling, |_, len| DepthTile::cleared(self.depth, len));
+        let mut tiles = alloc_tiles(&self.tiling, |t, _| {
+            DepthTile::cleared_in(self.depth, &self.tiling, t)
+        });
         if let Some(p) = probe {
             p.record_each(|tap| {
                 tap.event()
@@ -380,7 +389,14 @@ impl LightView {
             &tris,
             &bins,
             probe,
-            no_tile_culling,
+            |t, tile, tri, c| {
+                let [near, far] = tri.z_range;
+                let near = match near > 0.0 {
+                    true => offset.apply(format, near, tri.max_depth_slope(), far),
+                    false => 0.0,
+                };
+                hiz && tile.early_z_rejects(&self.tiling, t, near, c)
+            },
             |_, tile, tri, f, c, tap| {
                 let z = offset.apply(format, f.z, tri.max_depth_slope(), tri.z_range[1]);
                 let before = tile.values[f.local];
@@ -500,6 +516,48 @@ mod tests {
         let [x0, y0, _] = view.window(p.as_vec3()).unwrap();
         assert!((x - x0).abs() < 1e-4 && (y - y0).abs() < 1e-4);
         assert!((z - 0.25).abs() < 1e-6, "{z}");
+    }
+
+    /// Early Z in the shadow-map pass changes no texel, in every depth format, with no
+    /// offset, a positive one and a negative one; the counters show it at work.
+    #[test]
+    fn early_z_in_the_shadow_map_changes_no_texel() {
+        let offsets = [
+            PolygonOffset::NONE,
+            PolygonOffset {
+                factor: 2.0,
+                units: 4.0,
+            },
+            PolygonOffset {
+                factor: -1.5,
+                units: -64.0,
+            },
+        ];
+        let mut culled = 0;
+        for name in [
+            "cube-of-spheres",
+            "forest-spheres",
+            "pw-fractal",
+            "cylinder",
+        ] {
+            let scene = builtin::load(name).unwrap();
+            for format in [DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F] {
+                let view =
+                    LightView::fit(&scene, scene.light().center, tiling(128), format).unwrap();
+                for offset in offsets {
+                    let (on, c_on) = view.render_depth_probed(&scene, offset, true, None);
+                    let (off, c_off) = view.render_depth_probed(&scene, offset, false, None);
+                    let values = |tiles: &[DepthTile]| -> Vec<u32> {
+                        tiles.iter().flat_map(|t| t.values.clone()).collect()
+                    };
+                    assert!(values(&on) == values(&off), "{name} {format:?} {offset:?}");
+                    assert_eq!(c_off.tiles_culled_hiz, 0);
+                    assert!(c_on.fragments_rasterized <= c_off.fragments_rasterized);
+                    culled += c_on.tiles_culled_hiz;
+                }
+            }
+        }
+        assert!(culled > 0, "early Z never rejected a (tile, triangle) pair");
     }
 
     #[test]

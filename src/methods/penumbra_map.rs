@@ -371,7 +371,8 @@ pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRende
         BiasStage::Lookup => PolygonOffset::NONE,
     };
     let probe = map_probe("shadow-map");
-    let (shadow_map, c1) = view.render_depth_probed(scene, render_offset, probe.as_ref());
+    let (shadow_map, c1) =
+        view.render_depth_probed(scene, render_offset, frame.gpu.hiz, probe.as_ref());
     let pass1 = PassStats::since("shadow-map", t, c1);
 
     // The silhouette from the light center (CPU; the paper's 30 %).
@@ -735,12 +736,19 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let s = read_settings(frame)?;
     let r = render(frame, &s)?;
     let n = s.map_size;
-    let buffers = vec![
+    let mut buffers = vec![
         BufferPlan::depth(&frame.gpu),
         BufferPlan::depth_target(format!("shadow-map {n}x{n}"), s.depth),
         BufferPlan::color_target(format!("penumbra-map colour {n}x{n}"), s.storage, 1),
         BufferPlan::depth_target(format!("penumbra-map depth {n}x{n}"), s.depth),
     ];
+    if frame.gpu.hiz {
+        buffers.push(BufferPlan::hiz_zmin_zmax_of(
+            "shadow map",
+            s.depth,
+            frame.gpu.tile_size,
+        ));
+    }
     let stats = super::stats_after_scene_pass(
         "penumbra-map",
         frame,
