@@ -59,7 +59,7 @@ pub fn bin(tiling: &Tiling, tris: &[RasterTriangle]) -> Bins {
 
 /// The tiles of the tile rows `rows` where triangle `t` may cover a sample, in increasing
 /// index: in each tile row of its bounding box, the tile columns where no edge function is
-/// negative at every sample ([`touched_columns`]). A tile it leaves out would have been
+/// negative at every sample (`touched_columns`). A tile it leaves out would have been
 /// classified outside by [`rasterize_in_tile`], with no fragment, so binning to these tiles
 /// instead of the whole bounding box changes no output bit, only the work: shadow-volume
 /// quads are long slivers whose boxes span far more tiles than they touch (`ssv`'s hard quads
@@ -78,7 +78,7 @@ pub fn touched_tiles<'a>(
 }
 
 /// Whether triangle `t` may cover a sample of tile `tile` ([`touched_tiles`]): the same test
-/// as [`touched_columns`], each edge evaluated at the tile's corner where it is largest, with
+/// as `touched_columns`, each edge evaluated at the tile's corner where it is largest, with
 /// no division (unit-tested equal).
 pub fn touches_tile(tiling: &Tiling, t: &RasterTriangle, tile: usize) -> bool {
     let (tx, ty) = (tile as u32 % tiling.tiles_x, tile as u32 / tiling.tiles_x);
