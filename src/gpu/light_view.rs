@@ -358,10 +358,8 @@ impl LightView {
     /// in the scene pass: [`crate::gpu::hiz`]), recording the clear and every fragment at the
     /// texels `probe` watches ([`super::probe`]). A triangle whose offset depth is at or
     /// behind a tile's zmax at its nearest vertex fails LESS at every texel there and is not
-    /// drawn in it: the offset adds one amount per triangle and rounds, which keeps the order
-    /// of depths, so the nearest vertex's offset depth bounds its fragments' (a triangle
-    /// reaching in front of the near plane, nearest depth clamped to 0, is never rejected).
-    /// The same bits on and off (unit test).
+    /// drawn in it ([`super::setup::RasterTriangle::nearest_offset_depth`]). The same bits on
+    /// and off (unit test).
     pub fn render_depth_probed(
         &self,
         scene: &Scene,
@@ -390,15 +388,11 @@ impl LightView {
             &bins,
             probe,
             |t, tile, tri, c| {
-                let [near, far] = tri.z_range;
-                let near = match near > 0.0 {
-                    true => offset.apply(format, near, tri.max_depth_slope(), far),
-                    false => 0.0,
-                };
+                let near = tri.nearest_offset_depth(offset, format);
                 hiz && tile.early_z_rejects(&self.tiling, t, near, c)
             },
             |_, tile, tri, f, c, tap| {
-                let z = offset.apply(format, f.z, tri.max_depth_slope(), tri.z_range[1]);
+                let z = tri.offset_depth(offset, format, f.z);
                 let before = tile.values[f.local];
                 let pass = tile.test_and_write(&state, &Fragment { z, ..f }, c);
                 if let Some(tap) = tap {

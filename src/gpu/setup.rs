@@ -23,6 +23,7 @@
 
 use super::clip::{clip_triangle, clip_triangle_barycentric, fully_inside};
 use super::counters::{count, Counters};
+use super::depth::{DepthFormat, PolygonOffset};
 use super::fixed::Fixed8;
 use super::tiling::Tiling;
 use super::transform::{viewport, ClipVertex};
@@ -147,6 +148,26 @@ impl RasterTriangle {
     /// [`super::depth::PolygonOffset`]).
     pub fn max_depth_slope(&self) -> f64 {
         self.depth.max_slope()
+    }
+
+    /// The window depth a fragment of this triangle at interpolated depth `z` is tested and
+    /// stored with under polygon `offset` in `format` (the triangle's slope and largest vertex
+    /// depth: [`PolygonOffset::apply`]).
+    pub fn offset_depth(&self, offset: PolygonOffset, format: DepthFormat, z: f32) -> f32 {
+        offset.apply(format, z, self.max_depth_slope(), self.z_range[1])
+    }
+
+    /// A lower bound of [`RasterTriangle::offset_depth`] over the triangle's fragments, for
+    /// early Z: the offset adds one amount per triangle in f64 and rounds, which keeps the
+    /// order of depths, so its nearest vertex depth's offset depth bounds them all; 0 (no
+    /// bound) for a triangle reaching in front of the near plane, whose nearest vertex depth
+    /// was clamped to 0.
+    pub fn nearest_offset_depth(&self, offset: PolygonOffset, format: DepthFormat) -> f32 {
+        if self.z_range[0] > 0.0 {
+            self.offset_depth(offset, format, self.z_range[0])
+        } else {
+            0.0
+        }
     }
 
     /// The perspective-correct barycentric coordinates of the sample of pixel (i, j) with

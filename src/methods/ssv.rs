@@ -448,10 +448,12 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSett
             .binary_search(&(t as u32))
             .is_ok()
     };
-    // Each face is binned only to its wedge's kept tiles, and the (tile, face) pairs left out
-    // are counted as culled. With a probe, every face is binned to the tiles it touches and rejected tile
-    // by tile, in submission order, so that the watched samples record the rejection where
-    // it happens (the same pairs, the same counts).
+    // Each face is binned only to its wedge's kept tiles that it touches, and the tiles it
+    // touches left out are counted as culled (each pair decided again in the binning's
+    // bands: deciding once per face and collecting the lists measured slower). With a probe,
+    // every face is binned to the tiles it touches and rejected tile by tile, in submission
+    // order, so that the watched samples record the rejection where it happens (the same
+    // pairs, the same counts).
     let bins = match (&kept, &probe) {
         (Some(kept), None) => {
             for tri in &tris {
