@@ -64,6 +64,11 @@ pub struct GpuSettings {
     /// Whether passes consult the hierarchical-Z unit ([`crate::gpu::hiz`]) to reject
     /// (tile, triangle) pairs before rasterizing them; the output bits are the same either way.
     pub hiz: bool,
+    /// Edge of a hierarchical-Z tile in pixels (zmin/zmax are kept per HiZ tile): the
+    /// option's value, or the raster tile's edge when that is smaller. A HiZ tile never spans
+    /// raster tiles, because the tiles are drawn in parallel and each keeps its own bounds
+    /// as it writes depth (`docs/architecture.md`, "Hierarchical Z").
+    pub hiz_tile_size: u32,
 }
 
 impl Default for GpuSettings {
@@ -88,7 +93,7 @@ option_names!(ShaderPrecision {
 option_table! {
     /// `[options.gpu]`: the pipeline settings of every pass ([`GpuSettings`]).
     pub struct GpuOptions["gpu"] {
-        /// edge of a screen tile in pixels (binning, traversal, hierarchical Z)
+        /// edge of a screen tile in pixels (binning, traversal; the unit of the receiver bounds and of pw-restructured's culling)
         tile_size: PowerOfTwo [2..=256] = PowerOfTwo(crate::limits::DEFAULT_TILE_SIZE);
         /// depth format of every pass (the maps seen from a light default to it too)
         depth: DepthFormat = DepthFormat::D24;
@@ -96,6 +101,8 @@ option_table! {
         shader: ShaderPrecision = ShaderPrecision::F64;
         /// hierarchical Z: passes reject whole tiles of a triangle with the tiles' zmin/zmax and receiver bounds before rasterizing (same output bits on and off; counters show the work saved)
         hiz: Switch = Switch::On;
+        /// edge of a hierarchical-Z tile in pixels, whose zmin/zmax the unit keeps (at most the raster tile: a larger value is taken as the raster tile's edge)
+        hiz_tile_size: PowerOfTwo [2..=256] = PowerOfTwo(crate::limits::DEFAULT_HIZ_TILE_SIZE);
     }
 }
 
@@ -107,6 +114,7 @@ impl GpuOptions {
             depth: self.depth,
             shader: self.shader,
             hiz: self.hiz == Switch::On,
+            hiz_tile_size: self.hiz_tile_size.0.min(self.tile_size.0),
         }
     }
 }
@@ -203,7 +211,7 @@ impl<'s> Frame<'s> {
         let (tris, mut counters) = setup_all(&prims, CullMode::Back, &tiling);
         let bins = bin(&tiling, &tris);
         let mut tiles = alloc_tiles(&tiling, |t, len| SceneTile {
-            depth: DepthTile::cleared_in(gpu.depth, &tiling, t),
+            depth: DepthTile::cleared_in(gpu.depth, &tiling, t, gpu.hiz_tile_size),
             prim: vec![BACKGROUND; len],
         });
         let state = DepthState::LESS_WRITE;
@@ -214,7 +222,12 @@ impl<'s> Frame<'s> {
             &mut tiles,
             &tris,
             &bins,
-            |t, tile, tri, c| gpu.hiz && tile.depth.early_z_rejects(&tiling, t, tri.z_range[0], c),
+            |t, tile, tri, c| {
+                gpu.hiz
+                    && tile
+                        .depth
+                        .early_z_rejects(&tiling, t, tri.bbox, tri.z_range[0], c)
+            },
             |_, tile, tri, f, c| {
                 if tile.depth.test_and_write(&state, &f, c) {
                     tile.prim[f.local] = tri.prim;
@@ -394,8 +407,7 @@ impl<'s> Frame<'s> {
             return false;
         }
         let depth = &self.tiles[t].depth;
-        count!(c.hiz_read_bytes += depth.hiz_read_bytes());
-        let culled = depth.depth_outcome(func, tri) == Some(idle);
+        let culled = depth.depth_outcome(&self.tiling, t, func, tri, c) == Some(idle);
         count!(c.tiles_culled_hiz += culled as u64);
         if let (true, Some(probe)) = (culled, probe) {
             probe.record_culled(t, tri, HIZ_CULLED, event);
@@ -587,8 +599,9 @@ mod tests {
 
     /// Early Z in the scene pass: at its end the tiles' bounds are exactly what
     /// `DepthTile::build_hiz` computes from the stored depths (zmin, zmax, both thresholds),
-    /// with the unit on or off, in every depth format, with tiles cut by the image border
-    /// (50 is not a multiple of 8); the depths and primitive ids are the same on and off; and
+    /// with the unit on or off, with HiZ tiles finer than the raster tile (16 and 4, 8 and 2),
+    /// in every depth format, with tiles cut by the image border (50 is not a multiple of 8);
+    /// the depths and primitive ids are the same on and off and at every HiZ tile size; and
     /// with the floor drawn after the trees (the meshes reversed) it saves fragments.
     #[test]
     fn the_scene_pass_keeps_the_bounds_build_hiz_gives() {
@@ -603,21 +616,29 @@ mod tests {
                 if reversed {
                     s.meshes.reverse();
                 }
-                let [on, off] = [true, false].map(|hiz| {
-                    let gpu = GpuSettings {
-                        depth,
-                        hiz,
-                        ..GpuSettings::default()
-                    };
-                    let frame = Frame::render(&s, gpu).unwrap();
-                    for (t, tile) in frame.tiles.iter().enumerate() {
-                        let mut built = tile.depth.clone();
-                        built.build_hiz(&frame.tiling, t);
-                        assert_eq!(tile.depth, built, "{name}, hiz {hiz}, tile {t}");
-                    }
-                    frame
-                });
+                // HiZ tiles of the raster tile's size, and finer ones.
+                let [on, off, .., finest] =
+                    [(true, 8, 8), (false, 8, 8), (true, 16, 4), (true, 8, 2)].map(
+                        |(hiz, tile_size, hiz_tile_size)| {
+                            let gpu = GpuSettings {
+                                depth,
+                                hiz,
+                                tile_size,
+                                hiz_tile_size,
+                                ..GpuSettings::default()
+                            };
+                            let frame = Frame::render(&s, gpu).unwrap();
+                            for (t, tile) in frame.tiles.iter().enumerate() {
+                                let mut built = tile.depth.clone();
+                                built.build_hiz(&frame.tiling, t);
+                                assert_eq!(tile.depth, built, "{name}, hiz {hiz}, tile {t}");
+                            }
+                            frame
+                        },
+                    );
                 assert_eq!(on.tiles, off.tiles, "{name}");
+                assert_eq!(on.prim_ids(), finest.prim_ids(), "{name}");
+                assert_eq!(on.depth_values(), finest.depth_values(), "{name}");
                 let (c_on, c_off) = (on.pass.counters, off.pass.counters);
                 assert_eq!(c_on.depth_passed, c_off.depth_passed, "{name}");
                 assert!(c_on.fragments_rasterized <= c_off.fragments_rasterized);

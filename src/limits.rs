@@ -8,6 +8,9 @@ pub const SUBPIXEL_BITS: u32 = 8;
 pub const FIXED_ONE: i64 = 1 << SUBPIXEL_BITS;
 /// Default tile edge in pixels (`docs/architecture.md` "Rasterization": 8×8).
 pub const DEFAULT_TILE_SIZE: u32 = 8;
+/// Default edge of a hierarchical-Z tile in pixels (`docs/architecture.md` "Hierarchical Z":
+/// 8×8, independent of the raster tile, at most it).
+pub const DEFAULT_HIZ_TILE_SIZE: u32 = 8;
 /// Smallest tile edge the tile sweep allows (Paper II §7: 2×2).
 pub const MIN_TILE_SIZE: u32 = 2;
 /// Largest tile edge the tile sweep allows (Paper II §7: 256×256).

@@ -283,25 +283,25 @@ impl BufferPlan {
     /// ([`crate::gpu::hiz`]): two values in the depth format per tile, as whole bytes per
     /// sample rounded up.
     pub fn hiz_zmin_zmax(gpu: &crate::frame::GpuSettings) -> Self {
-        Self::zmin_zmax("", gpu.depth, gpu.tile_size)
+        Self::zmin_zmax("", gpu.depth, gpu.hiz_tile_size)
     }
 
     /// [`BufferPlan::hiz_zmin_zmax`] of a depth target seen from the light (`target`, e.g.
     /// "shadow map": its early Z, [`crate::gpu::light_view::LightView::render_depth_probed`]),
-    /// in its `depth` format and `tile_size`.
+    /// in its `depth` format with HiZ tiles of edge `hiz_tile`.
     pub fn hiz_zmin_zmax_of(
         target: &str,
         depth: crate::gpu::depth::DepthFormat,
-        tile_size: u32,
+        hiz_tile: u32,
     ) -> Self {
-        Self::zmin_zmax(&format!(" of the {target}"), depth, tile_size)
+        Self::zmin_zmax(&format!(" of the {target}"), depth, hiz_tile)
     }
 
-    fn zmin_zmax(of: &str, depth: crate::gpu::depth::DepthFormat, tile_size: u32) -> Self {
+    fn zmin_zmax(of: &str, depth: crate::gpu::depth::DepthFormat, hiz_tile: u32) -> Self {
         Self {
-            name: format!("tile zmin/zmax{of} (2 per {tile_size}×{tile_size} tile)"),
+            name: format!("tile zmin/zmax{of} (2 per {hiz_tile}×{hiz_tile} HiZ tile)"),
             format: format!("{depth:?}"),
-            bytes_per_sample: (2 * depth.bytes() as u32).div_ceil(tile_size * tile_size),
+            bytes_per_sample: (2 * depth.bytes() as u32).div_ceil(hiz_tile * hiz_tile),
         }
     }
 

@@ -212,3 +212,68 @@ fn wedge_blending_half_wedges_use_the_unit() {
         c_off.tiles_visited
     );
 }
+
+/// HiZ tiles finer than the raster tile (`[options.gpu] hiz-tile-size`, 32×32 raster tiles):
+/// the same bits as the unit off, for every method; and, since a finer HiZ tile's bounds lie
+/// inside the coarser one's, every pass rasterizes at most the fragments the coarser unit
+/// lets through, and the stencil passes that only test the scene depth reject at least the
+/// (tile, triangle) pairs it rejects.
+#[test]
+fn finer_hiz_tiles_change_no_bit_and_reject_at_least_as_much() {
+    let mut decided_more = Vec::new();
+    for scene in ["cube-of-spheres", "eye-in-shadow", "two-lights"] {
+        let render = |hiz: &str, hiz_tile: u32| {
+            let mut s = builtin::load(scene).unwrap();
+            s.resize(Some(96), Some(96));
+            s.methods = Some(
+                methods::ALL
+                    .iter()
+                    .filter(|m| methods::supports_scene(m, &s))
+                    .map(|m| m.to_string())
+                    .collect(),
+            );
+            for o in [
+                format!("gpu.hiz={hiz}"),
+                "gpu.tile-size=32".into(),
+                format!("gpu.hiz-tile-size={hiz_tile}"),
+            ] {
+                s.set_cli_option(&o).unwrap();
+            }
+            render_scene(&s).unwrap()
+        };
+        let off = render("off", 32);
+        let by_size = [32, 8, 4].map(|h| render("on", h));
+        for (i, runs) in by_size.iter().enumerate() {
+            for (r, o) in runs.iter().zip(&off) {
+                let at = format!("{scene}/{} at HiZ size index {i}", r.method);
+                assert!(
+                    bits(&r.output.visibility) == bits(&o.output.visibility),
+                    "{at}"
+                );
+            }
+        }
+        for pair in by_size.windows(2) {
+            for (coarse, fine) in pair[0].iter().zip(&pair[1]) {
+                let at = format!("{scene}/{}", coarse.method);
+                let (c, f) = (method_passes(coarse), method_passes(fine));
+                assert!(
+                    f.fragments_rasterized <= c.fragments_rasterized,
+                    "{at}: {} fragments with finer HiZ tiles, {} with coarser",
+                    f.fragments_rasterized,
+                    c.fragments_rasterized
+                );
+                if ["hard-sv", "nsample"].contains(&coarse.method.as_str()) {
+                    assert!(f.tiles_culled_hiz >= c.tiles_culled_hiz, "{at}");
+                }
+            }
+        }
+        let hard = |runs: &[MethodRun]| {
+            method_passes(runs.iter().find(|r| r.method == "hard-sv").expect("ran"))
+        };
+        if hard(&by_size[2]).tiles_culled_hiz > hard(&by_size[0]).tiles_culled_hiz {
+            decided_more.push(scene);
+        }
+    }
+    // Somewhere the finer tiles decide pairs the coarse ones could not.
+    assert!(!decided_more.is_empty());
+}

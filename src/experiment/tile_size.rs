@@ -11,6 +11,7 @@
 use crate::error::InputError;
 use crate::experiment::plotting::{png_and_svg, Plot, PALETTE};
 use crate::frame::{Frame, GpuSettings};
+use crate::limits::DEFAULT_HIZ_TILE_SIZE;
 use crate::methods::pw2002::frame_wedges;
 use crate::methods::pw_restructured::{
     render_li, Culling, Passes, PwRestructuredOptions, RestructuredSettings, WedgeTest,
@@ -83,6 +84,7 @@ pub fn sweep(scene: &Scene) -> Result<Vec<Row>, InputError> {
     for n in 1..=8u32 {
         let gpu = GpuSettings {
             tile_size: 1 << n,
+            hiz_tile_size: DEFAULT_HIZ_TILE_SIZE.min(1 << n),
             ..GpuSettings::default()
         };
         let frame = Frame::render(scene, gpu)?;

@@ -327,6 +327,9 @@ pub const VARIANTS: &[GoldenCase] = &[
     GoldenCase::variant("cube-of-spheres", "ssv", "d32f", &[]).gpu(&[("depth", "d32f")]),
     GoldenCase::variant("cube-of-spheres", "ssv", "tile16", &[]).gpu(&[("tile-size", "16")]),
     GoldenCase::variant("cube-of-spheres", "ssv", "tile2", &[]).gpu(&[("tile-size", "2")]),
+    // HiZ tiles finer than the raster tile: the image of the default golden, other counters.
+    GoldenCase::variant("cube-of-spheres", "hard-sv", "tile16-hiz4", &[])
+        .gpu(&[("tile-size", "16"), ("hiz-tile-size", "4")]),
     // Shader precision (issue 11): ssv's fragment program in ATI R300 fp24 and in fp16.
     GoldenCase::variant("cube-of-spheres", "ssv", "shader-fp24", &[]).gpu(&[("shader", "fp24")]),
     GoldenCase::variant("cube-of-spheres", "ssv", "shader-fp16", &[]).gpu(&[("shader", "fp16")]),

@@ -10,20 +10,17 @@ use super::probe::{Overflow, ProbeEvent, Raw};
 use super::raster::Fragment;
 use super::setup::RasterTriangle;
 use super::stencil::{StencilOp, StencilState};
-use super::tiling::Tiling;
+use super::tiling::{TileRect, Tiling};
 
-/// The depth samples of one tile, plus its hierarchical-Z bounds.
-#[derive(Debug, Clone, PartialEq)]
-pub struct DepthTile {
-    /// Storage format.
-    pub format: DepthFormat,
-    /// Stored values (see [`DepthFormat::quantize`]).
-    pub values: Vec<u32>,
-    /// Smallest stored value over the tile's pixels inside the image: built by
+/// The hierarchical-Z bounds of one HiZ tile: a square of the raster tile's samples whose edge
+/// is `[options.gpu] hiz-tile-size` ([`super::hiz`], "HiZ tiles").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HizBounds {
+    /// Smallest stored value over the HiZ tile's pixels inside the image: built by
     /// [`DepthTile::build_hiz`] and kept exact by every depth write of
     /// [`DepthTile::test_and_write`] under `Less` (such writes only lower values).
     pub zmin: u32,
-    /// Largest stored value over the tile's pixels inside the image: built by
+    /// Largest stored value over the HiZ tile's pixels inside the image: built by
     /// [`DepthTile::build_hiz`]; during a pass that writes under `Less`, an upper bound that
     /// [`DepthTile::early_z_rejects`] tightens when it must and [`DepthTile::finish_hiz`]
     /// makes exact again.
@@ -36,187 +33,28 @@ pub struct DepthTile {
     /// The smallest window depth that quantizes to `zmin` or more: a fragment before it is in
     /// front of every stored sample (computed with the bounds, not kept by the writes).
     in_front_below: f32,
-    /// How many samples hold `zmax` (the tile's pixels inside the image, or every sample of a
-    /// tile cleared without its rectangle, [`DepthTile::cleared`]); 0 once `Less` writes
+    /// How many samples hold `zmax` (the HiZ tile's pixels inside the image, or every sample
+    /// of a tile cleared without its rectangle, [`DepthTile::cleared`]); 0 once `Less` writes
     /// have replaced every one of them, `zmax` then being only an upper bound.
     at_zmax: u32,
 }
 
-impl DepthTile {
-    /// A tile of `len` samples cleared to depth 1.0.
-    pub fn cleared(format: DepthFormat, len: usize) -> Self {
-        Self::cleared_to(format, 1.0, len)
-    }
-
-    /// A tile of `len` samples cleared to window depth `z_w` (`glClearDepth`, quantized as a
-    /// fragment's depth is).
-    pub fn cleared_to(format: DepthFormat, z_w: f32, len: usize) -> Self {
-        let z = format.quantize(z_w);
+impl HizBounds {
+    /// The bounds of `samples` samples all holding `z` in `format`.
+    fn uniform(format: DepthFormat, z: u32, samples: u32) -> Self {
         let threshold = format.first_quantized_at_least(z);
-        Self {
-            format,
-            values: vec![z; len],
+        HizBounds {
             zmin: z,
             zmax: z,
             behind_from: threshold,
             in_front_below: threshold,
-            at_zmax: len as u32,
+            at_zmax: samples,
         }
     }
 
-    /// Tile `t` of `tiling` cleared to depth 1.0, its bounds over its pixels inside the image
-    /// (what [`DepthTile::build_hiz`] would give, without reading it): the start of a pass
-    /// with early Z ([`DepthTile::early_z_rejects`]).
-    pub fn cleared_in(format: DepthFormat, tiling: &Tiling, t: usize) -> Self {
-        let r = tiling.rect(t);
-        Self {
-            at_zmax: (r.x1 - r.x0) * (r.y1 - r.y0),
-            ..Self::cleared(format, tiling.tile_len())
-        }
-    }
-
-    /// Read sample `i` (counted).
-    #[inline]
-    pub fn read(&self, i: usize, c: &mut Counters) -> u32 {
-        count!(c.depth_read_bytes += self.format.bytes());
-        self.values[i]
-    }
-
-    /// Write sample `i` (counted).
-    #[inline]
-    pub fn write(&mut self, i: usize, v: u32, c: &mut Counters) {
-        count!(c.depth_write_bytes += self.format.bytes());
-        self.values[i] = v;
-    }
-
-    /// Compute zmin/zmax over the pixels of tile `t` that lie inside the image (Paper II §4:
-    /// built once after the scene pass; wedges and shadow volumes never write depth), with
-    /// both thresholds.
-    pub fn build_hiz(&mut self, tiling: &Tiling, t: usize) {
-        self.zmin = self.scan(tiling, t);
-        self.in_front_below = self.format.first_quantized_at_least(self.zmin);
-    }
-
-    /// Set zmax to the largest stored value over the pixels of tile `t` inside the image,
-    /// with the count of those holding it and its threshold (uncounted: the unit's own
-    /// reduction); returns the smallest.
-    fn scan(&mut self, tiling: &Tiling, t: usize) -> u32 {
-        let r = tiling.rect(t);
-        let width = (r.x1 - r.x0) as usize;
-        let rows = (r.y0..r.y1).map(|y| tiling.local(r.x0, y));
-        let (mut lo, mut hi) = (u32::MAX, 0);
-        for start in rows.clone() {
-            for &v in &self.values[start..start + width] {
-                lo = lo.min(v);
-                hi = hi.max(v);
-            }
-        }
-        let at_hi = rows.map(|start| {
-            let row = &self.values[start..start + width];
-            row.iter().filter(|&&v| v == hi).count() as u32
-        });
-        self.at_zmax = at_hi.sum();
-        if hi != self.zmax {
-            self.zmax = hi;
-            self.behind_from = self.format.first_quantized_at_least(hi);
-        }
-        lo
-    }
-
-    /// Early Z, in a pass that tests `Less` and writes depth into tiles started with
-    /// [`DepthTile::cleared_in`] (module [`super::hiz`], "Early Z"), asked before each
-    /// triangle the pass draws in tile `t` of `tiling`: whether every fragment of a triangle
-    /// whose fragment depths are all `near` or more (the depths it is tested with) fails the
-    /// test at every sample — what [`DepthTile::depth_outcome`] decides as `Some(false)` for
-    /// `Less` — so that it need not be drawn there.
-    ///
-    /// The writes keep zmin exact and zmax an upper bound with the count of the samples that
-    /// hold it ([`DepthTile::test_and_write`]). When zmax does not reject the triangle but no
-    /// sample holds it any more, it is made exact again by a reduction over the tile — unless
-    /// the triangle is in front of every sample (quantized `near` below zmin), which no bound
-    /// could reject. The zmax read (one value) and the rejection are counted in `c`; the
-    /// reduction is not, as [`DepthTile::build_hiz`]'s is not.
-    pub fn early_z_rejects(
-        &mut self,
-        tiling: &Tiling,
-        t: usize,
-        near: f32,
-        c: &mut Counters,
-    ) -> bool {
-        count!(c.hiz_read_bytes += self.format.bytes());
-        let mut culled = self.behind(near);
-        if !culled && self.at_zmax == 0 && self.format.quantize(near) >= self.zmin {
-            self.scan(tiling, t);
-            culled = self.behind(near);
-        }
-        count!(c.tiles_culled_hiz += culled as u64);
-        culled
-    }
-
-    /// The end of a pass with early Z ([`DepthTile::early_z_rejects`]) on tile `t` of
-    /// `tiling`: zmax made exact where no sample holds it any more, and both thresholds
-    /// computed — what [`DepthTile::build_hiz`] gives.
-    pub fn finish_hiz(&mut self, tiling: &Tiling, t: usize) {
-        if self.at_zmax == 0 {
-            self.scan(tiling, t);
-        }
-        self.in_front_below = self.format.first_quantized_at_least(self.zmin);
-    }
-
-    /// The depth test of fragment `f` against this tile (reads the stored value, counted).
-    /// Returns (passed, quantized fragment depth).
-    #[inline]
-    pub fn test(&self, state: &DepthState, f: &Fragment, c: &mut Counters) -> (bool, u32) {
-        let (pass, z, _) = self.test_read(state, f, c);
-        (pass, z)
-    }
-
-    /// [`DepthTile::test`], also returning the stored value it read.
-    #[inline]
-    fn test_read(&self, state: &DepthState, f: &Fragment, c: &mut Counters) -> (bool, u32, u32) {
-        let z = self.format.quantize(f.z);
-        let stored = self.read(f.local, c);
-        (state.func.test(z, stored), z, stored)
-    }
-
-    /// The depth test of fragment `f` followed, when it passes and `state.write` is set, by the
-    /// write of its quantized depth (all counted, `depth_passed` included). Returns whether it
-    /// passed. A write under `Less` keeps the tile's bounds: zmin exact, zmax an upper bound
-    /// with the count of the samples holding it ([`DepthTile::early_z_rejects`]).
-    #[inline]
-    pub fn test_and_write(&mut self, state: &DepthState, f: &Fragment, c: &mut Counters) -> bool {
-        let (pass, z, stored) = self.test_read(state, f, c);
-        if pass {
-            count!(c.depth_passed += 1);
-            if state.write {
-                if state.func == DepthFunc::Less {
-                    // z < stored ≤ zmax: the sample no longer holds zmax if it did.
-                    self.zmin = self.zmin.min(z);
-                    self.at_zmax -= (stored == self.zmax) as u32;
-                }
-                self.write(f.local, z, c);
-            }
-        }
-        pass
-    }
-
-    /// A probe's record ([`super::probe`]) of a depth test with `func` of the quantized fragment
-    /// depth `z` against sample `i`, which `pass`ed or not (the stored value read again,
-    /// uncounted).
-    pub fn record_test(
-        &self,
-        e: ProbeEvent,
-        func: DepthFunc,
-        i: usize,
-        z: u32,
-        pass: bool,
-    ) -> ProbeEvent {
-        e.depth(self.format, func, z, self.values[i], pass)
-    }
-
-    /// The outcome every fragment of `tri` in this tile has under the depth test `func`, when
-    /// the tile's zmin/zmax decide it for all of them ([`super::hiz`]): `Some(false)` when
-    /// none can pass, `Some(true)` when all pass, `None` when it depends on the sample. A
+    /// The outcome every fragment of `tri` in this HiZ tile has under the depth test `func`,
+    /// when the bounds decide it for all of them ([`super::hiz`]): `Some(false)` when none
+    /// can pass, `Some(true)` when all pass, `None` when it depends on the sample. A
     /// fragment's depth is the triangle's depth plane at a covered sample, between its vertex
     /// depths ([`RasterTriangle::z_range`]), and quantizing is monotone. A triangle reaching
     /// depth 0 is left undecided (a fragment depth of −0.0 quantizes out of order in D32F).
@@ -241,12 +79,341 @@ impl DepthTile {
 
     /// Whether every fragment at window depth `near` or beyond quantizes to `zmax` or more:
     /// at or behind every stored sample. Undecided (false) for a `near` that is not positive
-    /// ([`DepthTile::depth_outcome`]).
+    /// ([`HizBounds::depth_outcome`]).
     fn behind(&self, near: f32) -> bool {
         near > 0.0 && near >= self.behind_from
     }
+}
 
-    /// Bytes one hierarchical-Z read of this tile's zmin and zmax costs (two values in the
+/// The depth samples of one raster tile, plus the hierarchical-Z bounds of each of its HiZ
+/// tiles ([`HizBounds`]; one HiZ tile per raster tile when both edges are equal, the default).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DepthTile {
+    /// Storage format.
+    pub format: DepthFormat,
+    /// Stored values (see [`DepthFormat::quantize`]).
+    pub values: Vec<u32>,
+    /// The bounds of the HiZ tiles, row-major inside the raster tile (padding included: a
+    /// HiZ tile wholly outside the image holds no sample and is never consulted).
+    hiz: Vec<HizBounds>,
+    /// log₂ of the raster tile's edge.
+    tile_shift: u32,
+    /// log₂ of the HiZ tile's edge, at most `tile_shift`.
+    hiz_shift: u32,
+}
+
+impl DepthTile {
+    /// A tile of `len` samples (a square power of two) cleared to depth 1.0, one HiZ tile.
+    pub fn cleared(format: DepthFormat, len: usize) -> Self {
+        Self::cleared_to(format, 1.0, len)
+    }
+
+    /// A tile of `len` samples cleared to window depth `z_w` (`glClearDepth`, quantized as a
+    /// fragment's depth is), one HiZ tile.
+    pub fn cleared_to(format: DepthFormat, z_w: f32, len: usize) -> Self {
+        let z = format.quantize(z_w);
+        let tile_shift = len.trailing_zeros() / 2;
+        Self {
+            format,
+            values: vec![z; len],
+            hiz: vec![HizBounds::uniform(format, z, len as u32)],
+            tile_shift,
+            hiz_shift: tile_shift,
+        }
+    }
+
+    /// Tile `t` of `tiling` cleared to depth 1.0, with HiZ tiles of edge `hiz_tile` (taken as
+    /// the raster tile's edge when larger, [`crate::frame::GpuSettings::hiz_tile_size`]) and
+    /// their bounds over their pixels inside the image (what [`DepthTile::build_hiz`] would
+    /// give, without reading it): the start of a pass with early Z
+    /// ([`DepthTile::early_z_rejects`]).
+    pub fn cleared_in(format: DepthFormat, tiling: &Tiling, t: usize, hiz_tile: u32) -> Self {
+        let mut tile = Self::cleared(format, tiling.tile_len());
+        tile.hiz_shift = hiz_tile.min(tiling.tile).trailing_zeros();
+        let z = tile.values[0];
+        tile.hiz = (0..tile.hiz_count())
+            .map(|k| HizBounds::uniform(format, z, tile.hiz_rect(tiling, t, k).area()))
+            .collect();
+        tile
+    }
+
+    /// Number of HiZ tiles (padding included).
+    fn hiz_count(&self) -> usize {
+        1 << (2 * (self.tile_shift - self.hiz_shift))
+    }
+
+    /// The pixel rectangle of HiZ tile `k` of tile `t` of `tiling`, clipped to the image
+    /// (empty for a HiZ tile in the padding).
+    fn hiz_rect(&self, tiling: &Tiling, t: usize, k: usize) -> TileRect {
+        let r = tiling.rect(t);
+        let per_row_shift = self.tile_shift - self.hiz_shift;
+        let (kx, ky) = (
+            k as u32 & ((1 << per_row_shift) - 1),
+            k as u32 >> per_row_shift,
+        );
+        let (x0, y0) = (r.x0 + (kx << self.hiz_shift), r.y0 + (ky << self.hiz_shift));
+        let edge = 1 << self.hiz_shift;
+        TileRect {
+            x0: x0.min(r.x1),
+            y0: y0.min(r.y1),
+            x1: (x0 + edge).min(r.x1),
+            y1: (y0 + edge).min(r.y1),
+        }
+    }
+
+    /// The HiZ tile holding sample `i` of the tile.
+    #[inline]
+    fn hiz_index(&self, i: usize) -> usize {
+        let (y, x) = (i >> self.tile_shift, i & ((1 << self.tile_shift) - 1));
+        ((y >> self.hiz_shift) << (self.tile_shift - self.hiz_shift)) + (x >> self.hiz_shift)
+    }
+
+    /// The HiZ tiles of tile `t` of `tiling` that the inclusive pixel box `bbox` (a
+    /// triangle's, [`RasterTriangle::bbox`]) overlaps, in row-major order. A box that misses
+    /// the tile is clamped into it: the triangle then has no fragment there, and any HiZ
+    /// tile's decision holds for none.
+    pub fn hiz_under(
+        &self,
+        tiling: &Tiling,
+        t: usize,
+        [x0, y0, x1, y1]: [u32; 4],
+    ) -> impl Iterator<Item = usize> + Clone {
+        let r = tiling.rect(t);
+        let span = |lo: u32, hi: u32, r0: u32, r1: u32| {
+            let at = |v: u32| (v.clamp(r0, r1 - 1) - r0) >> self.hiz_shift;
+            at(lo)..=at(hi)
+        };
+        let (xs, ys) = (span(x0, x1, r.x0, r.x1), span(y0, y1, r.y0, r.y1));
+        let per_row_shift = self.tile_shift - self.hiz_shift;
+        ys.flat_map(move |ky| {
+            xs.clone()
+                .map(move |kx| ((ky << per_row_shift) + kx) as usize)
+        })
+    }
+
+    /// The bounds of HiZ tile `k` ([`DepthTile::hiz_under`]).
+    pub fn hiz_bounds(&self, k: usize) -> &HizBounds {
+        &self.hiz[k]
+    }
+
+    /// The bounds of the whole raster tile `t` of `tiling`: the union of its HiZ tiles'
+    /// (those holding samples), for a test made per raster tile (`pw-restructured`, Paper II
+    /// §4).
+    pub fn tile_bounds(&self, tiling: &Tiling, t: usize) -> HizBounds {
+        let union = |a: HizBounds, b: HizBounds| {
+            let lo = if a.zmin <= b.zmin { a } else { b };
+            let hi = if a.zmax >= b.zmax { a } else { b };
+            HizBounds {
+                zmin: lo.zmin,
+                zmax: hi.zmax,
+                behind_from: hi.behind_from,
+                in_front_below: lo.in_front_below,
+                at_zmax: [a, b]
+                    .iter()
+                    .filter(|x| x.zmax == hi.zmax)
+                    .map(|x| x.at_zmax)
+                    .sum(),
+            }
+        };
+        let holding = self.hiz_tiles_holding_samples(tiling, t);
+        holding
+            .map(|k| self.hiz[k])
+            .reduce(union)
+            .unwrap_or(self.hiz[0])
+    }
+
+    /// The HiZ tiles of tile `t` of `tiling` that hold pixels of the image: those
+    /// [`DepthTile::tile_bounds`] reads.
+    pub fn hiz_tiles_holding_samples(
+        &self,
+        tiling: &Tiling,
+        t: usize,
+    ) -> impl Iterator<Item = usize> + '_ {
+        let r = tiling.rect(t);
+        self.hiz_under(tiling, t, [r.x0, r.y0, r.x1 - 1, r.y1 - 1])
+    }
+
+    /// Read sample `i` (counted).
+    #[inline]
+    pub fn read(&self, i: usize, c: &mut Counters) -> u32 {
+        count!(c.depth_read_bytes += self.format.bytes());
+        self.values[i]
+    }
+
+    /// Write sample `i` (counted).
+    #[inline]
+    pub fn write(&mut self, i: usize, v: u32, c: &mut Counters) {
+        count!(c.depth_write_bytes += self.format.bytes());
+        self.values[i] = v;
+    }
+
+    /// Compute each HiZ tile's zmin/zmax over its pixels inside the image of tile `t` (Paper
+    /// II §4: built once after the scene pass; wedges and shadow volumes never write depth),
+    /// with both thresholds.
+    pub fn build_hiz(&mut self, tiling: &Tiling, t: usize) {
+        for k in 0..self.hiz_count() {
+            if !self.hiz_rect(tiling, t, k).is_empty() {
+                self.hiz[k].zmin = self.scan(tiling, t, k);
+                self.hiz[k].in_front_below = self.format.first_quantized_at_least(self.hiz[k].zmin);
+            }
+        }
+    }
+
+    /// Set HiZ tile `k`'s zmax to the largest stored value over its pixels inside the image
+    /// of tile `t`, with the count of those holding it and its threshold (uncounted: the
+    /// unit's own reduction); returns the smallest.
+    fn scan(&mut self, tiling: &Tiling, t: usize, k: usize) -> u32 {
+        let r = self.hiz_rect(tiling, t, k);
+        let width = (r.x1 - r.x0) as usize;
+        let rows = (r.y0..r.y1).map(|y| tiling.local(r.x0, y));
+        let (mut lo, mut hi) = (u32::MAX, 0);
+        for start in rows.clone() {
+            for &v in &self.values[start..start + width] {
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+        }
+        let at_hi = rows.map(|start| {
+            let row = &self.values[start..start + width];
+            row.iter().filter(|&&v| v == hi).count() as u32
+        });
+        let b = &mut self.hiz[k];
+        b.at_zmax = at_hi.sum();
+        if hi != b.zmax {
+            b.zmax = hi;
+            b.behind_from = self.format.first_quantized_at_least(hi);
+        }
+        lo
+    }
+
+    /// Early Z, in a pass that tests `Less` and writes depth into tiles started with
+    /// [`DepthTile::cleared_in`] (module [`super::hiz`], "Early Z"), asked before each
+    /// triangle the pass draws in tile `t` of `tiling`: whether every fragment of a triangle
+    /// with pixel box `bbox` whose fragment depths are all `near` or more (the depths it is
+    /// tested with) fails the test at every sample — what [`HizBounds::depth_outcome`] decides
+    /// as `Some(false)` for `Less` in every HiZ tile under the box — so that it need not be
+    /// drawn there.
+    ///
+    /// The writes keep zmin exact and zmax an upper bound with the count of the samples that
+    /// hold it ([`DepthTile::test_and_write`]). When a HiZ tile's zmax does not reject the
+    /// triangle but no sample holds it any more, it is made exact again by a reduction over
+    /// the HiZ tile — unless the triangle is in front of every sample (quantized `near` below
+    /// zmin), which no bound could reject. The HiZ tiles are read in order until one keeps
+    /// the triangle; each zmax read (one value) and the rejection are counted in `c`; the
+    /// reduction is not, as [`DepthTile::build_hiz`]'s is not.
+    pub fn early_z_rejects(
+        &mut self,
+        tiling: &Tiling,
+        t: usize,
+        bbox: [u32; 4],
+        near: f32,
+        c: &mut Counters,
+    ) -> bool {
+        let culled = self.hiz_under(tiling, t, bbox).all(|k| {
+            count!(c.hiz_read_bytes += self.format.bytes());
+            let b = self.hiz[k];
+            if b.behind(near) {
+                return true;
+            }
+            if b.at_zmax == 0 && self.format.quantize(near) >= b.zmin {
+                self.scan(tiling, t, k);
+                return self.hiz[k].behind(near);
+            }
+            false
+        });
+        count!(c.tiles_culled_hiz += culled as u64);
+        culled
+    }
+
+    /// The end of a pass with early Z ([`DepthTile::early_z_rejects`]) on tile `t` of
+    /// `tiling`: each HiZ tile's zmax made exact where no sample holds it any more, and both
+    /// thresholds computed — what [`DepthTile::build_hiz`] gives.
+    pub fn finish_hiz(&mut self, tiling: &Tiling, t: usize) {
+        for k in 0..self.hiz_count() {
+            if self.hiz_rect(tiling, t, k).is_empty() {
+                continue;
+            }
+            if self.hiz[k].at_zmax == 0 {
+                self.scan(tiling, t, k);
+            }
+            self.hiz[k].in_front_below = self.format.first_quantized_at_least(self.hiz[k].zmin);
+        }
+    }
+
+    /// The depth test of fragment `f` against this tile (reads the stored value, counted).
+    /// Returns (passed, quantized fragment depth).
+    #[inline]
+    pub fn test(&self, state: &DepthState, f: &Fragment, c: &mut Counters) -> (bool, u32) {
+        let (pass, z, _) = self.test_read(state, f, c);
+        (pass, z)
+    }
+
+    /// [`DepthTile::test`], also returning the stored value it read.
+    #[inline]
+    fn test_read(&self, state: &DepthState, f: &Fragment, c: &mut Counters) -> (bool, u32, u32) {
+        let z = self.format.quantize(f.z);
+        let stored = self.read(f.local, c);
+        (state.func.test(z, stored), z, stored)
+    }
+
+    /// The depth test of fragment `f` followed, when it passes and `state.write` is set, by the
+    /// write of its quantized depth (all counted, `depth_passed` included). Returns whether it
+    /// passed. A write under `Less` keeps its HiZ tile's bounds: zmin exact, zmax an upper
+    /// bound with the count of the samples holding it ([`DepthTile::early_z_rejects`]).
+    #[inline]
+    pub fn test_and_write(&mut self, state: &DepthState, f: &Fragment, c: &mut Counters) -> bool {
+        let (pass, z, stored) = self.test_read(state, f, c);
+        if pass {
+            count!(c.depth_passed += 1);
+            if state.write {
+                if state.func == DepthFunc::Less {
+                    // z < stored ≤ zmax: the sample no longer holds zmax if it did.
+                    let k = self.hiz_index(f.local);
+                    let b = &mut self.hiz[k];
+                    b.zmin = b.zmin.min(z);
+                    b.at_zmax -= (stored == b.zmax) as u32;
+                }
+                self.write(f.local, z, c);
+            }
+        }
+        pass
+    }
+
+    /// A probe's record ([`super::probe`]) of a depth test with `func` of the quantized fragment
+    /// depth `z` against sample `i`, which `pass`ed or not (the stored value read again,
+    /// uncounted).
+    pub fn record_test(
+        &self,
+        e: ProbeEvent,
+        func: DepthFunc,
+        i: usize,
+        z: u32,
+        pass: bool,
+    ) -> ProbeEvent {
+        e.depth(self.format, func, z, self.values[i], pass)
+    }
+
+    /// The outcome every fragment of `tri` in tile `t` of `tiling` has under the depth test
+    /// `func`, when the bounds of every HiZ tile under its box decide it alike
+    /// ([`HizBounds::depth_outcome`]), else `None`. Every HiZ tile under the box is read (two
+    /// values each, [`DepthTile::hiz_read_bytes`]), counted in `c`.
+    pub fn depth_outcome(
+        &self,
+        tiling: &Tiling,
+        t: usize,
+        func: DepthFunc,
+        tri: &RasterTriangle,
+        c: &mut Counters,
+    ) -> Option<bool> {
+        let mut outcomes = self.hiz_under(tiling, t, tri.bbox).map(|k| {
+            count!(c.hiz_read_bytes += self.hiz_read_bytes());
+            self.hiz[k].depth_outcome(func, tri)
+        });
+        let first = outcomes.next().flatten();
+        outcomes.fold(first, |same, o| same.filter(|_| o == same))
+    }
+
+    /// Bytes one hierarchical-Z read of a HiZ tile's zmin and zmax costs (two values in the
     /// depth format; [`Counters::hiz_read_bytes`]).
     pub fn hiz_read_bytes(&self) -> u64 {
         2 * self.format.bytes()
@@ -372,4 +539,97 @@ pub fn alloc_tiles<T>(tiling: &Tiling, make: impl Fn(usize, usize) -> T) -> Vec<
     (0..tiling.tile_count())
         .map(|t| make(t, tiling.tile_len()))
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 21×13 image (tiles cut by both borders) with pseudo-random D24 depths: each tile
+    /// started with [`DepthTile::cleared_in`] and its pixels written, for HiZ tiles of edge
+    /// `hiz` inside 8×8 raster tiles.
+    fn filled(hiz: u32) -> (Tiling, Vec<DepthTile>) {
+        let tiling = Tiling::new(21, 13, 8).unwrap();
+        let mut state = 0x2545_f491_u32;
+        let mut tiles = alloc_tiles(&tiling, |t, _| {
+            DepthTile::cleared_in(DepthFormat::D24, &tiling, t, hiz)
+        });
+        for y in 0..tiling.height {
+            for x in 0..tiling.width {
+                state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+                tiles[tiling.tile_of(x, y)].values[tiling.local(x, y)] = state >> 8;
+            }
+        }
+        for (t, tile) in tiles.iter_mut().enumerate() {
+            tile.build_hiz(&tiling, t);
+        }
+        (tiling, tiles)
+    }
+
+    /// The HiZ tile of pixel (x, y) of tile `t`, from the geometry alone.
+    fn hiz_tile_of(tiling: &Tiling, t: usize, hiz: u32, (x, y): (u32, u32)) -> usize {
+        let r = tiling.rect(t);
+        (((y - r.y0) / hiz) * (tiling.tile / hiz) + (x - r.x0) / hiz) as usize
+    }
+
+    /// Every HiZ tile's zmin and zmax are the smallest and largest depth of the image pixels
+    /// it covers, the tile's bounds are their union, and a write finds its HiZ tile.
+    #[test]
+    fn hiz_tiles_hold_the_extremes_of_their_pixels() {
+        for hiz in [2, 4, 8, 16] {
+            let (tiling, tiles) = filled(hiz);
+            let edge = hiz.min(tiling.tile);
+            for (t, tile) in tiles.iter().enumerate() {
+                let r = tiling.rect(t);
+                let mut want = vec![None; tile.hiz_count()];
+                for y in r.y0..r.y1 {
+                    for x in r.x0..r.x1 {
+                        let k = hiz_tile_of(&tiling, t, edge, (x, y));
+                        assert_eq!(tile.hiz_index(tiling.local(x, y)), k);
+                        let v = tile.values[tiling.local(x, y)];
+                        let [lo, hi] = want[k].unwrap_or([v, v]);
+                        want[k] = Some([lo.min(v), hi.max(v)]);
+                    }
+                }
+                for (k, w) in want.iter().enumerate() {
+                    assert_eq!(w.is_none(), tile.hiz_rect(&tiling, t, k).is_empty());
+                    if let Some([lo, hi]) = *w {
+                        let b = tile.hiz_bounds(k);
+                        assert_eq!([b.zmin, b.zmax], [lo, hi], "hiz {hiz}, tile {t}, {k}");
+                    }
+                }
+                let all = want.iter().flatten();
+                let lo = all.clone().map(|w| w[0]).min().unwrap();
+                let hi = all.map(|w| w[1]).max().unwrap();
+                let union = tile.tile_bounds(&tiling, t);
+                assert_eq!([union.zmin, union.zmax], [lo, hi], "hiz {hiz}, tile {t}");
+            }
+        }
+    }
+
+    /// The HiZ tiles under a pixel box are those holding a pixel of the box in the tile.
+    #[test]
+    fn hiz_under_lists_the_hiz_tiles_a_box_overlaps() {
+        for hiz in [2, 4, 8] {
+            let (tiling, tiles) = filled(hiz);
+            for bbox in [[0, 0, 20, 12], [3, 2, 9, 5], [7, 7, 8, 8], [17, 9, 20, 12]] {
+                for (t, tile) in tiles.iter().enumerate() {
+                    let r = tiling.rect(t);
+                    let mut want: Vec<usize> = (bbox[1].max(r.y0)..=bbox[3].min(r.y1 - 1))
+                        .flat_map(|y| {
+                            (bbox[0].max(r.x0)..=bbox[2].min(r.x1 - 1))
+                                .map(move |x| hiz_tile_of(&tiling, t, hiz, (x, y)))
+                        })
+                        .collect();
+                    want.sort();
+                    want.dedup();
+                    if want.is_empty() {
+                        continue; // the box misses the tile: no triangle of it is drawn there
+                    }
+                    let got: Vec<usize> = tile.hiz_under(&tiling, t, bbox).collect();
+                    assert_eq!(got, want, "hiz {hiz}, box {bbox:?}, tile {t}");
+                }
+            }
+        }
+    }
 }

@@ -6,11 +6,12 @@
 //! reads) and prices (`hiz_read_bytes`).
 //!
 //! Two kinds of per-tile bounds:
-//! * **zmin/zmax of the scene depth** ([`DepthTile::zmin`](super::buffers::DepthTile),
+//! * **zmin/zmax of the scene depth**, per HiZ tile ([`HizBounds`](super::buffers::HizBounds),
 //!   [`DepthTile::depth_outcome`](super::buffers::DepthTile::depth_outcome)): when the
-//!   triangle's depth range lies wholly on one side of the tile's, every fragment has the same
-//!   depth-test outcome, and a pass whose fragments do nothing on that outcome skips the tile
-//!   (the hardware's hierarchical Z, Paper II §4 for Paper I's passes).
+//!   triangle's depth range lies wholly on one side of the bounds of every HiZ tile under it,
+//!   every fragment has the same depth-test outcome, and a pass whose fragments do nothing on
+//!   that outcome skips the tile (the hardware's hierarchical Z, Paper II §4 for Paper I's
+//!   passes).
 //! * **Receiver bounds** ([`TileReceiverBounds`]): the box of the receiver points the tile's
 //!   fragment programs read (the world position a wedge's inside test and coverage take). A
 //!   wedge whose inside test fails at every point of that box — one of its planes rejects the
@@ -19,6 +20,13 @@
 //!   the depth buffer (Paper IV §4.2 keeps positions in a texture); a tile without receivers
 //!   (all background) rejects every wedge. A coarse level over blocks of [`BLOCK_TILES`]²
 //!   tiles is read first ([`TileReceiverBounds::kept_tiles`]).
+//!
+//! **HiZ tiles** (`[options.gpu] hiz-tile-size`, default 8×8): the square one zmin/zmax
+//! covers, independent of the raster tile but at most it — each raster tile holds its HiZ
+//! tiles and keeps their bounds as it writes depth, in parallel with the other tiles. The
+//! HiZ tiles a triangle's pixel box overlaps in a raster tile decide the (raster tile,
+//! triangle) pair together ([`DepthTile::hiz_under`](super::buffers::DepthTile::hiz_under));
+//! each one read is counted.
 //!
 //! **Early Z** ([`DepthTile::early_z_rejects`](super::buffers::DepthTile::early_z_rejects)):
 //! in the scene pass, which writes depth under LESS, the same zmax rejects a triangle at or

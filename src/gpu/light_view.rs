@@ -58,6 +58,7 @@ use super::setup::{setup_all, CullMode};
 use super::texture::{nearest, sample_2d, Filter, Wrap};
 use super::tiling::Tiling;
 use super::transform::{viewport, ClipVertex, Projection};
+use crate::limits::DEFAULT_HIZ_TILE_SIZE;
 use crate::scene::Scene;
 use glam::{DVec3, Vec3};
 
@@ -351,11 +352,12 @@ impl LightView {
     /// cast none) from the light with polygon `offset` (module doc, "The shadow map"), with
     /// early Z: the tile-major depth target and the pass counters.
     pub fn render_depth(&self, scene: &Scene, offset: PolygonOffset) -> (Vec<DepthTile>, Counters) {
-        self.render_depth_probed(scene, offset, true, None)
+        self.render_depth_probed(scene, offset, Some(DEFAULT_HIZ_TILE_SIZE), None)
     }
 
-    /// [`LightView::render_depth`] with the hierarchical-Z unit on or off (`hiz`, early Z as
-    /// in the scene pass: [`crate::gpu::hiz`]), recording the clear and every fragment at the
+    /// [`LightView::render_depth`] with the hierarchical-Z unit on, with HiZ tiles of edge
+    /// `hiz` (`Some`), or off (`None`) (early Z as in the scene pass: [`crate::gpu::hiz`]),
+    /// recording the clear and every fragment at the
     /// texels `probe` watches ([`super::probe`]). A triangle whose offset depth is at or
     /// behind a tile's zmax at its nearest vertex fails LESS at every texel there and is not
     /// drawn in it ([`super::setup::RasterTriangle::nearest_offset_depth`]). The same bits on
@@ -364,14 +366,15 @@ impl LightView {
         &self,
         scene: &Scene,
         offset: PolygonOffset,
-        hiz: bool,
+        hiz: Option<u32>,
         probe: Option<&PassProbe>,
     ) -> (Vec<DepthTile>, Counters) {
         let prims = self.scene_triangles(scene, true);
         let (tris, mut counters) = setup_all(&prims, CullMode::Back, &self.tiling);
         let bins = bin(&self.tiling, &tris);
         let mut tiles = alloc_tiles(&self.tiling, |t, _| {
-            DepthTile::cleared_in(self.depth, &self.tiling, t)
+            let hiz_tile = hiz.unwrap_or(self.tiling.tile);
+            DepthTile::cleared_in(self.depth, &self.tiling, t, hiz_tile)
         });
         if let Some(p) = probe {
             p.record_each(|tap| {
@@ -389,7 +392,7 @@ impl LightView {
             probe,
             |t, tile, tri, c| {
                 let near = tri.nearest_offset_depth(offset, format);
-                hiz && tile.early_z_rejects(&self.tiling, t, near, c)
+                hiz.is_some() && tile.early_z_rejects(&self.tiling, t, tri.bbox, near, c)
             },
             |_, tile, tri, f, c, tap| {
                 let z = tri.offset_depth(offset, format, f.z);
@@ -539,8 +542,8 @@ mod tests {
                 let view =
                     LightView::fit(&scene, scene.light().center, tiling(128), format).unwrap();
                 for offset in offsets {
-                    let (on, c_on) = view.render_depth_probed(&scene, offset, true, None);
-                    let (off, c_off) = view.render_depth_probed(&scene, offset, false, None);
+                    let (on, c_on) = view.render_depth_probed(&scene, offset, Some(8), None);
+                    let (off, c_off) = view.render_depth_probed(&scene, offset, None, None);
                     let values = |tiles: &[DepthTile]| -> Vec<u32> {
                         tiles.iter().flat_map(|t| t.values.clone()).collect()
                     };

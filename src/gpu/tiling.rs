@@ -35,6 +35,22 @@ pub struct TileRect {
     pub y1: u32,
 }
 
+impl TileRect {
+    /// Whether the rectangle holds no pixel.
+    pub fn is_empty(&self) -> bool {
+        self.x0 >= self.x1 || self.y0 >= self.y1
+    }
+
+    /// How many pixels it holds.
+    pub fn area(&self) -> u32 {
+        if self.is_empty() {
+            0
+        } else {
+            (self.x1 - self.x0) * (self.y1 - self.y0)
+        }
+    }
+}
+
 impl Tiling {
     /// A tiling; `tile` must be a power of two in [2, 256].
     pub fn new(width: u32, height: u32, tile: u32) -> Result<Self, String> {

@@ -371,8 +371,8 @@ pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRende
         BiasStage::Lookup => PolygonOffset::NONE,
     };
     let probe = map_probe("shadow-map");
-    let (shadow_map, c1) =
-        view.render_depth_probed(scene, render_offset, frame.gpu.hiz, probe.as_ref());
+    let hiz_tile = frame.gpu.hiz.then_some(frame.gpu.hiz_tile_size);
+    let (shadow_map, c1) = view.render_depth_probed(scene, render_offset, hiz_tile, probe.as_ref());
     let pass1 = PassStats::since("shadow-map", t, c1);
 
     // The silhouette from the light center (CPU; the paper's 30 %).
@@ -746,7 +746,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         buffers.push(BufferPlan::hiz_zmin_zmax_of(
             "shadow map",
             s.depth,
-            frame.gpu.tile_size,
+            frame.gpu.hiz_tile_size,
         ));
     }
     let stats = super::stats_after_scene_pass(
