@@ -13,7 +13,7 @@ use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::{DepthFormat, DepthFunc, DepthState};
 use crate::gpu::hiz::{TileReceiverBounds, HIZ_CULLED};
 use crate::gpu::probe::{PassProbe, Probe, ProbeEvent, Tap};
-use crate::gpu::raster::{bin, draw};
+use crate::gpu::raster::{bin, draw, TileDraw};
 pub use crate::gpu::setup::setup_all;
 use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::shader_float::ShaderPrecision;
@@ -222,11 +222,9 @@ impl<'s> Frame<'s> {
             &mut tiles,
             &tris,
             &bins,
-            |t, tile, tri, c| {
-                gpu.hiz
-                    && tile
-                        .depth
-                        .early_z_rejects(&tiling, t, tri.bbox, tri.z_range[0], c)
+            |t, tile, tri, c| match gpu.hiz {
+                true => tile.depth.early_z(&tiling, t, tri.bbox, tri.z_range[0], c),
+                false => TileDraw::Whole,
             },
             |_, tile, tri, f, c| {
                 if tile.depth.test_and_write(&state, &f, c) {
@@ -387,32 +385,38 @@ impl<'s> Frame<'s> {
         &self.depth_receivers_and_snaps().0
     }
 
-    /// Whether the hierarchical-Z unit ([`crate::gpu::hiz`], on with `[options.gpu] hiz`)
-    /// rejects `tri` in tile `t` for a pass that tests the scene depth with `func` (without
-    /// writing it) and leaves every buffer alone for a fragment whose test outcome is `idle`
-    /// (z-pass volume counting does nothing where the test fails: `idle = false`; z-fail
-    /// nothing where it passes: `idle = true`). The zmin/zmax read and the rejection are
-    /// counted in `c`; a rejection is recorded at the watched samples of `probe` the triangle
-    /// covers, as `event` describes the primitive, with the note [`HIZ_CULLED`].
-    pub fn hiz_rejects_depth(
+    /// What the hierarchical-Z unit ([`crate::gpu::hiz`], on with `[options.gpu] hiz`) lets
+    /// the draw loop rasterize of `tri` in tile `t` ([`TileDraw`]), for a pass that tests the
+    /// scene depth with `func` (without writing it) and leaves every buffer alone for a
+    /// fragment whose test outcome is `idle` (z-pass volume counting does nothing where the
+    /// test fails: `idle = false`; z-fail nothing where it passes: `idle = true`): nothing
+    /// when every HiZ tile under the triangle decides `idle` for all its fragments, else the
+    /// HiZ tiles that do not ([`crate::gpu::buffers::DepthTile::hiz_draw`]). The zmin/zmax
+    /// reads and a rejection of the whole pair are counted in `c`; the watched samples of
+    /// `probe` the triangle covers outside what is drawn record the rejection, as `event`
+    /// describes the primitive, with the note [`HIZ_CULLED`].
+    pub fn hiz_depth_draw(
         &self,
         t: usize,
         tri: &RasterTriangle,
-        (func, idle): (DepthFunc, bool),
+        idle: (DepthFunc, bool),
         c: &mut Counters,
         probe: Option<&PassProbe>,
         event: impl Fn(Tap) -> ProbeEvent,
-    ) -> bool {
+    ) -> TileDraw {
         if !self.gpu.hiz {
-            return false;
+            return TileDraw::Whole;
         }
-        let depth = &self.tiles[t].depth;
-        let culled = depth.depth_outcome(&self.tiling, t, func, tri, c) == Some(idle);
-        count!(c.tiles_culled_hiz += culled as u64);
-        if let (true, Some(probe)) = (culled, probe) {
-            probe.record_culled(t, tri, HIZ_CULLED, event);
+        let draw = self.tiles[t].depth.hiz_draw(&self.tiling, t, idle, tri, c);
+        count!(c.tiles_culled_hiz += (draw == TileDraw::Skip) as u64);
+        if let Some(probe) = probe {
+            match draw {
+                TileDraw::Skip => probe.record_culled(t, tri, None, HIZ_CULLED, event),
+                TileDraw::Within(r) => probe.record_culled(t, tri, Some(r), HIZ_CULLED, event),
+                TileDraw::Whole => {}
+            }
         }
-        culled
+        draw
     }
 
     /// The hierarchical-Z unit's per-tile bounds of [`Frame::receivers`]

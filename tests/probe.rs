@@ -345,3 +345,45 @@ fn bad_probe_arguments_exit_2() {
         assert!(out.stdout.is_empty(), "{args:?}");
     }
 }
+
+/// HiZ tiles finer than the raster tile (`gpu.hiz-tile-size = 4` in 32×32 tiles): a volume
+/// triangle rejected by the HiZ tiles under part of a raster tile is recorded as culled at
+/// the watched samples it covers there, though it is drawn in the rest of the tile. At each
+/// pixel of a grid, the probe records at least the rejections of 32×32 HiZ tiles (a finer
+/// HiZ tile rejects whatever the coarser one holding it rejects), more at some, and probing
+/// changes no bit or counter.
+#[test]
+fn finer_hiz_tiles_record_rejections_inside_a_raster_tile() {
+    let culled_notes = |hiz: i64, x: u32, y: u32| {
+        let s = scene(
+            "cube-of-spheres",
+            64,
+            &[
+                ("gpu", "tile-size", OptionValue::Int(32)),
+                ("gpu", "hiz-tile-size", OptionValue::Int(hiz)),
+            ],
+        );
+        let mut frame = checked_frame(&s).unwrap();
+        let plain = methods::run("hard-sv", &frame).unwrap();
+        let probe = Arc::new(Probe::new(x, y));
+        frame.probe = Some(probe.clone());
+        let probed = methods::run("hard-sv", &frame).unwrap();
+        assert_eq!(bits(&plain), bits(&probed), "({x}, {y})");
+        assert_eq!(plain.stats.totals, probed.stats.totals, "({x}, {y})");
+        let events = probe.events();
+        assert_eq!(check_chains(&events), Ok(()), "({x}, {y})");
+        events
+            .iter()
+            .filter(|e| e.note == penumbra::gpu::hiz::HIZ_CULLED)
+            .count()
+    };
+    let mut more = 0;
+    for y in (2..64).step_by(6) {
+        for x in (1..64).step_by(6) {
+            let (fine, coarse) = (culled_notes(4, x, y), culled_notes(32, x, y));
+            assert!(fine >= coarse, "({x}, {y}): {fine} < {coarse}");
+            more += (fine > coarse) as u32;
+        }
+    }
+    assert!(more > 0, "no pixel shows a rejection inside a raster tile");
+}

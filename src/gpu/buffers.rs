@@ -7,7 +7,7 @@
 use super::counters::{count, Counters};
 use super::depth::{DepthFormat, DepthFunc, DepthState};
 use super::probe::{Overflow, ProbeEvent, Raw};
-use super::raster::Fragment;
+use super::raster::{Fragment, TileDraw};
 use super::setup::RasterTriangle;
 use super::stencil::{StencilOp, StencilState};
 use super::tiling::{TileRect, Tiling};
@@ -22,7 +22,7 @@ pub struct HizBounds {
     pub zmin: u32,
     /// Largest stored value over the HiZ tile's pixels inside the image: built by
     /// [`DepthTile::build_hiz`]; during a pass that writes under `Less`, an upper bound that
-    /// [`DepthTile::early_z_rejects`] tightens when it must and [`DepthTile::finish_hiz`]
+    /// [`DepthTile::early_z`] tightens when it must and [`DepthTile::finish_hiz`]
     /// makes exact again.
     pub zmax: u32,
     /// The smallest window depth that quantizes to `zmax` or more
@@ -96,10 +96,107 @@ pub struct DepthTile {
     /// The bounds of the HiZ tiles, row-major inside the raster tile (padding included: a
     /// HiZ tile wholly outside the image holds no sample and is never consulted).
     hiz: Vec<HizBounds>,
+    /// How the raster tile is cut into HiZ tiles.
+    grid: HizGrid,
+}
+
+/// How a raster tile is cut into HiZ tiles: both edges powers of two, the HiZ tile's at most
+/// the raster tile's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct HizGrid {
     /// log₂ of the raster tile's edge.
     tile_shift: u32,
     /// log₂ of the HiZ tile's edge, at most `tile_shift`.
     hiz_shift: u32,
+}
+
+impl HizGrid {
+    /// log₂ of the number of HiZ tiles per row.
+    fn per_row_shift(self) -> u32 {
+        self.tile_shift - self.hiz_shift
+    }
+
+    /// Number of HiZ tiles (padding included).
+    fn count(self) -> usize {
+        1 << (2 * self.per_row_shift())
+    }
+
+    /// The pixel rectangle of HiZ tile `k` of tile `t` of `tiling`, clipped to the image
+    /// (empty for a HiZ tile in the padding).
+    fn rect(self, tiling: &Tiling, t: usize, k: usize) -> TileRect {
+        let r = tiling.rect(t);
+        let (kx, ky) = (
+            k as u32 & ((1 << self.per_row_shift()) - 1),
+            k as u32 >> self.per_row_shift(),
+        );
+        let (x0, y0) = (r.x0 + (kx << self.hiz_shift), r.y0 + (ky << self.hiz_shift));
+        let edge = 1 << self.hiz_shift;
+        TileRect {
+            x0: x0.min(r.x1),
+            y0: y0.min(r.y1),
+            x1: (x0 + edge).min(r.x1),
+            y1: (y0 + edge).min(r.y1),
+        }
+    }
+
+    /// The HiZ tile holding sample `i` of the tile.
+    #[inline]
+    fn index(self, i: usize) -> usize {
+        let (y, x) = (i >> self.tile_shift, i & ((1 << self.tile_shift) - 1));
+        ((y >> self.hiz_shift) << self.per_row_shift()) + (x >> self.hiz_shift)
+    }
+
+    /// The HiZ tiles of tile `t` of `tiling` that the inclusive pixel box `bbox` overlaps,
+    /// in row-major order ([`DepthTile::hiz_under`]).
+    fn under(
+        self,
+        tiling: &Tiling,
+        t: usize,
+        [x0, y0, x1, y1]: [u32; 4],
+    ) -> impl Iterator<Item = usize> + Clone {
+        let r = tiling.rect(t);
+        let span = |lo: u32, hi: u32, r0: u32, r1: u32| {
+            let at = |v: u32| (v.clamp(r0, r1 - 1) - r0) >> self.hiz_shift;
+            at(lo)..=at(hi)
+        };
+        let (xs, ys) = (span(x0, x1, r.x0, r.x1), span(y0, y1, r.y0, r.y1));
+        let per_row_shift = self.per_row_shift();
+        ys.flat_map(move |ky| {
+            xs.clone()
+                .map(move |kx| ((ky << per_row_shift) + kx) as usize)
+        })
+    }
+}
+
+/// The HiZ tiles of one (raster tile, triangle) pair that keep the triangle, gathered into
+/// what the draw loop rasterizes ([`TileDraw`]).
+#[derive(Debug, Default)]
+struct KeptHizTiles {
+    /// The smallest rectangle holding every HiZ tile that keeps the triangle.
+    kept: Option<TileRect>,
+    /// Whether some HiZ tile rejected it.
+    rejected_some: bool,
+}
+
+impl KeptHizTiles {
+    /// Add HiZ tile `rect`, which `rejected` the triangle or kept it.
+    fn add(&mut self, rect: TileRect, rejected: bool) {
+        if rejected {
+            self.rejected_some = true;
+        } else {
+            self.kept = Some(self.kept.map_or(rect, |k| k.union(&rect)));
+        }
+    }
+
+    /// Nothing when every HiZ tile rejected the triangle, the whole tile when none did, else
+    /// the rectangle of those that kept it.
+    fn draw(self) -> TileDraw {
+        match self.kept {
+            None => TileDraw::Skip,
+            Some(_) if !self.rejected_some => TileDraw::Whole,
+            Some(r) => TileDraw::Within(r),
+        }
+    }
 }
 
 impl DepthTile {
@@ -117,8 +214,10 @@ impl DepthTile {
             format,
             values: vec![z; len],
             hiz: vec![HizBounds::uniform(format, z, len as u32)],
-            tile_shift,
-            hiz_shift: tile_shift,
+            grid: HizGrid {
+                tile_shift,
+                hiz_shift: tile_shift,
+            },
         }
     }
 
@@ -126,46 +225,15 @@ impl DepthTile {
     /// the raster tile's edge when larger, [`crate::frame::GpuSettings::hiz_tile_size`]) and
     /// their bounds over their pixels inside the image (what [`DepthTile::build_hiz`] would
     /// give, without reading it): the start of a pass with early Z
-    /// ([`DepthTile::early_z_rejects`]).
+    /// ([`DepthTile::early_z`]).
     pub fn cleared_in(format: DepthFormat, tiling: &Tiling, t: usize, hiz_tile: u32) -> Self {
         let mut tile = Self::cleared(format, tiling.tile_len());
-        tile.hiz_shift = hiz_tile.min(tiling.tile).trailing_zeros();
-        let z = tile.values[0];
-        tile.hiz = (0..tile.hiz_count())
-            .map(|k| HizBounds::uniform(format, z, tile.hiz_rect(tiling, t, k).area()))
+        tile.grid.hiz_shift = hiz_tile.min(tiling.tile).trailing_zeros();
+        let (z, grid) = (tile.values[0], tile.grid);
+        tile.hiz = (0..grid.count())
+            .map(|k| HizBounds::uniform(format, z, grid.rect(tiling, t, k).area()))
             .collect();
         tile
-    }
-
-    /// Number of HiZ tiles (padding included).
-    fn hiz_count(&self) -> usize {
-        1 << (2 * (self.tile_shift - self.hiz_shift))
-    }
-
-    /// The pixel rectangle of HiZ tile `k` of tile `t` of `tiling`, clipped to the image
-    /// (empty for a HiZ tile in the padding).
-    fn hiz_rect(&self, tiling: &Tiling, t: usize, k: usize) -> TileRect {
-        let r = tiling.rect(t);
-        let per_row_shift = self.tile_shift - self.hiz_shift;
-        let (kx, ky) = (
-            k as u32 & ((1 << per_row_shift) - 1),
-            k as u32 >> per_row_shift,
-        );
-        let (x0, y0) = (r.x0 + (kx << self.hiz_shift), r.y0 + (ky << self.hiz_shift));
-        let edge = 1 << self.hiz_shift;
-        TileRect {
-            x0: x0.min(r.x1),
-            y0: y0.min(r.y1),
-            x1: (x0 + edge).min(r.x1),
-            y1: (y0 + edge).min(r.y1),
-        }
-    }
-
-    /// The HiZ tile holding sample `i` of the tile.
-    #[inline]
-    fn hiz_index(&self, i: usize) -> usize {
-        let (y, x) = (i >> self.tile_shift, i & ((1 << self.tile_shift) - 1));
-        ((y >> self.hiz_shift) << (self.tile_shift - self.hiz_shift)) + (x >> self.hiz_shift)
     }
 
     /// The HiZ tiles of tile `t` of `tiling` that the inclusive pixel box `bbox` (a
@@ -176,19 +244,9 @@ impl DepthTile {
         &self,
         tiling: &Tiling,
         t: usize,
-        [x0, y0, x1, y1]: [u32; 4],
+        bbox: [u32; 4],
     ) -> impl Iterator<Item = usize> + Clone {
-        let r = tiling.rect(t);
-        let span = |lo: u32, hi: u32, r0: u32, r1: u32| {
-            let at = |v: u32| (v.clamp(r0, r1 - 1) - r0) >> self.hiz_shift;
-            at(lo)..=at(hi)
-        };
-        let (xs, ys) = (span(x0, x1, r.x0, r.x1), span(y0, y1, r.y0, r.y1));
-        let per_row_shift = self.tile_shift - self.hiz_shift;
-        ys.flat_map(move |ky| {
-            xs.clone()
-                .map(move |kx| ((ky << per_row_shift) + kx) as usize)
-        })
+        self.grid.under(tiling, t, bbox)
     }
 
     /// The bounds of HiZ tile `k` ([`DepthTile::hiz_under`]).
@@ -251,8 +309,8 @@ impl DepthTile {
     /// II §4: built once after the scene pass; wedges and shadow volumes never write depth),
     /// with both thresholds.
     pub fn build_hiz(&mut self, tiling: &Tiling, t: usize) {
-        for k in 0..self.hiz_count() {
-            if !self.hiz_rect(tiling, t, k).is_empty() {
+        for k in 0..self.grid.count() {
+            if !self.grid.rect(tiling, t, k).is_empty() {
                 self.hiz[k].zmin = self.scan(tiling, t, k);
                 self.hiz[k].in_front_below = self.format.first_quantized_at_least(self.hiz[k].zmin);
             }
@@ -263,7 +321,7 @@ impl DepthTile {
     /// of tile `t`, with the count of those holding it and its threshold (uncounted: the
     /// unit's own reduction); returns the smallest.
     fn scan(&mut self, tiling: &Tiling, t: usize, k: usize) -> u32 {
-        let r = self.hiz_rect(tiling, t, k);
+        let r = self.grid.rect(tiling, t, k);
         let width = (r.x1 - r.x0) as usize;
         let rows = (r.y0..r.y1).map(|y| tiling.local(r.x0, y));
         let (mut lo, mut hi) = (u32::MAX, 0);
@@ -288,49 +346,52 @@ impl DepthTile {
 
     /// Early Z, in a pass that tests `Less` and writes depth into tiles started with
     /// [`DepthTile::cleared_in`] (module [`super::hiz`], "Early Z"), asked before each
-    /// triangle the pass draws in tile `t` of `tiling`: whether every fragment of a triangle
-    /// with pixel box `bbox` whose fragment depths are all `near` or more (the depths it is
-    /// tested with) fails the test at every sample — what [`HizBounds::depth_outcome`] decides
-    /// as `Some(false)` for `Less` in every HiZ tile under the box — so that it need not be
-    /// drawn there.
+    /// triangle the pass draws in tile `t` of `tiling`: where in the tile a triangle with
+    /// pixel box `bbox`, whose fragment depths are all `near` or more (the depths it is tested
+    /// with), may pass the test at some sample. A HiZ tile under the box rejects it when it is
+    /// at or behind every sample there — what [`HizBounds::depth_outcome`] decides as
+    /// `Some(false)` for `Less` — and the triangle is drawn only over the HiZ tiles that keep
+    /// it ([`TileDraw`]).
     ///
     /// The writes keep zmin exact and zmax an upper bound with the count of the samples that
     /// hold it ([`DepthTile::test_and_write`]). When a HiZ tile's zmax does not reject the
     /// triangle but no sample holds it any more, it is made exact again by a reduction over
     /// the HiZ tile — unless the triangle is in front of every sample (quantized `near` below
-    /// zmin), which no bound could reject. The HiZ tiles are read in order until one keeps
-    /// the triangle; each zmax read (one value) and the rejection are counted in `c`; the
-    /// reduction is not, as [`DepthTile::build_hiz`]'s is not.
-    pub fn early_z_rejects(
+    /// zmin), which no bound could reject. Each zmax read (one value per HiZ tile) and a
+    /// rejection of the whole pair are counted in `c`; the reduction is not, as
+    /// [`DepthTile::build_hiz`]'s is not.
+    pub fn early_z(
         &mut self,
         tiling: &Tiling,
         t: usize,
         bbox: [u32; 4],
         near: f32,
         c: &mut Counters,
-    ) -> bool {
-        let culled = self.hiz_under(tiling, t, bbox).all(|k| {
+    ) -> TileDraw {
+        let mut kept = KeptHizTiles::default();
+        for k in self.grid.under(tiling, t, bbox) {
             count!(c.hiz_read_bytes += self.format.bytes());
             let b = self.hiz[k];
-            if b.behind(near) {
-                return true;
-            }
-            if b.at_zmax == 0 && self.format.quantize(near) >= b.zmin {
-                self.scan(tiling, t, k);
-                return self.hiz[k].behind(near);
-            }
-            false
-        });
-        count!(c.tiles_culled_hiz += culled as u64);
-        culled
+            let rescan = b.at_zmax == 0 && self.format.quantize(near) >= b.zmin;
+            let rejected = b.behind(near) || {
+                if rescan {
+                    self.scan(tiling, t, k);
+                }
+                rescan && self.hiz[k].behind(near)
+            };
+            kept.add(self.grid.rect(tiling, t, k), rejected);
+        }
+        let draw = kept.draw();
+        count!(c.tiles_culled_hiz += (draw == TileDraw::Skip) as u64);
+        draw
     }
 
-    /// The end of a pass with early Z ([`DepthTile::early_z_rejects`]) on tile `t` of
+    /// The end of a pass with early Z ([`DepthTile::early_z`]) on tile `t` of
     /// `tiling`: each HiZ tile's zmax made exact where no sample holds it any more, and both
     /// thresholds computed — what [`DepthTile::build_hiz`] gives.
     pub fn finish_hiz(&mut self, tiling: &Tiling, t: usize) {
-        for k in 0..self.hiz_count() {
-            if self.hiz_rect(tiling, t, k).is_empty() {
+        for k in 0..self.grid.count() {
+            if self.grid.rect(tiling, t, k).is_empty() {
                 continue;
             }
             if self.hiz[k].at_zmax == 0 {
@@ -359,7 +420,7 @@ impl DepthTile {
     /// The depth test of fragment `f` followed, when it passes and `state.write` is set, by the
     /// write of its quantized depth (all counted, `depth_passed` included). Returns whether it
     /// passed. A write under `Less` keeps its HiZ tile's bounds: zmin exact, zmax an upper
-    /// bound with the count of the samples holding it ([`DepthTile::early_z_rejects`]).
+    /// bound with the count of the samples holding it ([`DepthTile::early_z`]).
     #[inline]
     pub fn test_and_write(&mut self, state: &DepthState, f: &Fragment, c: &mut Counters) -> bool {
         let (pass, z, stored) = self.test_read(state, f, c);
@@ -368,7 +429,7 @@ impl DepthTile {
             if state.write {
                 if state.func == DepthFunc::Less {
                     // z < stored ≤ zmax: the sample no longer holds zmax if it did.
-                    let k = self.hiz_index(f.local);
+                    let k = self.grid.index(f.local);
                     let b = &mut self.hiz[k];
                     b.zmin = b.zmin.min(z);
                     b.at_zmax -= (stored == b.zmax) as u32;
@@ -393,24 +454,27 @@ impl DepthTile {
         e.depth(self.format, func, z, self.values[i], pass)
     }
 
-    /// The outcome every fragment of `tri` in tile `t` of `tiling` has under the depth test
-    /// `func`, when the bounds of every HiZ tile under its box decide it alike
-    /// ([`HizBounds::depth_outcome`]), else `None`. Every HiZ tile under the box is read (two
-    /// values each, [`DepthTile::hiz_read_bytes`]), counted in `c`.
-    pub fn depth_outcome(
+    /// Where in tile `t` of `tiling` a fragment of `tri` may have a depth-test outcome under
+    /// `func` other than `idle` (the outcome on which the pass's fragments do nothing): the
+    /// HiZ tiles under its box whose bounds decide `idle` for every fragment
+    /// ([`HizBounds::depth_outcome`]) reject it, and it is drawn only over the others
+    /// ([`TileDraw`]). Every HiZ tile under the box is read (two values each,
+    /// [`DepthTile::hiz_read_bytes`]), counted in `c`.
+    pub fn hiz_draw(
         &self,
         tiling: &Tiling,
         t: usize,
-        func: DepthFunc,
+        (func, idle): (DepthFunc, bool),
         tri: &RasterTriangle,
         c: &mut Counters,
-    ) -> Option<bool> {
-        let mut outcomes = self.hiz_under(tiling, t, tri.bbox).map(|k| {
+    ) -> TileDraw {
+        let mut kept = KeptHizTiles::default();
+        for k in self.grid.under(tiling, t, tri.bbox) {
             count!(c.hiz_read_bytes += self.hiz_read_bytes());
-            self.hiz[k].depth_outcome(func, tri)
-        });
-        let first = outcomes.next().flatten();
-        outcomes.fold(first, |same, o| same.filter(|_| o == same))
+            let rejected = self.hiz[k].depth_outcome(func, tri) == Some(idle);
+            kept.add(self.grid.rect(tiling, t, k), rejected);
+        }
+        kept.draw()
     }
 
     /// Bytes one hierarchical-Z read of a HiZ tile's zmin and zmax costs (two values in the
@@ -581,18 +645,18 @@ mod tests {
             let edge = hiz.min(tiling.tile);
             for (t, tile) in tiles.iter().enumerate() {
                 let r = tiling.rect(t);
-                let mut want = vec![None; tile.hiz_count()];
+                let mut want = vec![None; tile.grid.count()];
                 for y in r.y0..r.y1 {
                     for x in r.x0..r.x1 {
                         let k = hiz_tile_of(&tiling, t, edge, (x, y));
-                        assert_eq!(tile.hiz_index(tiling.local(x, y)), k);
+                        assert_eq!(tile.grid.index(tiling.local(x, y)), k);
                         let v = tile.values[tiling.local(x, y)];
                         let [lo, hi] = want[k].unwrap_or([v, v]);
                         want[k] = Some([lo.min(v), hi.max(v)]);
                     }
                 }
                 for (k, w) in want.iter().enumerate() {
-                    assert_eq!(w.is_none(), tile.hiz_rect(&tiling, t, k).is_empty());
+                    assert_eq!(w.is_none(), tile.grid.rect(&tiling, t, k).is_empty());
                     if let Some([lo, hi]) = *w {
                         let b = tile.hiz_bounds(k);
                         assert_eq!([b.zmin, b.zmax], [lo, hi], "hiz {hiz}, tile {t}, {k}");

@@ -50,7 +50,7 @@ impl DepthFormat {
     /// for every finite `z ≥ 0`, `quantize(z) >= q` ⇔ `z >= first_quantized_at_least(q)`
     /// (quantizing is monotone over the ordered bit patterns of the non-negative f32). The
     /// hierarchical-Z unit compares a triangle's f32 depth range with these thresholds instead
-    /// of quantizing it per tile ([`super::buffers::DepthTile::depth_outcome`]). A binary
+    /// of quantizing it per tile ([`super::buffers::HizBounds::depth_outcome`]). A binary
     /// search over the bit patterns between the window depths of `q − 1` and `q` (the whole
     /// of [0, 1] where rounding put either on the wrong side): a few steps, not thirty.
     pub fn first_quantized_at_least(self, q: u32) -> f32 {

@@ -7,7 +7,7 @@
 //!
 //! Two kinds of per-tile bounds:
 //! * **zmin/zmax of the scene depth**, per HiZ tile ([`HizBounds`](super::buffers::HizBounds),
-//!   [`DepthTile::depth_outcome`](super::buffers::DepthTile::depth_outcome)): when the
+//!   [`HizBounds::depth_outcome`](super::buffers::HizBounds::depth_outcome)): when the
 //!   triangle's depth range lies wholly on one side of the bounds of every HiZ tile under it,
 //!   every fragment has the same depth-test outcome, and a pass whose fragments do nothing on
 //!   that outcome skips the tile (the hardware's hierarchical Z, Paper II §4 for Paper I's
@@ -23,12 +23,13 @@
 //!
 //! **HiZ tiles** (`[options.gpu] hiz-tile-size`, default 8×8): the square one zmin/zmax
 //! covers, independent of the raster tile but at most it — each raster tile holds its HiZ
-//! tiles and keeps their bounds as it writes depth, in parallel with the other tiles. The
-//! HiZ tiles a triangle's pixel box overlaps in a raster tile decide the (raster tile,
-//! triangle) pair together ([`DepthTile::hiz_under`](super::buffers::DepthTile::hiz_under));
-//! each one read is counted.
+//! tiles and keeps their bounds as it writes depth, in parallel with the other tiles. Each
+//! HiZ tile a triangle's pixel box overlaps in a raster tile
+//! ([`DepthTile::hiz_under`](super::buffers::DepthTile::hiz_under)) is read, counted, and
+//! rejects the triangle or keeps it; the pair is rasterized over the rectangle of those
+//! that keep it ([`TileDraw`](super::raster::TileDraw)), skipped when none does.
 //!
-//! **Early Z** ([`DepthTile::early_z_rejects`](super::buffers::DepthTile::early_z_rejects)):
+//! **Early Z** ([`DepthTile::early_z`](super::buffers::DepthTile::early_z)):
 //! in the scene pass, which writes depth under LESS, the same zmax rejects a triangle at or
 //! behind it before traversal; the writes keep the bounds as they lower the depths
 //! (`docs/architecture.md`, "Hierarchical Z").
@@ -46,7 +47,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 /// The probe's note for a triangle the zmin/zmax test rejected for the probed pixel's tile
-/// (`Frame::hiz_rejects_depth`).
+/// (`Frame::hiz_depth_draw`).
 pub const HIZ_CULLED: &str =
     "culled for the tile by the hierarchical Z (zmin/zmax): no fragment could change a buffer";
 

@@ -53,7 +53,7 @@ use super::buffers::{alloc_tiles, DepthTile};
 use super::counters::Counters;
 use super::depth::{DepthFormat, DepthState, PolygonOffset};
 use super::probe::{Overflow, PassProbe, PrimitiveKind, Raw};
-use super::raster::{bin, draw_probed, Fragment};
+use super::raster::{bin, draw_probed, Fragment, TileDraw};
 use super::setup::{setup_all, CullMode};
 use super::texture::{nearest, sample_2d, Filter, Wrap};
 use super::tiling::Tiling;
@@ -392,7 +392,10 @@ impl LightView {
             probe,
             |t, tile, tri, c| {
                 let near = tri.nearest_offset_depth(offset, format);
-                hiz.is_some() && tile.early_z_rejects(&self.tiling, t, tri.bbox, near, c)
+                match hiz {
+                    Some(_) => tile.early_z(&self.tiling, t, tri.bbox, near, c),
+                    None => TileDraw::Whole,
+                }
             },
             |_, tile, tri, f, c, tap| {
                 let z = tri.offset_depth(offset, format, f.z);

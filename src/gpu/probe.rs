@@ -36,7 +36,7 @@
 
 use super::depth::{DepthFormat, DepthFunc};
 use super::setup::RasterTriangle;
-use super::tiling::Tiling;
+use super::tiling::{TileRect, Tiling};
 use serde::Serialize;
 use std::fmt;
 use std::sync::Mutex;
@@ -592,18 +592,22 @@ impl PassProbe<'_> {
         }
     }
 
-    /// Record, at each watched sample of tile `t` that `tri` covers, that the triangle was
-    /// rejected for the whole tile before rasterization ([`super::hiz`]): `event` builds the
+    /// Record, at each watched sample of tile `t` that `tri` covers outside the rectangle
+    /// `drawn` (where the triangle is still rasterized; `None`: nowhere), that the triangle
+    /// was rejected there before rasterization ([`super::hiz`]): `event` builds the
     /// primitive's event, `why` says by what.
     pub fn record_culled(
         &self,
         t: usize,
         tri: &RasterTriangle,
+        drawn: Option<TileRect>,
         why: &str,
         event: impl Fn(Tap) -> ProbeEvent,
     ) {
         for x in self.targets.iter().filter(|x| x.tile == t) {
-            if tri.covers(x.at[0], x.at[1]) {
+            let [px, py] = x.at;
+            let inside = |r: TileRect| (r.x0..r.x1).contains(&px) && (r.y0..r.y1).contains(&py);
+            if tri.covers(px, py) && !drawn.is_some_and(inside) {
                 let tap = Tap {
                     pass: self,
                     at: x.at,

@@ -27,6 +27,30 @@ pub struct Fragment {
     pub z: f32,
 }
 
+/// What a pass's tile test (`skip_tile` of [`draw`]) lets the draw loop rasterize of a
+/// (tile, triangle) pair. A test returning `bool` means [`TileDraw::Skip`] for `true` and
+/// [`TileDraw::Whole`] for `false`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TileDraw {
+    /// Nothing: no fragment of the triangle in the tile could change a buffer.
+    Skip,
+    /// The whole tile.
+    Whole,
+    /// Only this rectangle of the tile (the hierarchical-Z tiles that did not reject the
+    /// triangle, [`super::hiz`]): no fragment outside it could change a buffer.
+    Within(TileRect),
+}
+
+impl From<bool> for TileDraw {
+    fn from(skip: bool) -> Self {
+        if skip {
+            TileDraw::Skip
+        } else {
+            TileDraw::Whole
+        }
+    }
+}
+
 /// Per-tile lists of triangle indices, in submission order, stored one after the other
 /// (compressed rows: tile t's list is `indices[starts[t]..starts[t + 1]]`), so that binning
 /// makes two allocations however many tiles and triangles there are.
@@ -296,12 +320,13 @@ pub fn rasterize_in_tile(
 
 /// Run `fragment` for every covered sample of every triangle, tiles in parallel, triangles in
 /// submission order within a tile. `tiles[t]` is the method's per-tile storage for tile t.
-/// `skip_tile(t, storage, tri)` may reject a (tile, triangle) pair before traversal (used for
-/// hierarchical-Z culling; count the rejection in the counters it is given). It gets the
+/// `skip_tile(t, storage, tri)` may reject a (tile, triangle) pair before traversal, or limit
+/// it to part of the tile ([`TileDraw`]; used for hierarchical-Z culling; count the rejection
+/// in the counters it is given). It gets the
 /// tile's storage mutably, so that a pass writing depth can bring the tile's bounds up to date
 /// before it decides (early Z in a pass that writes depth).
 /// Returns the counters summed over tiles.
-pub fn draw<T, S, F>(
+pub fn draw<T, S, D, F>(
     tiling: &Tiling,
     tiles: &mut [T],
     tris: &[RasterTriangle],
@@ -311,7 +336,8 @@ pub fn draw<T, S, F>(
 ) -> Counters
 where
     T: Send,
-    S: Fn(usize, &mut T, &RasterTriangle, &mut Counters) -> bool + Sync,
+    S: Fn(usize, &mut T, &RasterTriangle, &mut Counters) -> D + Sync,
+    D: Into<TileDraw>,
     F: Fn(usize, &mut T, &RasterTriangle, Fragment, &mut Counters) + Sync,
 {
     draw_probed(
@@ -328,7 +354,7 @@ where
 /// [`draw`] with a probe ([`super::probe`]): `fragment` gets a [`Tap`] for the fragments of
 /// the samples `probe` watches and `None` for every other one. The tile index is compared with
 /// the watched tiles once per tile; only in a watched tile is each fragment's sample compared.
-pub fn draw_probed<T, S, F>(
+pub fn draw_probed<T, S, D, F>(
     tiling: &Tiling,
     tiles: &mut [T],
     tris: &[RasterTriangle],
@@ -339,7 +365,8 @@ pub fn draw_probed<T, S, F>(
 ) -> Counters
 where
     T: Send,
-    S: Fn(usize, &mut T, &RasterTriangle, &mut Counters) -> bool + Sync,
+    S: Fn(usize, &mut T, &RasterTriangle, &mut Counters) -> D + Sync,
+    D: Into<TileDraw>,
     F: Fn(usize, &mut T, &RasterTriangle, Fragment, &mut Counters, Option<Tap>) + Sync,
 {
     assert_eq!(tiles.len(), tiling.tile_count());
@@ -357,10 +384,12 @@ where
             let watched = probe.filter(|p| p.watches_tile(t));
             for &k in bins.tile(t) {
                 let tri = &tris[k as usize];
-                if skip_tile(t, &mut *storage, tri, &mut c) {
-                    continue;
-                }
-                let (visited, n) = rasterize_in_tile(tiling, tri, &rect, |f| {
+                let within = match skip_tile(t, &mut *storage, tri, &mut c).into() {
+                    TileDraw::Skip => continue,
+                    TileDraw::Whole => rect,
+                    TileDraw::Within(part) => part,
+                };
+                let (visited, n) = rasterize_in_tile(tiling, tri, &within, |f| {
                     let tap = watched.and_then(|p| p.tap(t, f.local));
                     fragment(t, storage, tri, f, &mut c, tap)
                 });

@@ -41,6 +41,16 @@ impl TileRect {
         self.x0 >= self.x1 || self.y0 >= self.y1
     }
 
+    /// The smallest rectangle holding both.
+    pub fn union(&self, other: &TileRect) -> TileRect {
+        TileRect {
+            x0: self.x0.min(other.x0),
+            y0: self.y0.min(other.y0),
+            x1: self.x1.max(other.x1),
+            y1: self.y1.max(other.y1),
+        }
+    }
+
     /// How many pixels it holds.
     pub fn area(&self) -> u32 {
         if self.is_empty() {

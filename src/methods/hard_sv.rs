@@ -49,7 +49,7 @@ pub enum ShadowTest {
 impl ShadowTest {
     /// The outcome of the LESS depth test on which a volume face counts nothing — z-pass counts
     /// where it passes, z-fail where it fails — so a tile where every fragment has it can be
-    /// skipped ([`Frame::hiz_rejects_depth`]).
+    /// skipped ([`Frame::hiz_depth_draw`]).
     pub fn idle_outcome(self) -> bool {
         self == ShadowTest::ZFail
     }
@@ -215,7 +215,7 @@ pub fn stencil_shadow(
             probe.as_ref(),
             |t, _, tri, c| {
                 let idle = (depth.func, s.test.idle_outcome());
-                frame.hiz_rejects_depth(t, tri, idle, c, probe.as_ref(), |tap| {
+                frame.hiz_depth_draw(t, tri, idle, c, probe.as_ref(), |tap| {
                     volume_event(tap.event(), parts.as_deref(), tri)
                 })
             },

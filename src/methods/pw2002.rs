@@ -59,7 +59,7 @@ use crate::gpu::counters::count;
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::li_buffer::{li_clamped, li_visibility, LiFormat, LiOverflow, LiTile, LI_CLEAR};
 use crate::gpu::probe::{PrimitiveKind, ProbeEvent, Raw, Tap};
-use crate::gpu::raster::{bin, draw_probed};
+use crate::gpu::raster::{bin, draw_probed, TileDraw};
 use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::shader_vec::SVec3;
@@ -344,23 +344,17 @@ fn render_li_with<T: ShaderFloat>(
         probe.as_ref(),
         |t, _, tri, c| {
             // A fragment failing the depth test does nothing (below).
-            s.hiz_culling
-                && frame.hiz_rejects_depth(
-                    t,
-                    tri,
-                    (depth_state.func, false),
-                    c,
-                    probe.as_ref(),
-                    |tap| {
-                        let wt = &tris[tri.prim as usize];
-                        match (wt.wedge, wt.kind) {
-                            (Some(wi), Some(kind)) => {
-                                wedge_primitive(tap.event(), set, wi, kind, tri)
-                            }
-                            _ => tap.event(),
-                        }
-                    },
-                )
+            if !s.hiz_culling {
+                return TileDraw::Whole;
+            }
+            let idle = (depth_state.func, false);
+            frame.hiz_depth_draw(t, tri, idle, c, probe.as_ref(), |tap| {
+                let wt = &tris[tri.prim as usize];
+                match (wt.wedge, wt.kind) {
+                    (Some(wi), Some(kind)) => wedge_primitive(tap.event(), set, wi, kind, tri),
+                    _ => tap.event(),
+                }
+            })
         },
         |t, tile, tri, f, c, tap| {
             let depth = &frame.tiles[t].depth;

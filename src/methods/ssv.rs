@@ -494,7 +494,7 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSett
             let culled = !is_kept(kept, t, tri);
             count!(c.tiles_culled_hiz += culled as u64);
             if let (true, Some(probe)) = (culled, &probe) {
-                probe.record_culled(t, tri, WEDGE_CULLED, |tap| event(tap, tri));
+                probe.record_culled(t, tri, None, WEDGE_CULLED, |tap| event(tap, tri));
             }
             culled
         },
@@ -701,7 +701,7 @@ fn hard_quads_pass<V: VBufferTile>(frame: &Frame, test: ShadowTest, vbuf: &mut [
         probe.as_ref(),
         |t, _, tri, c| {
             let idle = (depth.func, test.idle_outcome());
-            frame.hiz_rejects_depth(t, tri, idle, c, probe.as_ref(), |tap| {
+            frame.hiz_depth_draw(t, tri, idle, c, probe.as_ref(), |tap| {
                 volume_event(tap.event(), parts.as_deref(), tri)
             })
         },

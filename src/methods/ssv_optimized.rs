@@ -113,7 +113,7 @@ use crate::gpu::buffers::{alloc_tiles, StencilTile};
 use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw};
-use crate::gpu::raster::{bin, draw_probed};
+use crate::gpu::raster::{bin, draw_probed, TileDraw};
 use crate::gpu::setup::setup_all_culled;
 use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::shader_float::{ShaderFloat, FP16};
@@ -724,11 +724,11 @@ fn render_group<T: ShaderFloat>(
                     if st.marked != h + 1 {
                         count!(cnt.tiles_culled_hiz += 1);
                         if let Some(probe) = &probe {
-                            probe.record_culled(t, tri, STENCIL_CULLED, |tap| {
+                            probe.record_culled(t, tri, None, STENCIL_CULLED, |tap| {
                                 primitive(tap.event(), tri)
                             });
                         }
-                        return true;
+                        return TileDraw::Skip;
                     }
                 }
                 // The depth-test outcome on which the role's fragment does nothing: a quad
@@ -739,7 +739,7 @@ fn render_group<T: ShaderFloat>(
                     Role::Mark(_) => (less.func, false),
                     Role::Shade(_) | Role::ShadeTested(_) => (gequal.func, false),
                 };
-                frame.hiz_rejects_depth(t, tri, (func, idle), cnt, probe.as_ref(), |tap| {
+                frame.hiz_depth_draw(t, tri, (func, idle), cnt, probe.as_ref(), |tap| {
                     primitive(tap.event(), tri)
                 })
             },

@@ -144,7 +144,7 @@ use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::pack4ub::{FloatTarget, StoreEvents};
 use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw, Tap};
-use crate::gpu::raster::{bin, draw_probed};
+use crate::gpu::raster::{bin, draw_probed, TileDraw};
 use crate::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::tiling::Tiling;
@@ -768,12 +768,12 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
             &bins,
             probes[0].as_ref(),
             // The hierarchical-Z unit skips a tile where every fragment of the volume face
-            // would count nothing ([`Frame::hiz_rejects_depth`]); such a tile is not marked
+            // would count nothing ([`Frame::hiz_depth_draw`]); such a tile is not marked
             // as drawn, and a tile the silhouette left alone is skipped by the later passes
             // without changing the result (module doc, "Only where the silhouette was drawn").
             |t, _, tri, cnt| {
                 let idle = (less.func, s.test.idle_outcome());
-                frame.hiz_rejects_depth(t, tri, idle, cnt, probes[0].as_ref(), |tap| {
+                frame.hiz_depth_draw(t, tri, idle, cnt, probes[0].as_ref(), |tap| {
                     tap.event().primitive(
                         PrimitiveKind::VolumeTriangle,
                         tri.prim,
@@ -933,7 +933,7 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
             &bins,
             probes[2].as_ref(),
             // The hierarchical-Z unit skips a depth-tested face in a tile where LESS fails at
-            // every sample ([`Frame::hiz_rejects_depth`], idle outcome `false`): there the
+            // every sample ([`Frame::hiz_depth_draw`], idle outcome `false`): there the
             // fragment program below returns at the depth test, having counted the fragment
             // in `rejected_depth` and written no buffer — neither the silhouette vBuffer nor
             // the tile's `dirty` flag, which only a shaded fragment sets. Faces drawn without
@@ -941,15 +941,12 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
             // skipped: their fragments do not depend on the scene depth's outcome.
             |t, _, tri, cnt| {
                 let role = roles[tri.prim as usize];
-                role.depth_tested
-                    && frame.hiz_rejects_depth(
-                        t,
-                        tri,
-                        (less.func, false),
-                        cnt,
-                        probes[2].as_ref(),
-                        |tap| half_wedge_event(tap, &jobs[role.job as usize], role.job, tri, si),
-                    )
+                if !role.depth_tested {
+                    return TileDraw::Whole;
+                }
+                frame.hiz_depth_draw(t, tri, (less.func, false), cnt, probes[2].as_ref(), |tap| {
+                    half_wedge_event(tap, &jobs[role.job as usize], role.job, tri, si)
+                })
             },
             |t, tile, tri, f, cnt, tap| {
                 let role = roles[tri.prim as usize];
