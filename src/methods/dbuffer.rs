@@ -57,6 +57,9 @@
 //!    slope is then the change of that distance to the next texel), to measure what the
 //!    linear-interpolation artifact costs.
 //!
+//!    **Early Z** in the scene draw, with interpolated distances and `[options.gpu] hiz = on`
+//!    (`early_z_applies`; `docs/architecture.md`, "Hierarchical Z").
+//!
 //!    Clear values: R = range (nothing nearer), G = B = A = 0 ("no volume on this ray"; every
 //!    volume distance is positive).
 //! 3. **Screen** (§4): per pixel, the visible triangle's point x at the pixel center
@@ -144,7 +147,7 @@ use crate::gpu::depth::DepthFunc;
 use crate::gpu::depth::{DepthFormat, DepthState, PolygonOffset};
 use crate::gpu::light_view::LightView;
 use crate::gpu::probe::{Overflow, PassProbe, PrimitiveKind, ProbeEvent, Raw, Tap};
-use crate::gpu::raster::{bin, draw_probed, no_tile_culling, Fragment};
+use crate::gpu::raster::{bin, draw_probed, Fragment, TileDraw};
 use crate::gpu::setup::{setup_all_barycentric, CullMode};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::shader_vec::SVec3;
@@ -468,6 +471,18 @@ pub struct DBufferRender {
     pub passes: Vec<PassStats>,
 }
 
+/// The HiZ tile edge of early Z in the D-buffer's scene draw (`docs/architecture.md`,
+/// "Hierarchical Z"), `None` where it does not apply: with the unit off, and with `distances =
+/// exact`, where a fragment's depth is the distance along its texel's ray to the triangle's
+/// plane and its offset uses that distance's slope per fragment — neither bounded by the
+/// vertex depths (the nearest point of a triangle to the light can lie inside it). With the
+/// paper's interpolated distances a fragment's depth is the rasterizer's, between the vertex
+/// depths, offset as the shadow map's ([`crate::gpu::setup::RasterTriangle::offset_depth`]):
+/// the bound the shadow map's early Z uses holds.
+fn early_z_applies(gpu: &crate::frame::GpuSettings, distances: Distances) -> Option<u32> {
+    (gpu.hiz && distances == Distances::Interpolated).then_some(gpu.hiz_tile_size)
+}
+
 /// One D-buffer draw (module doc, pass 2).
 #[derive(Debug, Clone, Copy)]
 enum DrawKind {
@@ -515,7 +530,9 @@ fn texel_raw(tile: &RgbaTile, i: usize) -> Raw {
 }
 
 /// Run one D-buffer draw of `input` into `tiles` (module doc, pass 2), recording at the texel
-/// `probe` watches.
+/// `probe` watches; with `early_z`, a scene draw rejects a triangle in the HiZ tiles of a tile
+/// where its nearest offset depth is at or behind every stored depth ([`early_z_applies`]).
+#[allow(clippy::too_many_arguments)]
 fn draw_dbuffer(
     view: &LightView,
     range: f64,
@@ -523,6 +540,7 @@ fn draw_dbuffer(
     tiles: &mut [DTile],
     input: &DrawInput,
     kind: DrawKind,
+    early_z: bool,
     probe: Option<&PassProbe>,
 ) -> Counters {
     let cull = match kind {
@@ -538,7 +556,13 @@ fn draw_dbuffer(
         &tris,
         &bins,
         probe,
-        no_tile_culling,
+        |t, tile, tri, c| match (early_z, kind) {
+            (true, DrawKind::Scene(offset)) => {
+                let near = tri.nearest_offset_depth(offset, format);
+                tile.depth.early_z(&view.tiling, t, tri.bbox, near, c)
+            }
+            _ => TileDraw::Whole,
+        },
         |_, tile, tri, f, c, tap| {
             let before = tap.map(|_| {
                 let (depth, texel) = (tile.depth.values[f.local], texel_raw(&tile.color, f.local));
@@ -727,10 +751,12 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
 
     // Pass 2: the D-buffer, three draws; a probe watches the texel the screen pass reads for
     // its pixel.
-    let mut tiles = alloc_tiles(&view.tiling, |_, len| DTile {
+    let early_z = early_z_applies(&frame.gpu, s.distances);
+    let hiz_tile = early_z.unwrap_or(view.tiling.tile);
+    let mut tiles = alloc_tiles(&view.tiling, |t, len| DTile {
         color: RgbaTile::cleared(s.storage, [range, 0.0, 0.0, 0.0], len)
             .recording(frame.dump_buffers),
-        depth: DepthTile::cleared(view.depth, len),
+        depth: DepthTile::cleared_in(view.depth, &view.tiling, t, hiz_tile),
         stats: DBufferStats::default(),
     });
     let texel = frame.probe.as_ref().and_then(|p| {
@@ -772,6 +798,7 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
         &mut tiles,
         &scene_input,
         DrawKind::Scene(s.offset),
+        early_z.is_some(),
         map_probe("dbuffer-scene").as_ref(),
     );
     let pass_scene = PassStats::since("dbuffer-scene", t, c1);
@@ -797,6 +824,7 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
             &mut tiles,
             &input,
             kind,
+            false,
             probe.as_ref(),
         );
         PassStats::since(name, t, counters)
@@ -938,7 +966,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let s = read_settings(frame)?;
     let r = render(frame, &s)?;
     let n = s.map_size;
-    let buffers = vec![
+    let mut buffers = vec![
         BufferPlan::depth(&frame.gpu),
         BufferPlan::color_target(
             format!("D-buffer RGBA {n}x{n} (R |cx_o|, G |cx_uv|, B |cx_pv|, A |cx_s|)"),
@@ -947,6 +975,13 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         ),
         BufferPlan::depth_target(format!("D-buffer depth {n}x{n}"), s.depth),
     ];
+    if let Some(hiz_tile) = early_z_applies(&frame.gpu, s.distances) {
+        buffers.push(BufferPlan::hiz_zmin_zmax_of(
+            "D-buffer depth",
+            s.depth,
+            hiz_tile,
+        ));
+    }
     let mut stats = super::stats_after_scene_pass(
         "dbuffer",
         frame,
@@ -1048,6 +1083,97 @@ mod tests {
         // Ray: lateral = u·depth, u = x/z; line: lateral = p + (σ − p)·depth/h.
         let u = x / z;
         p / (u - (sigma - p) / h)
+    }
+
+    /// Early Z in the D-buffer's scene draw (interpolated distances) changes no texel of the
+    /// D-buffer and no output bit: unit on and off, HiZ tiles of 8 and 2, in D16, D24 and D32F,
+    /// with no offset and with a positive and a negative one, on disk scenes drawn in file
+    /// order and reversed (nearer meshes first, where it rejects); with exact distances it
+    /// stays off. The counters show it at work.
+    #[test]
+    fn early_z_in_the_scene_draw_changes_no_texel() {
+        use crate::gpu::color::RgbaTile;
+        let offsets = [
+            PolygonOffset::NONE,
+            PolygonOffset {
+                factor: 2.0,
+                units: 4.0,
+            },
+            PolygonOffset {
+                factor: -1.5,
+                units: -64.0,
+            },
+        ];
+        let (mut culled, mut saved) = (0, 0);
+        // The disk scenes, and scenes with intersecting meshes under a disk light of the same
+        // center (where a triangle can lie partly in front of a tile's depths).
+        for name in [
+            "disk-block",
+            "disk-torus",
+            "disk-small-sphere",
+            "pw-fractal",
+            "forest-spheres",
+        ] {
+            let mut scene = crate::scene::builtin::load(name).unwrap();
+            scene.resize(Some(48), Some(48));
+            let light = &mut scene.lights[0];
+            if !matches!(light.shape, LightShape::Disk { .. }) {
+                // Facing the origin, which the built-in scenes are around.
+                let normal = -light.center.normalize();
+                light.shape = LightShape::Disk {
+                    radius: 0.3,
+                    normal,
+                };
+            }
+            for reversed in [false, true] {
+                if reversed {
+                    scene.meshes.reverse();
+                }
+                for depth in [DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F] {
+                    for offset in offsets {
+                        let run = |hiz: bool, hiz_tile_size: u32, distances: Distances| {
+                            let gpu = crate::frame::GpuSettings {
+                                hiz,
+                                hiz_tile_size,
+                                ..Default::default()
+                            };
+                            let frame = Frame::render(&scene, gpu).unwrap();
+                            let s = DBufferSettings {
+                                depth,
+                                offset,
+                                distances,
+                                ..read_settings(&frame).unwrap()
+                            };
+                            render(&frame, &s).unwrap()
+                        };
+                        let texels = |r: &DBufferRender| -> Vec<[u32; 4]> {
+                            r.dbuffer
+                                .iter()
+                                .flat_map(|t: &RgbaTile| t.values.clone())
+                                .collect()
+                        };
+                        let at = format!("{name} reversed {reversed} {depth:?} {offset:?}");
+                        let off = run(false, 8, Distances::Interpolated);
+                        for hiz_tile in [8, 2] {
+                            let on = run(true, hiz_tile, Distances::Interpolated);
+                            assert!(texels(&on) == texels(&off), "{at}, HiZ {hiz_tile}");
+                            assert_eq!(on.visibility, off.visibility, "{at}");
+                            let (c_on, c_off) = (on.passes[1].counters, off.passes[1].counters);
+                            assert_eq!(c_off.tiles_culled_hiz, 0);
+                            assert!(c_on.fragments_rasterized <= c_off.fragments_rasterized);
+                            culled += c_on.tiles_culled_hiz;
+                            saved += c_off.fragments_rasterized - c_on.fragments_rasterized;
+                        }
+                        let exact = run(true, 8, Distances::Exact);
+                        assert_eq!(exact.passes[1].counters.hiz_read_bytes, 0, "{at}");
+                    }
+                }
+            }
+        }
+        assert!(
+            culled > 0 && saved > 0,
+            "{culled} pairs rejected, {saved} fragments saved"
+        );
     }
 
     #[test]
