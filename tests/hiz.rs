@@ -11,8 +11,14 @@ use penumbra::scene::builtin;
 
 /// Every method `scene` (built-in, at 48²) supports, rendered with `hiz = on|off`.
 fn runs(scene: &str, hiz: &str) -> Vec<MethodRun> {
+    runs_with(scene, 48, &[format!("gpu.hiz={hiz}")])
+}
+
+/// Every method `scene` (built-in, at `size`²) supports, rendered with the `--opt` options
+/// `opts`.
+fn runs_with(scene: &str, size: u32, opts: &[String]) -> Vec<MethodRun> {
     let mut s = builtin::load(scene).unwrap();
-    s.resize(Some(48), Some(48));
+    s.resize(Some(size), Some(size));
     s.methods = Some(
         methods::ALL
             .iter()
@@ -20,7 +26,9 @@ fn runs(scene: &str, hiz: &str) -> Vec<MethodRun> {
             .map(|m| m.to_string())
             .collect(),
     );
-    s.set_cli_option(&format!("gpu.hiz={hiz}")).unwrap();
+    for o in opts {
+        s.set_cli_option(o).unwrap();
+    }
     render_scene(&s).unwrap()
 }
 
@@ -224,23 +232,12 @@ fn finer_hiz_tiles_change_no_bit_and_reject_at_least_as_much() {
     let (mut decided_more, mut drew_less) = (Vec::new(), Vec::new());
     for scene in ["cube-of-spheres", "eye-in-shadow", "two-lights"] {
         let render = |hiz: &str, hiz_tile: u32| {
-            let mut s = builtin::load(scene).unwrap();
-            s.resize(Some(96), Some(96));
-            s.methods = Some(
-                methods::ALL
-                    .iter()
-                    .filter(|m| methods::supports_scene(m, &s))
-                    .map(|m| m.to_string())
-                    .collect(),
-            );
-            for o in [
+            let opts = [
                 format!("gpu.hiz={hiz}"),
                 "gpu.tile-size=32".into(),
                 format!("gpu.hiz-tile-size={hiz_tile}"),
-            ] {
-                s.set_cli_option(&o).unwrap();
-            }
-            render_scene(&s).unwrap()
+            ];
+            runs_with(scene, 96, &opts)
         };
         let off = render("off", 32);
         let by_size = [32, 8, 4].map(|h| render("on", h));

@@ -134,6 +134,21 @@ impl PolygonOffset {
         units: 0.0,
     };
 
+    /// No offset, a positive one and a negative one: the offsets the early-Z tests of the
+    /// passes drawn from the light try (a bound on fragment depths must hold for each).
+    #[cfg(test)]
+    pub(crate) const EARLY_Z_TEST_CASES: [PolygonOffset; 3] = [
+        PolygonOffset::NONE,
+        PolygonOffset {
+            factor: 2.0,
+            units: 4.0,
+        },
+        PolygonOffset {
+            factor: -1.5,
+            units: -64.0,
+        },
+    ];
+
     /// The offset `o = m·factor + r·units` of a primitive with largest depth slope
     /// `max_slope` and largest vertex depth `z_max`, stored as `format` (a slope that is not
     /// finite — a primitive seen edge-on — counts as 0).

@@ -522,17 +522,7 @@ mod tests {
     /// offset, a positive one and a negative one; the counters show it at work.
     #[test]
     fn early_z_in_the_shadow_map_changes_no_texel() {
-        let offsets = [
-            PolygonOffset::NONE,
-            PolygonOffset {
-                factor: 2.0,
-                units: 4.0,
-            },
-            PolygonOffset {
-                factor: -1.5,
-                units: -64.0,
-            },
-        ];
+        let offsets = PolygonOffset::EARLY_Z_TEST_CASES;
         let mut culled = 0;
         for name in [
             "cube-of-spheres",

@@ -1093,17 +1093,7 @@ mod tests {
     #[test]
     fn early_z_in_the_scene_draw_changes_no_texel() {
         use crate::gpu::color::RgbaTile;
-        let offsets = [
-            PolygonOffset::NONE,
-            PolygonOffset {
-                factor: 2.0,
-                units: 4.0,
-            },
-            PolygonOffset {
-                factor: -1.5,
-                units: -64.0,
-            },
-        ];
+        let offsets = PolygonOffset::EARLY_Z_TEST_CASES;
         let (mut culled, mut saved) = (0, 0);
         // The disk scenes, and scenes with intersecting meshes under a disk light of the same
         // center (where a triangle can lie partly in front of a tile's depths).
