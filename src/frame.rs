@@ -387,9 +387,9 @@ impl<'s> Frame<'s> {
 
     /// What the hierarchical-Z unit ([`crate::gpu::hiz`], on with `[options.gpu] hiz`) lets
     /// the draw loop rasterize of `tri` in tile `t` ([`TileDraw`]), for a pass that tests the
-    /// scene depth with `func` (without writing it) and leaves every buffer alone for a
-    /// fragment whose test outcome is `idle` (z-pass volume counting does nothing where the
-    /// test fails: `idle = false`; z-fail nothing where it passes: `idle = true`): nothing
+    /// scene depth with `idle.0` (without writing it) and leaves every buffer alone for a
+    /// fragment whose test outcome is `idle.1` (z-pass volume counting does nothing where the
+    /// test fails: `false`; z-fail nothing where it passes: `true`): nothing
     /// when every HiZ tile under the triangle decides `idle` for all its fragments, else the
     /// HiZ tiles that do not ([`crate::gpu::buffers::DepthTile::hiz_draw`]). The zmin/zmax
     /// reads and a rejection of the whole pair are counted in `c`; the watched samples of

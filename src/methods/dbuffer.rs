@@ -1087,9 +1087,10 @@ mod tests {
 
     /// Early Z in the D-buffer's scene draw (interpolated distances) changes no texel of the
     /// D-buffer and no output bit: unit on and off, HiZ tiles of 8 and 2, in D16, D24 and D32F,
-    /// with no offset and with a positive and a negative one, on disk scenes drawn in file
-    /// order and reversed (nearer meshes first, where it rejects); with exact distances it
-    /// stays off. The counters show it at work.
+    /// with no offset and with a positive and a negative one, on disk scenes and on scenes of
+    /// intersecting meshes under a disk light, drawn in file order and reversed (nearer
+    /// meshes first, where it rejects); with exact distances it stays off. The counters show
+    /// it at work, and a bound taken at the farthest vertex instead fails it.
     #[test]
     fn early_z_in_the_scene_draw_changes_no_texel() {
         use crate::gpu::color::RgbaTile;
