@@ -96,6 +96,11 @@ pub struct DepthTile {
     /// The bounds of the HiZ tiles, row-major inside the raster tile (padding included: a
     /// HiZ tile wholly outside the image holds no sample and is never consulted).
     hiz: Vec<HizBounds>,
+    /// The coarse level: the union of the bounds of the HiZ tiles holding samples, built with
+    /// them ([`DepthTile::build_hiz`], [`DepthTile::finish_hiz`]) and read first where a
+    /// raster tile holds several HiZ tiles ([`DepthTile::hiz_draw`]). Not kept by the
+    /// writes: early Z reads the HiZ tiles only.
+    coarse: HizBounds,
     /// How the raster tile is cut into HiZ tiles.
     grid: HizGrid,
 }
@@ -261,6 +266,7 @@ impl DepthTile {
             format,
             values: vec![z; len],
             hiz: vec![HizBounds::uniform(format, z, len as u32)],
+            coarse: HizBounds::uniform(format, z, len as u32),
             grid: HizGrid {
                 tile_shift,
                 hiz_shift: tile_shift,
@@ -280,6 +286,7 @@ impl DepthTile {
         tile.hiz = (0..grid.count())
             .map(|k| HizBounds::uniform(format, z, grid.rect(tiling, t, k).area()))
             .collect();
+        tile.coarse = HizBounds::uniform(format, z, tiling.rect(t).area());
         tile
     }
 
@@ -301,10 +308,16 @@ impl DepthTile {
         &self.hiz[k]
     }
 
-    /// The bounds of the whole raster tile `t` of `tiling`: the union of its HiZ tiles'
-    /// (those holding samples), for a test made per raster tile (`pw-restructured`, Paper II
-    /// §4).
-    pub fn tile_bounds(&self, tiling: &Tiling, t: usize) -> HizBounds {
+    /// The bounds of the whole raster tile: the coarse level, the union of its HiZ tiles'
+    /// (those holding samples), as of the last [`DepthTile::build_hiz`] or
+    /// [`DepthTile::finish_hiz`] — for a test made per raster tile (`pw-restructured`, Paper
+    /// II §4).
+    pub fn tile_bounds(&self) -> HizBounds {
+        self.coarse
+    }
+
+    /// The union of the bounds of the HiZ tiles of tile `t` of `tiling` that hold samples.
+    fn union_of_hiz_tiles(&self, tiling: &Tiling, t: usize) -> HizBounds {
         let union = |a: HizBounds, b: HizBounds| {
             let lo = if a.zmin <= b.zmin { a } else { b };
             let hi = if a.zmax >= b.zmax { a } else { b };
@@ -320,22 +333,12 @@ impl DepthTile {
                     .sum(),
             }
         };
-        let holding = self.hiz_tiles_holding_samples(tiling, t);
+        let r = tiling.rect(t);
+        let holding = self.grid.under(tiling, t, [r.x0, r.y0, r.x1 - 1, r.y1 - 1]);
         holding
             .map(|k| self.hiz[k])
             .reduce(union)
             .unwrap_or(self.hiz[0])
-    }
-
-    /// The HiZ tiles of tile `t` of `tiling` that hold pixels of the image: those
-    /// [`DepthTile::tile_bounds`] reads.
-    pub fn hiz_tiles_holding_samples(
-        &self,
-        tiling: &Tiling,
-        t: usize,
-    ) -> impl Iterator<Item = usize> + '_ {
-        let r = tiling.rect(t);
-        self.hiz_under(tiling, t, [r.x0, r.y0, r.x1 - 1, r.y1 - 1])
     }
 
     /// Read sample `i` (counted).
@@ -362,6 +365,7 @@ impl DepthTile {
                 self.hiz[k].in_front_below = self.format.first_quantized_at_least(self.hiz[k].zmin);
             }
         }
+        self.coarse = self.union_of_hiz_tiles(tiling, t);
     }
 
     /// Set HiZ tile `k`'s zmax to the largest stored value over its pixels inside the image
@@ -443,6 +447,7 @@ impl DepthTile {
             }
             self.hiz[k].in_front_below = self.format.first_quantized_at_least(self.hiz[k].zmin);
         }
+        self.coarse = self.union_of_hiz_tiles(tiling, t);
     }
 
     /// The depth test of fragment `f` against this tile (reads the stored value, counted).
@@ -512,6 +517,14 @@ impl DepthTile {
         tri: &RasterTriangle,
         c: &mut Counters,
     ) -> TileDraw {
+        // The coarse level first, where the raster tile holds several HiZ tiles: a pair it
+        // rejects, every HiZ tile would (their bounds lie inside it), for one read.
+        if self.hiz.len() > 1 {
+            count!(c.hiz_read_bytes += self.hiz_read_bytes());
+            if self.coarse.depth_outcome(func, tri) == Some(idle) {
+                return TileDraw::Skip;
+            }
+        }
         self.grid.draw(tiling, t, tri.bbox, |k| {
             count!(c.hiz_read_bytes += self.hiz_read_bytes());
             self.hiz[k].depth_outcome(func, tri) == Some(idle)
@@ -706,7 +719,7 @@ mod tests {
                 let all = want.iter().flatten();
                 let lo = all.clone().map(|w| w[0]).min().unwrap();
                 let hi = all.map(|w| w[1]).max().unwrap();
-                let union = tile.tile_bounds(&tiling, t);
+                let union = tile.tile_bounds();
                 assert_eq!([union.zmin, union.zmax], [lo, hi], "hiz {hiz}, tile {t}");
             }
         }

@@ -215,17 +215,15 @@ struct Ctx<'a> {
 
 impl Ctx<'_> {
     /// Count one tile zmin/zmax test of tile `t` in `c` (`hiz_read_bytes`): the values the
-    /// culling mode reads, zmax, or zmin and zmax, in the depth format, of each HiZ tile of
-    /// the tile (one with the default sizes; `DepthTile::tile_bounds`).
+    /// culling mode reads, zmax, or zmin and zmax, in the depth format, of the tile's bounds
+    /// (`DepthTile::tile_bounds`, the HiZ unit's coarse level).
     fn count_tile_test(&self, t: usize, c: &mut Counters) {
         let values = match self.s.culling {
             Culling::Off => 0,
             Culling::Zmax => 1,
             Culling::ZminZmax => 2,
         };
-        let d = &self.frame.tiles[t].depth;
-        let hiz_tiles = || d.hiz_tiles_holding_samples(&self.frame.tiling, t).count() as u64;
-        count!(c.hiz_read_bytes += hiz_tiles() * values * d.format.bytes());
+        count!(c.hiz_read_bytes += values * self.frame.tiles[t].depth.format.bytes());
     }
 
     /// Umbra sign of a front-plane or cap fragment (per §3/§5): the LI amount it adds when its
@@ -265,7 +263,7 @@ impl Ctx<'_> {
         // z-pass adds nothing where LESS fails (every fragment at or behind every stored
         // depth), z-fail nothing where it passes (every fragment in front of every one).
         let idle = self.s.test == WedgeTest::ZFail;
-        let tile = self.frame.tiles[t].depth.tile_bounds(&self.frame.tiling, t);
+        let tile = self.frame.tiles[t].depth.tile_bounds();
         tile.depth_outcome(DepthFunc::Less, tri) == Some(idle)
     }
 
@@ -280,7 +278,7 @@ impl Ctx<'_> {
         let sw = &self.screen[wi as usize];
         let d = &self.frame.tiles[t].depth;
         let fmt = d.format;
-        let tile = d.tile_bounds(&self.frame.tiling, t);
+        let tile = d.tile_bounds();
         let (tz0, tz1) = (fmt.to_window(tile.zmin), fmt.to_window(tile.zmax));
         // Quick rejection: the wedge lies behind every stored point.
         if sw.z_range[0] > tz1 {
