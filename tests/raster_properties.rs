@@ -2,11 +2,15 @@
 //! every pixel of its interior exactly once — no gaps, no double hits — for random quads, both
 //! diagonals, random tile sizes, including vertices off screen and at sub-pixel positions; the
 //! single-pixel coverage query agrees with the traversal; binning keeps exactly the tiles where
-//! no edge function is negative at every sample, so every tile with a covered sample.
+//! no edge function is negative at every sample, so every tile with a covered sample; the
+//! hierarchical-Z unit leaves out no fragment whose depth test could change a buffer.
 
+use penumbra::gpu::buffers::DepthTile;
 use penumbra::gpu::counters::Counters;
+use penumbra::gpu::depth::{DepthFormat, DepthFunc};
 use penumbra::gpu::raster::{
-    bin, draw, no_tile_culling, touched_tile_count, touched_tiles, touches_tile,
+    bin, draw, no_tile_culling, rasterize_in_tile, touched_tile_count, touched_tiles, touches_tile,
+    TileDraw,
 };
 use penumbra::gpu::setup::RasterTriangle;
 use penumbra::gpu::setup::{setup_triangle, CullMode};
@@ -249,4 +253,77 @@ fn triangle_fan_around_a_vertex_is_watertight() {
     let counts = hits(&tris, 8);
     assert!(counts.iter().all(|&n| n <= 1));
     assert!(counts.iter().filter(|&&n| n == 1).count() > 500);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// The hierarchical-Z unit never leaves out a fragment that could change a buffer: on a
+    /// random depth surface (a plane with noise, D24) and a random triangle, for LESS and
+    /// GEQUAL and either idle outcome, every covered sample of every tile whose depth test
+    /// outcome differs from the idle one lies in what `DepthTile::hiz_draw` lets the draw loop
+    /// rasterize (the bound is the depth test itself, sample by sample), at every HiZ tile
+    /// size up to the raster tile.
+    #[test]
+    fn hiz_draws_every_fragment_whose_outcome_is_not_idle(
+        v in triangle_or_sliver(),
+        zs in prop::array::uniform3(-0.95f32..0.95),
+        w in 0.5f32..3.0,
+        tile_log in 2u32..6,
+        hiz_log in 1u32..6,
+        surface in (0.05f32..0.95, -0.01f32..0.01, -0.01f32..0.01, 0.0f32..0.05, any::<u32>()),
+    ) {
+        let tiling = Tiling::new(W, H, 1 << tile_log).unwrap();
+        let format = DepthFormat::D24;
+        let (base, dx, dy, noise, seed) = surface;
+        let mut state = seed | 1;
+        let mut tiles: Vec<DepthTile> = (0..tiling.tile_count())
+            .map(|t| DepthTile::cleared_in(format, &tiling, t, 1 << hiz_log))
+            .collect();
+        for y in 0..H {
+            for x in 0..W {
+                state ^= state << 13;
+                state ^= state >> 17;
+                state ^= state << 5;
+                let jitter = noise * (state as f32 / u32::MAX as f32);
+                let z = (base + dx * x as f32 + dy * y as f32 + jitter).clamp(0.0, 1.0);
+                tiles[tiling.tile_of(x, y)].values[tiling.local(x, y)] = format.quantize(z);
+            }
+        }
+        for (t, tile) in tiles.iter_mut().enumerate() {
+            tile.build_hiz(&tiling, t);
+        }
+        let tri: [ClipVertex; 3] =
+            std::array::from_fn(|k| ClipVertex([v[k][0] * w, v[k][1] * w, zs[k] * w, w]));
+        let mut setup = Vec::new();
+        let mut c = Counters::default();
+        setup_triangle(&tri, 0, CullMode::None, W, H, &mut setup, &mut c);
+        let Some(tri) = setup.first() else {
+            return Ok(());
+        };
+        let mut missed = Vec::new();
+        for t in touched_tiles(&tiling, tri, 0..tiling.tiles_y) {
+            let depth = &tiles[t];
+            for (func, idle) in [DepthFunc::Less, DepthFunc::GEqual]
+                .into_iter()
+                .flat_map(|f| [(f, false), (f, true)])
+            {
+                let drawn = depth.hiz_draw(&tiling, t, (func, idle), tri, &mut c);
+                rasterize_in_tile(&tiling, tri, &tiling.rect(t), |f| {
+                    let outcome = func.test(format.quantize(f.z), depth.values[f.local]);
+                    let inside = match drawn {
+                        TileDraw::Skip => false,
+                        TileDraw::Whole => true,
+                        TileDraw::Within(r) => {
+                            (r.x0..r.x1).contains(&f.x) && (r.y0..r.y1).contains(&f.y)
+                        }
+                    };
+                    if outcome != idle && !inside {
+                        missed.push((t, func, idle, f.x, f.y));
+                    }
+                });
+            }
+        }
+        prop_assert!(missed.is_empty(), "{missed:?}");
+    }
 }
