@@ -71,6 +71,14 @@ pub struct GpuSettings {
     pub hiz_tile_size: u32,
 }
 
+impl GpuSettings {
+    /// The HiZ tile edge with the hierarchical-Z unit on, `None` with it off: what a pass with
+    /// early Z starts its depth tiles with and its plan lists.
+    pub fn hiz_tile(&self) -> Option<u32> {
+        self.hiz.then_some(self.hiz_tile_size)
+    }
+}
+
 impl Default for GpuSettings {
     fn default() -> Self {
         GpuOptions::default().settings()
@@ -222,9 +230,11 @@ impl<'s> Frame<'s> {
             &mut tiles,
             &tris,
             &bins,
-            |t, tile, tri, c| match gpu.hiz {
-                true => tile.depth.early_z(&tiling, t, tri.bbox, tri.z_range[0], c),
-                false => TileDraw::Whole,
+            |t, tile, tri, c| {
+                if !gpu.hiz {
+                    return TileDraw::Whole;
+                }
+                tile.depth.early_z(&tiling, t, tri.bbox, tri.z_range[0], c)
             },
             |_, tile, tri, f, c| {
                 if tile.depth.test_and_write(&state, &f, c) {

@@ -314,9 +314,7 @@ proptest! {
                     let inside = match drawn {
                         TileDraw::Skip => false,
                         TileDraw::Whole => true,
-                        TileDraw::Within(r) => {
-                            (r.x0..r.x1).contains(&f.x) && (r.y0..r.y1).contains(&f.y)
-                        }
+                        TileDraw::Within(r) => r.contains(f.x, f.y),
                     };
                     if outcome != idle && !inside {
                         missed.push((t, func, idle, f.x, f.y));

@@ -163,8 +163,10 @@ impl HizGrid {
         self.index_of(x >> self.hiz_shift, y >> self.hiz_shift)
     }
 
-    /// The HiZ tiles of tile `t` of `tiling` that the inclusive pixel box `bbox` overlaps,
-    /// in row-major order ([`DepthTile::hiz_under`]).
+    /// The HiZ tiles of tile `t` of `tiling` that the inclusive pixel box `bbox` (a
+    /// triangle's, [`RasterTriangle::bbox`]) overlaps, in row-major order. A box that misses
+    /// the tile is clamped into it: the triangle then has no fragment there, and any HiZ
+    /// tile's decision holds for none.
     fn under(
         self,
         tiling: &Tiling,
@@ -192,7 +194,7 @@ impl HizGrid {
         bbox: [u32; 4],
         mut rejects: impl FnMut(usize) -> bool,
     ) -> TileDraw {
-        if self.per_row_shift() == 0 {
+        if self.count() == 1 {
             return rejects(0).into();
         }
         let mut kept = KeptHizTiles::new(self);
@@ -288,24 +290,6 @@ impl DepthTile {
             .collect();
         tile.coarse = HizBounds::uniform(format, z, tiling.rect(t).area());
         tile
-    }
-
-    /// The HiZ tiles of tile `t` of `tiling` that the inclusive pixel box `bbox` (a
-    /// triangle's, [`RasterTriangle::bbox`]) overlaps, in row-major order. A box that misses
-    /// the tile is clamped into it: the triangle then has no fragment there, and any HiZ
-    /// tile's decision holds for none.
-    pub fn hiz_under(
-        &self,
-        tiling: &Tiling,
-        t: usize,
-        bbox: [u32; 4],
-    ) -> impl Iterator<Item = usize> + Clone {
-        self.grid.under(tiling, t, bbox)
-    }
-
-    /// The bounds of HiZ tile `k` ([`DepthTile::hiz_under`]).
-    pub fn hiz_bounds(&self, k: usize) -> &HizBounds {
-        &self.hiz[k]
     }
 
     /// The bounds of the whole raster tile: the coarse level, the union of its HiZ tiles'
@@ -507,8 +491,10 @@ impl DepthTile {
     /// `func` other than `idle` (the outcome on which the pass's fragments do nothing): the
     /// HiZ tiles under its box whose bounds decide `idle` for every fragment
     /// ([`HizBounds::depth_outcome`]) reject it, and it is drawn only over the others
-    /// ([`TileDraw`]). Every HiZ tile under the box is read (two values each,
-    /// [`DepthTile::hiz_read_bytes`]), counted in `c`.
+    /// ([`TileDraw`]). Where the raster tile holds several HiZ tiles, the coarse level
+    /// ([`DepthTile::tile_bounds`]) is read first and a pair it rejects is skipped; otherwise
+    /// every HiZ tile under the box is read. Each read (two values,
+    /// [`DepthTile::hiz_read_bytes`]) is counted in `c`.
     pub fn hiz_draw(
         &self,
         tiling: &Tiling,
@@ -519,7 +505,7 @@ impl DepthTile {
     ) -> TileDraw {
         // The coarse level first, where the raster tile holds several HiZ tiles: a pair it
         // rejects, every HiZ tile would (their bounds lie inside it), for one read.
-        if self.hiz.len() > 1 {
+        if self.grid.count() > 1 {
             count!(c.hiz_read_bytes += self.hiz_read_bytes());
             if self.coarse.depth_outcome(func, tri) == Some(idle) {
                 return TileDraw::Skip;
@@ -712,7 +698,7 @@ mod tests {
                 for (k, w) in want.iter().enumerate() {
                     assert_eq!(w.is_none(), tile.grid.rect(&tiling, t, k).is_empty());
                     if let Some([lo, hi]) = *w {
-                        let b = tile.hiz_bounds(k);
+                        let b = tile.hiz[k];
                         assert_eq!([b.zmin, b.zmax], [lo, hi], "hiz {hiz}, tile {t}, {k}");
                     }
                 }
@@ -744,7 +730,7 @@ mod tests {
                     if want.is_empty() {
                         continue; // the box misses the tile: no triangle of it is drawn there
                     }
-                    let got: Vec<usize> = tile.hiz_under(&tiling, t, bbox).collect();
+                    let got: Vec<usize> = tile.grid.under(&tiling, t, bbox).collect();
                     assert_eq!(got, want, "hiz {hiz}, box {bbox:?}, tile {t}");
                 }
             }

@@ -25,7 +25,7 @@
 //! covers, independent of the raster tile but at most it — each raster tile holds its HiZ
 //! tiles and keeps their bounds as it writes depth, in parallel with the other tiles. Each
 //! HiZ tile a triangle's pixel box overlaps in a raster tile
-//! ([`DepthTile::hiz_under`](super::buffers::DepthTile::hiz_under)) is read, counted, and
+//! ([`DepthTile::hiz_draw`](super::buffers::DepthTile::hiz_draw)) is read, counted, and
 //! rejects the triangle or keeps it; the pair is rasterized over the rectangle of those
 //! that keep it ([`TileDraw`](super::raster::TileDraw)), skipped when none does.
 //!
@@ -307,14 +307,19 @@ mod tests {
         ] {
             let rejects = |bx: [DVec3; 2]| plane_rejects_box(n, o, bx, &rounding);
             for rect in [[0, 0, 12, 8], [3, 1, 9, 6], [5, 5, 5, 5]] {
+                let [tx0, ty0, tx1, ty1] = rect;
                 let mut c = Counters::default();
                 let kept = b.kept_tiles(rect, rejects, &mut c);
                 let want: Vec<u32> = (0..tiling.tile_count() as u32)
-                    .filter(|&t| tiling.tile_in_rect(t as usize, rect))
+                    .filter(|&t| {
+                        let (tx, ty) = (t % tiling.tiles_x, t / tiling.tiles_x);
+                        (tx0..=tx1).contains(&tx) && (ty0..=ty1).contains(&ty)
+                    })
                     .filter(|&t| b.tile(t as usize).is_some_and(|bx| !rejects(bx)))
                     .collect();
                 assert_eq!(kept, want, "plane {n} through {o}, tiles {rect:?}");
-                let per_tile = tiling.rect_tile_count(rect) as u64 * TileReceiverBounds::READ_BYTES;
+                let tiles_in_rect = ((tx1 - tx0 + 1) * (ty1 - ty0 + 1)) as u64;
+                let per_tile = tiles_in_rect * TileReceiverBounds::READ_BYTES;
                 if rect == [0, 0, 12, 8] && n.x == 1.0 {
                     assert!(c.hiz_read_bytes < per_tile, "{} reads", c.hiz_read_bytes);
                 }

@@ -390,12 +390,12 @@ impl LightView {
             &tris,
             &bins,
             probe,
-            |t, tile, tri, c| {
-                let near = tri.nearest_offset_depth(offset, format);
-                match hiz {
-                    Some(_) => tile.early_z(&self.tiling, t, tri.bbox, near, c),
-                    None => TileDraw::Whole,
+            |t, tile, tri, c| match hiz {
+                Some(_) => {
+                    let near = tri.nearest_offset_depth(offset, format);
+                    tile.early_z(&self.tiling, t, tri.bbox, near, c)
                 }
+                None => TileDraw::Whole,
             },
             |_, tile, tri, f, c, tap| {
                 let z = tri.offset_depth(offset, format, f.z);

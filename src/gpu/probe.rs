@@ -606,8 +606,7 @@ impl PassProbe<'_> {
     ) {
         for x in self.targets.iter().filter(|x| x.tile == t) {
             let [px, py] = x.at;
-            let inside = |r: TileRect| (r.x0..r.x1).contains(&px) && (r.y0..r.y1).contains(&py);
-            if tri.covers(px, py) && !drawn.is_some_and(inside) {
+            if tri.covers(px, py) && !drawn.is_some_and(|r| r.contains(px, py)) {
                 let tap = Tap {
                     pass: self,
                     at: x.at,

@@ -285,10 +285,10 @@ pub fn rasterize_in_tile(
     let y0 = r.y0.max(by0);
     let x1 = r.x1.min(bx1 + 1);
     let y1 = r.y1.min(by1 + 1);
-    if x0 >= x1 || y0 >= y1 {
+    let sub = TileRect { x0, y0, x1, y1 };
+    if sub.is_empty() {
         return (false, 0);
     }
-    let sub = TileRect { x0, y0, x1, y1 };
     let coverage = classify(t, &sub);
     if coverage == TileCoverage::Outside {
         return (true, 0);

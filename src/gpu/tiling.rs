@@ -41,6 +41,11 @@ impl TileRect {
         self.x0 >= self.x1 || self.y0 >= self.y1
     }
 
+    /// Whether pixel (x, y) lies in the rectangle.
+    pub fn contains(&self, x: u32, y: u32) -> bool {
+        (self.x0..self.x1).contains(&x) && (self.y0..self.y1).contains(&y)
+    }
+
     /// The smallest rectangle holding both.
     pub fn union(&self, other: &TileRect) -> TileRect {
         TileRect {
@@ -123,17 +128,6 @@ impl Tiling {
     pub fn tiles_of_box(&self, [x0, y0, x1, y1]: [u32; 4]) -> [u32; 4] {
         let shift = self.tile.trailing_zeros();
         [x0 >> shift, y0 >> shift, x1 >> shift, y1 >> shift]
-    }
-
-    /// Whether tile `t` lies in the inclusive tile rectangle `[tx0, ty0, tx1, ty1]`.
-    pub fn tile_in_rect(&self, t: usize, [tx0, ty0, tx1, ty1]: [u32; 4]) -> bool {
-        let (tx, ty) = (t as u32 % self.tiles_x, t as u32 / self.tiles_x);
-        (tx0..=tx1).contains(&tx) && (ty0..=ty1).contains(&ty)
-    }
-
-    /// The number of tiles in the inclusive tile rectangle `[tx0, ty0, tx1, ty1]`.
-    pub fn rect_tile_count(&self, [tx0, ty0, tx1, ty1]: [u32; 4]) -> usize {
-        ((tx1 - tx0 + 1) * (ty1 - ty0 + 1)) as usize
     }
 
     /// Index of pixel (x, y) inside its tile's storage.

@@ -480,14 +480,20 @@ pub struct DBufferRender {
 /// depths, offset as the shadow map's ([`crate::gpu::setup::RasterTriangle::offset_depth`]):
 /// the bound the shadow map's early Z uses holds.
 fn early_z_applies(gpu: &crate::frame::GpuSettings, distances: Distances) -> Option<u32> {
-    (gpu.hiz && distances == Distances::Interpolated).then_some(gpu.hiz_tile_size)
+    gpu.hiz_tile()
+        .filter(|_| distances == Distances::Interpolated)
 }
 
 /// One D-buffer draw (module doc, pass 2).
 #[derive(Debug, Clone, Copy)]
 enum DrawKind {
-    /// The scene into R, LESS, with the R bias.
-    Scene(PolygonOffset),
+    /// The scene into R, LESS, with the R bias, with early Z when `early_z`
+    /// ([`early_z_applies`]): a triangle is rejected in the HiZ tiles of a tile where its
+    /// nearest offset depth is at or behind every stored depth.
+    Scene {
+        offset: PolygonOffset,
+        early_z: bool,
+    },
     /// A volume into the channels of the mask, GREATER.
     Volume(ColorMask),
 }
@@ -530,9 +536,7 @@ fn texel_raw(tile: &RgbaTile, i: usize) -> Raw {
 }
 
 /// Run one D-buffer draw of `input` into `tiles` (module doc, pass 2), recording at the texel
-/// `probe` watches; with `early_z`, a scene draw rejects a triangle in the HiZ tiles of a tile
-/// where its nearest offset depth is at or behind every stored depth ([`early_z_applies`]).
-#[allow(clippy::too_many_arguments)]
+/// `probe` watches.
 fn draw_dbuffer(
     view: &LightView,
     range: f64,
@@ -540,11 +544,10 @@ fn draw_dbuffer(
     tiles: &mut [DTile],
     input: &DrawInput,
     kind: DrawKind,
-    early_z: bool,
     probe: Option<&PassProbe>,
 ) -> Counters {
     let cull = match kind {
-        DrawKind::Scene(_) => CullMode::Back,
+        DrawKind::Scene { .. } => CullMode::Back,
         DrawKind::Volume(_) => CullMode::None,
     };
     let (tris, mut counters) = setup_all_barycentric(&input.prims, cull, &view.tiling);
@@ -556,8 +559,11 @@ fn draw_dbuffer(
         &tris,
         &bins,
         probe,
-        |t, tile, tri, c| match (early_z, kind) {
-            (true, DrawKind::Scene(offset)) => {
+        |t, tile, tri, c| match kind {
+            DrawKind::Scene {
+                offset,
+                early_z: true,
+            } => {
                 let near = tri.nearest_offset_depth(offset, format);
                 tile.depth.early_z(&view.tiling, t, tri.bbox, near, c)
             }
@@ -589,7 +595,7 @@ fn draw_dbuffer(
                 },
             };
             match kind {
-                DrawKind::Scene(offset) => {
+                DrawKind::Scene { offset, .. } => {
                     tile.stats.scene_fragments += 1;
                     let m = match distances {
                         Distances::Interpolated => tri.max_depth_slope(),
@@ -797,8 +803,10 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
         s.distances,
         &mut tiles,
         &scene_input,
-        DrawKind::Scene(s.offset),
-        early_z.is_some(),
+        DrawKind::Scene {
+            offset: s.offset,
+            early_z: early_z.is_some(),
+        },
         map_probe("dbuffer-scene").as_ref(),
     );
     let pass_scene = PassStats::since("dbuffer-scene", t, c1);
@@ -824,7 +832,6 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
             &mut tiles,
             &input,
             kind,
-            false,
             probe.as_ref(),
         );
         PassStats::since(name, t, counters)

@@ -371,7 +371,7 @@ pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRende
         BiasStage::Lookup => PolygonOffset::NONE,
     };
     let probe = map_probe("shadow-map");
-    let hiz_tile = frame.gpu.hiz.then_some(frame.gpu.hiz_tile_size);
+    let hiz_tile = frame.gpu.hiz_tile();
     let (shadow_map, c1) = view.render_depth_probed(scene, render_offset, hiz_tile, probe.as_ref());
     let pass1 = PassStats::since("shadow-map", t, c1);
 
@@ -742,11 +742,11 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         BufferPlan::color_target(format!("penumbra-map colour {n}x{n}"), s.storage, 1),
         BufferPlan::depth_target(format!("penumbra-map depth {n}x{n}"), s.depth),
     ];
-    if frame.gpu.hiz {
+    if let Some(hiz_tile) = frame.gpu.hiz_tile() {
         buffers.push(BufferPlan::hiz_zmin_zmax_of(
             "shadow map",
             s.depth,
-            frame.gpu.hiz_tile_size,
+            hiz_tile,
         ));
     }
     let stats = super::stats_after_scene_pass(

@@ -1108,8 +1108,7 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
                 tile.counters.packing_clamps += clamps;
                 count!(cnt.color_write_bytes += fin_bytes);
             });
-            let r = tiling.rect(t);
-            let pixels = ((r.x1 - r.x0) * (r.y1 - r.y0)) as u64;
+            let pixels = tiling.rect(t).area() as u64;
             tile.silhouette.fill(cleared);
             tile.stencil.values.fill(0);
             count!(cnt.color_write_bytes += pixels * sil_bytes);
