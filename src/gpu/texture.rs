@@ -26,23 +26,48 @@ pub enum Wrap {
     ClampToEdge,
 }
 
-/// The texel a texel index addresses in a texture of `size` texels.
+/// The texel a texel index addresses in a texture of `size` texels. An index inside the
+/// texture, or one texel past either end (a linear filter's second tap at a border), is
+/// wrapped without the integer division of `rem_euclid`, with the same result (the tables of
+/// `ssv-optimized`, 1 thread: `rem_euclid` was 6 % of its profile).
 fn address(i: i64, size: u32, wrap: Wrap) -> u32 {
+    let n = i64::from(size);
     match wrap {
-        Wrap::Repeat => i.rem_euclid(size as i64) as u32,
-        Wrap::ClampToEdge => i.clamp(0, size as i64 - 1) as u32,
+        Wrap::Repeat if (0..n).contains(&i) => i as u32,
+        Wrap::Repeat if i == -1 => size - 1,
+        Wrap::Repeat if i == n => 0,
+        Wrap::Repeat => i.rem_euclid(n) as u32,
+        Wrap::ClampToEdge => i.clamp(0, n - 1) as u32,
+    }
+}
+
+/// `⌊x⌋`, the same bits as `f64::floor` (without SSE4.1 that is a call into libm, 2 % of
+/// `ssv-optimized`'s profile): below 2⁵², truncation through `i64` is exact and a negative
+/// non-integer is one above its floor; at or above 2⁵² (and for NaN and infinities) `x` is
+/// its own floor and `f64::floor` is kept. A zero keeps its sign.
+fn floor(x: f64) -> f64 {
+    const EXACT: f64 = (1u64 << 52) as f64;
+    if x.abs() < EXACT {
+        let t = (x as i64 as f64).copysign(x);
+        if t > x {
+            t - 1.0
+        } else {
+            t
+        }
+    } else {
+        x.floor()
     }
 }
 
 /// The texel nearest coordinate `x` (module doc).
 pub fn nearest(x: f64, size: u32, wrap: Wrap) -> u32 {
-    address(x.floor() as i64, size, wrap)
+    address(floor(x) as i64, size, wrap)
 }
 
 /// The two texels of a linear filter at coordinate `x` and the weight of the second.
 pub fn linear_taps(x: f64, size: u32, wrap: Wrap) -> ([u32; 2], f64) {
     let x = x - 0.5;
-    let i = x.floor();
+    let i = floor(x);
     let f = x - i;
     let i = i as i64;
     ([address(i, size, wrap), address(i + 1, size, wrap)], f)
@@ -73,6 +98,37 @@ pub fn sample_2d(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`floor`] has the bits of `f64::floor` (and [`address`] the results of `rem_euclid`
+    /// and `clamp`) on signed zeros, halves, values next to integers, the 2⁵² boundary,
+    /// huge values, infinities and NaN.
+    #[test]
+    fn floor_and_address_agree_with_the_library() {
+        let two52 = (1u64 << 52) as f64;
+        let mut xs = vec![0.0, -0.0, f64::INFINITY, f64::NEG_INFINITY, 1e300, -1e300];
+        for base in [0.5, 1.0, 3.0, 127.0, 128.0, two52, 2.0 * two52, 1e18, 1e19] {
+            for x in [base, base.next_up(), base.next_down()] {
+                xs.extend([x, -x]);
+            }
+        }
+        for k in -1000..1000 {
+            xs.push(k as f64 * 0.37);
+        }
+        for x in xs {
+            assert_eq!(floor(x).to_bits(), x.floor().to_bits(), "floor({x:e})");
+        }
+        assert!(floor(f64::NAN).is_nan());
+        for size in [1u32, 2, 5, 128, 256] {
+            let n = i64::from(size);
+            for i in (-3 * n - 2..=3 * n + 2).chain([i64::MIN, i64::MAX]) {
+                assert_eq!(address(i, size, Wrap::Repeat), i.rem_euclid(n) as u32);
+                assert_eq!(
+                    address(i, size, Wrap::ClampToEdge),
+                    i.clamp(0, n - 1) as u32
+                );
+            }
+        }
+    }
 
     #[test]
     fn nearest_and_wrapping() {
