@@ -67,6 +67,11 @@ impl Bins {
     pub fn tile(&self, t: usize) -> &[u32] {
         &self.indices[self.starts[t] as usize..self.starts[t + 1] as usize]
     }
+
+    /// The number of (tile, triangle) pairs binned, over every tile.
+    pub fn pair_count(&self) -> usize {
+        self.indices.len()
+    }
 }
 
 /// Tile rows one parallel binning task covers ([`bin`]).
