@@ -339,9 +339,12 @@ impl DepthTile {
         self.values[i] = v;
     }
 
-    /// Compute each HiZ tile's zmin/zmax over its pixels inside the image of tile `t` (Paper
-    /// II §4: built once after the scene pass; wedges and shadow volumes never write depth),
-    /// with both thresholds.
+    /// Compute each HiZ tile's zmin/zmax over its pixels inside the image of tile `t`, with
+    /// both thresholds and the coarse level, by a full reduction (Paper II §4's bounds: the
+    /// scene depth is final after the scene pass; wedges and shadow volumes never write
+    /// depth). The pipeline does not call it: the scene pass keeps the bounds as it writes and
+    /// [`DepthTile::finish_hiz`] completes them, unit-tested equal to this. It gives bounds to
+    /// depth values written directly (tests).
     pub fn build_hiz(&mut self, tiling: &Tiling, t: usize) {
         for k in 0..self.grid.count() {
             if !self.grid.rect(tiling, t, k).is_empty() {
