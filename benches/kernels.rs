@@ -49,7 +49,6 @@ mod common;
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use glam::{DVec2, DVec3};
 use penumbra::frame::{Frame, GpuSettings};
-use penumbra::geometry::adjacency;
 use penumbra::geometry::loops::silhouette_loops;
 use penumbra::geometry::silhouette::{light_facing, possible_silhouettes, SilhouetteEdge};
 use penumbra::geometry::ssv_wedge::{SsvWedge, WedgeLight};
@@ -64,6 +63,7 @@ use penumbra::light::coverage_texture::{
     coverage_texture, CoverageFilter, CoverageTexture, CoverageTextureKey, DEFAULT_N,
 };
 use penumbra::methods::pw2002;
+use penumbra::scene::adjacency;
 use penumbra::scene::{builtin, LightShape, Scene};
 
 /// The scene every kernel runs on.

@@ -25,9 +25,9 @@
 
 use penumbra::frame::{Frame, GpuSettings};
 use penumbra::methods::dbuffer;
-use penumbra::methods::output::Visibility;
 use penumbra::metrics::{compare, ClassTable, ShadowClass};
 use penumbra::scene::{builtin, LightShape, OptionValue, Scene};
+use penumbra::visibility::Visibility;
 
 /// The tolerance of the shadow classes: visibility 0 and 1 up to f32 rounding — each method's
 /// own classification (pw2002's LI is k/255, dbuffer's V is 0 or 1 exactly outside its

@@ -7,7 +7,6 @@
 //! primitive id = running triangle index over all meshes.
 
 use crate::error::InputError;
-use crate::geometry::adjacency::{self, Adjacency};
 use crate::gpu::buffers::{alloc_tiles, DepthTile};
 use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::{DepthFormat, DepthFunc, DepthState};
@@ -19,8 +18,9 @@ use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::shader_float::ShaderPrecision;
 use crate::gpu::tiling::Tiling;
 use crate::gpu::transform::{ClipVertex, Projection};
-use crate::methods::output::PassStats;
 use crate::options::{option_names, option_table, OptionTable, PowerOfTwo, Switch};
+use crate::pass::PassStats;
+use crate::scene::adjacency::{self, Adjacency};
 use crate::scene::{Mesh, Scene};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -543,14 +543,14 @@ impl<'s> Frame<'s> {
 /// point of the near-plane rectangle is inside or on a closed mesh, the near plane cuts it open and
 /// every shadow-volume count is wrong (z-fail only repairs near-plane points inside shadow
 /// *volumes*, not inside occluders), so the scene is rejected naming the mesh, the point and the
-/// near distance ([`crate::plan::near_plane_points`], the same ray-parity test as for lights,
+/// near distance ([`crate::geometry::near_plane::near_plane_points`], the same ray-parity test as for lights,
 /// [`crate::scene::validate::point_touches`]).
 ///
 /// The message reports the most telling contact: the eye before the near plane, and a point
 /// inside a mesh before a point on a surface (a near plane reaching into a mesh also has
 /// points on its surface, which come first in grid order).
 fn check_camera_outside_geometry(scene: &Scene, near: f64) -> Result<(), InputError> {
-    let points = crate::plan::near_plane_points(scene, near);
+    let points = crate::geometry::near_plane::near_plane_points(scene, near);
     let contacts = points.iter().enumerate().flat_map(|(k, p)| {
         scene
             .meshes

@@ -1,12 +1,22 @@
 //! penumbra — a deterministic, tile-based CPU rasterizer that reproduces the classic
 //! real-time soft-shadow algorithms with each paper's exact buffer arithmetic.
 //!
-//! The crate is layered; dependency arrows point down:
+//! The crate is layered; dependency arrows point down, floor by floor (a module uses only
+//! modules on floors below its own; the test in `src/module_graph.rs` fails on a cycle):
 //!
 //! ```text
-//! cli (main.rs) ─► report ─► render ─► methods ─► gpu, geometry, light ─► scene ─► limits
-//!       │             │         └────► output, metrics
-//!       └► progress   └────► experiment (results read back for the page)
+//! cli (main.rs)
+//!   report · probe · golden       the HTML page, one pixel explained, the bit-exact goldens
+//!   experiment                    sweeps: tile size, wedge blending, accuracy–time, precision
+//!   render · memory               one scene with its methods, in memory; the memory estimate
+//!   output                        the files of a run, all or nothing
+//!   methods                       one module per paper, the registry
+//!   frame · metrics               the scene depth pass; image error against the reference
+//!   geometry                      silhouettes, volumes, wedges, cones; the z-fail decision
+//!   light                         coverage of a light, samples, lookup tables
+//!   gpu · pass · options          the emulated pipeline; a pass's record; option tables
+//!   scene                         the scene, its meshes and their adjacency, validation
+//!   error · limits · visibility · drawing · progress
 //! ```
 //!
 //! # Example
@@ -15,7 +25,8 @@
 //!
 //! ```
 //! use penumbra::frame::{Frame, GpuSettings};
-//! use penumbra::methods::{self, output::Visibility};
+//! use penumbra::methods;
+//! use penumbra::visibility::Visibility;
 //! use penumbra::scene::builtin;
 //!
 //! // A square occluder above a floor under a rectangular light (`penumbra list` names them all).
@@ -45,6 +56,7 @@
 //! in the code) and `docs/papers.md` (the full reference of every paper cited as "Paper III
 //! §3.2.2" and so on).
 
+pub mod drawing;
 pub mod error;
 pub mod experiment;
 pub mod frame;
@@ -56,11 +68,14 @@ pub mod limits;
 pub mod memory;
 pub mod methods;
 pub mod metrics;
+#[cfg(test)]
+mod module_graph;
 pub mod options;
 pub mod output;
-pub mod plan;
+pub mod pass;
 pub mod probe;
 pub mod progress;
 pub mod render;
 pub mod report;
 pub mod scene;
+pub mod visibility;

@@ -9,6 +9,7 @@ use clap::{Parser, Subcommand};
 use penumbra::error::InputError;
 use penumbra::limits::MAX_THREADS;
 use penumbra::memory;
+use penumbra::methods::DefaultRun;
 use penumbra::progress::Progress;
 use penumbra::render::MethodRun;
 use penumbra::report::SceneRuns;
@@ -464,7 +465,7 @@ fn experiment(cmd: ExperimentCmd) -> Result<(), Box<dyn std::error::Error>> {
                     None => scene,
                 };
                 // The sweep keeps one method's output at a time.
-                for m in penumbra::methods::ALL {
+                for m in penumbra::methods::names() {
                     memory::check_fits(
                         &scene,
                         (&[m.to_string()], false),
@@ -576,8 +577,11 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
                 let scene = builtin::load(name).ok_or("missing built-in companion scene")?;
                 let methods = penumbra::methods::ALL
                     .iter()
-                    .filter(|m| **m != "nsample" && penumbra::methods::supports_scene(m, &scene))
-                    .map(|m| m.to_string())
+                    .filter(|m| {
+                        m.default_run == DefaultRun::EveryScene
+                            && penumbra::methods::supports_scene(m.name, &scene)
+                    })
+                    .map(|m| m.name.to_string())
                     .collect();
                 rendered.push(render(
                     &RenderArgs {
@@ -611,7 +615,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
                 println!("{n}");
             }
             println!("# methods");
-            for m in penumbra::methods::ALL {
+            for m in penumbra::methods::names() {
                 println!("{m}");
             }
             Ok(())

@@ -31,20 +31,17 @@ pub const PER_LIGHT_BYTES_PER_PIXEL: u64 = 16;
 /// their default size, the image's larger side squared.
 pub const DUMP_BYTES_PER_PIXEL: u64 = 48;
 
-/// A method's peak memory per pixel while it runs (module doc: measured, rounded up).
+/// A method's peak memory per pixel while it runs (module doc: measured, rounded up), as its
+/// registry entry gives it ([`crate::methods::Method::bytes_per_pixel`]); an unknown name
+/// (names are checked before) counts as the largest.
 pub fn method_bytes_per_pixel(method: &str) -> u64 {
-    match method {
-        "raycast" | "hard-sv" => 72,
-        "pw2002" => 88,
-        // Up to `nsample::MAX_CONCURRENT_SAMPLES` stencil passes at once, each with its own
-        // stencil and scratch: 92 bytes per pixel on one thread, 185 on eight (n = 16,
-        // `cube-of-spheres`, 512² and 1024²).
-        "nsample" => 208,
-        "pw-restructured" | "ssv-optimized" => 96,
-        "ssv" => 160,
-        // wedge-blending, sized for packing = f32 (two RGBA32F targets per vBuffer; 8bit
-        // needs about a third), and any other name (names are checked before) as the largest.
-        _ => 384,
+    match crate::methods::find(method) {
+        Some(m) => m.bytes_per_pixel,
+        None => crate::methods::ALL
+            .iter()
+            .map(|m| m.bytes_per_pixel)
+            .max()
+            .unwrap_or(0),
     }
 }
 

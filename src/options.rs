@@ -289,6 +289,12 @@ pub trait OptionTable: OptionSet {
         Ok(table)
     }
 
+    /// [`OptionTable::read`] without its result: whether the table reads (the check the
+    /// registry runs on every table a scene writes, `crate::methods::check_option_tables`).
+    fn check(scene: &Scene) -> Result<(), InputError> {
+        Self::read(scene).map(drop)
+    }
+
     /// Whether `scene` writes `key` (for a key that cannot act in some configuration, which is
     /// then an error rather than ignored).
     fn is_written(scene: &Scene, key: &str) -> bool {

@@ -91,7 +91,7 @@ pub fn probe_pixel(
     let i = (y * scene.width + x) as usize;
     let mut mask = vec![false; frame.pixel_count()];
     mask[i] = true;
-    let reference = methods::raycast_where(&frame, &mask, 0)?.channels(i);
+    let reference = methods::raycast::raycast_where(&frame, &mask, 0)?.channels(i);
     let probe = Arc::new(Probe::new(x, y));
     frame.probe = Some(probe.clone());
     let visibility = methods::run(method, &frame)?.visibility.channels(i);
@@ -127,7 +127,7 @@ pub fn probe_pixel(
         events: shown,
         visibility,
         reference,
-        reference_samples: methods::reference_samples(scene)?,
+        reference_samples: methods::raycast::reference_samples(scene)?,
         error,
     })
 }

@@ -5,12 +5,13 @@
 
 use crate::error::InputError;
 use crate::frame::{Frame, GpuOptions, GpuSettings, BACKGROUND};
-use crate::methods::{self, output::MethodOutput, output::Visibility};
+use crate::methods::{self, output::MethodOutput};
 use crate::metrics::error_report::{error_report, ErrorReport};
 use crate::metrics::ErrorStats;
 use crate::options::OptionTable;
 use crate::output::Comparison;
 use crate::scene::Scene;
+use crate::visibility::Visibility;
 use std::path::Path;
 
 /// Where `render`, `report` and the default run write by default.
@@ -135,7 +136,10 @@ pub fn render_scene_dumping(
             .filter(|_| m != methods::REFERENCE)
             .map(|r| error_report(&output.visibility, &r.output.visibility, methods::REFERENCE));
         let noise_floor = if m == methods::REFERENCE {
-            Some(methods::reference_noise_floor(&frame, &output.visibility)?)
+            Some(methods::raycast::reference_noise_floor(
+                &frame,
+                &output.visibility,
+            )?)
         } else {
             None
         };

@@ -10,11 +10,12 @@ use penumbra::gpu::pack4ub::FloatTarget;
 use penumbra::gpu::split_blend::SplitVTile;
 use penumbra::gpu::vbuffer::{VBuffer8Tile, VBufferTile};
 use penumbra::methods::dump::{BufferDump, DumpValues, ElementFormat, EventKind};
-use penumbra::methods::output::{MethodOutput, Visibility};
+use penumbra::methods::output::MethodOutput;
 use penumbra::methods::wedge_blending::vbuffer::{Packed8, VBufferStorage};
 use penumbra::methods::Falloff;
 use penumbra::render::{render_scene_dumping, MethodRun};
 use penumbra::scene::{file, OptionValue, Scene};
+use penumbra::visibility::Visibility;
 
 /// `name` (built-in or file) at `width` (aspect kept) with `methods` and `opts`
 /// (`METHOD.KEY=VALUE`).
@@ -102,8 +103,7 @@ fn u8s(d: &BufferDump) -> &[u8] {
 fn asking_for_dumps_changes_no_visibility_bit_and_no_counter() {
     for name in ["cube-of-spheres", "cube-of-spheres-sphere", "disk-block"] {
         let mut s = scene(name, 40, &[], &["nsample.n=16", "raycast.samples=64"]);
-        let methods: Vec<String> = penumbra::methods::ALL
-            .iter()
+        let methods: Vec<String> = penumbra::methods::names()
             .filter(|m| penumbra::methods::supports_scene(m, &s))
             .map(|m| m.to_string())
             .collect();

@@ -594,8 +594,8 @@ fn list_prints_scenes_and_methods_one_per_line() {
     for name in penumbra::scene::builtin::names() {
         assert!(lines.contains(name), "list lacks scene {name}: {stdout}");
     }
-    for m in penumbra::methods::ALL {
-        assert!(lines.contains(m), "list lacks method {m}: {stdout}");
+    for m in penumbra::methods::names() {
+        assert!(lines.contains(&m), "list lacks method {m}: {stdout}");
     }
 }
 

@@ -12,12 +12,12 @@
 
 use glam::{DVec3, Vec3};
 use penumbra::frame::{Frame, GpuSettings};
-use penumbra::geometry::adjacency;
 use penumbra::geometry::umbra_penumbra::{build_volumes, Disk, Extrusion, VolumeVertex};
 use penumbra::methods::dbuffer::{self, DBufferRender, DBufferSettings, Region};
-use penumbra::methods::output::Visibility;
 use penumbra::metrics::{ClassTable, ShadowClass};
+use penumbra::scene::adjacency;
 use penumbra::scene::{builtin, LightShape, Mesh, OptionValue, Scene};
+use penumbra::visibility::Visibility;
 
 mod sphere_hard_cases;
 use sphere_hard_cases::{gray, small};
@@ -308,7 +308,7 @@ fn volume_classes(
     let truth = |x: DVec3| {
         let blocked = samples
             .iter()
-            .filter(|p| penumbra::plan::segment_hits_mesh(mesh, x, **p))
+            .filter(|p| penumbra::geometry::near_plane::segment_hits_mesh(mesh, x, **p))
             .count();
         match blocked {
             0 => ShadowClass::Lit,
@@ -319,7 +319,7 @@ fn volume_classes(
     let c = disk.center;
     let volumes = |x: DVec3| {
         let d = (x - c).length();
-        if penumbra::plan::segment_hits_mesh(mesh, x, c) {
+        if penumbra::geometry::near_plane::segment_hits_mesh(mesh, x, c) {
             match farthest_crossing(c, x, &v.umbra) {
                 Some(g) if d >= g => ShadowClass::Penumbra,
                 _ => ShadowClass::Umbra,

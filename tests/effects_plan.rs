@@ -33,12 +33,11 @@ fn small(name: &str) -> Scene {
 fn run_all(scene: &Scene) -> Vec<(&'static str, MethodOutput)> {
     penumbra::scene::validate::validate(scene).unwrap_or_else(|e| panic!("{e}"));
     let frame = Frame::render(scene, penumbra::render::gpu_settings(scene).unwrap()).unwrap();
-    methods::ALL
-        .iter()
+    methods::names()
         .filter(|m| methods::supports_scene(m, scene))
         .map(|m| {
             let out = methods::run(m, &frame).unwrap_or_else(|e| panic!("{m}: {e}"));
-            (*m, out)
+            (m, out)
         })
         .collect()
 }
@@ -447,9 +446,7 @@ fn outside_cases() -> Vec<OutsideCase> {
     [(quad, ql, qh), (sph, sl, sh)]
         .into_iter()
         .map(|(scene, lo, hi)| OutsideCase {
-            methods: methods::ALL
-                .iter()
-                .copied()
+            methods: methods::names()
                 .filter(|m| methods::supports_scene(m, &scene))
                 .filter(|m| !["raycast", "penumbra-map"].contains(m))
                 .collect(),

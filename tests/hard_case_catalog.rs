@@ -29,8 +29,9 @@
 
 use penumbra::frame::Frame;
 use penumbra::methods;
-use penumbra::methods::output::{MethodOutput, Visibility};
+use penumbra::methods::output::MethodOutput;
 use penumbra::scene::{LightShape, Scene};
+use penumbra::visibility::Visibility;
 use std::path::{Path, PathBuf};
 
 /// A pixel differs from the reference when |method − raycast| exceeds this (module doc).
@@ -366,7 +367,7 @@ fn every_hard_scene_renders_with_every_method_within_its_bound() {
         scene.height = 64;
         let straddle = straddles(&scene);
         let mut outputs: Vec<(String, MethodOutput)> = Vec::new();
-        for &m in methods::ALL {
+        for m in methods::names() {
             if !methods::supports_scene(m, &scene) {
                 continue;
             }
@@ -450,4 +451,57 @@ fn every_hard_scene_renders_with_every_method_within_its_bound() {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Methods the hard-case catalog has no entry for yet, each with the reason: the list may only
+/// shrink (the test below fails when a listed method gains an entry).
+const NOT_IN_CATALOG: &[(&str, &str)] = &[(
+    "dbuffer",
+    "no hard-case scene has a disk light, the only light dbuffer renders",
+)];
+
+/// Every method of the registry (`methods::ALL`, "How to add a method" in
+/// docs/architecture.md) is wired into everything that pins or measures methods: a golden
+/// case, a hard-case catalog entry (or a reason in [`NOT_IN_CATALOG`]), a criterion benchmark
+/// in `benches/pipeline.rs`, and an accuracy–time configuration.
+#[test]
+fn every_method_has_goldens_catalog_entries_a_benchmark_and_sweep_configurations() {
+    let golden = penumbra::golden::cases::cases();
+    let benches =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/pipeline.rs"))
+            .expect("benches/pipeline.rs");
+    let bench_table = benches
+        .split("const METHOD_BENCHES")
+        .nth(1)
+        .and_then(|t| t.split("];").next())
+        .expect("benches/pipeline.rs declares METHOD_BENCHES");
+    let mut missing = Vec::new();
+    for m in methods::names() {
+        if !golden.iter().any(|c| c.method == m) {
+            missing.push(format!("{m}: no golden case (src/golden/cases.rs)"));
+        }
+        let listed = NOT_IN_CATALOG.iter().any(|(n, _)| *n == m);
+        let in_catalog = TABLE.iter().any(|(_, method, _)| *method == m);
+        match (in_catalog, listed) {
+            (false, false) => missing.push(format!("{m}: no hard-case catalog entry (TABLE)")),
+            (true, true) => missing.push(format!(
+                "{m}: in the catalog now, remove it from NOT_IN_CATALOG"
+            )),
+            _ => {}
+        }
+        if !bench_table.contains(&format!("\"{m}\"")) {
+            missing.push(format!(
+                "{m}: no benchmark in METHOD_BENCHES (benches/pipeline.rs)"
+            ));
+        }
+        if !penumbra::experiment::accuracy_time::CONFIGURATIONS
+            .iter()
+            .any(|(method, _)| *method == m)
+        {
+            missing.push(format!(
+                "{m}: no accuracy-time configuration (CONFIGURATIONS)"
+            ));
+        }
+    }
+    assert!(missing.is_empty(), "{}", missing.join("\n"));
 }

@@ -4,11 +4,11 @@
 //! gives the same bits.
 
 use penumbra::frame::{Frame, GpuSettings, BACKGROUND};
+use penumbra::geometry::near_plane::eye_in_shadow;
 use penumbra::methods::hard_sv::{
     stencil_row_major, stencil_shadow, ShadowTest, StencilOverflow, StencilShadowSettings,
     Submission,
 };
-use penumbra::plan::eye_in_shadow;
 use penumbra::scene::{builtin, Scene};
 
 fn scene(name: &str, size: u32) -> Scene {
@@ -49,7 +49,11 @@ fn in_hard_shadow(frame: &Frame) -> Vec<Option<bool>> {
                 if r.normal.dot(light - r.point) <= 0.0 {
                     return true; // faces away from the light: inside its own object's volume
                 }
-                penumbra::plan::segment_blocked(frame.scene, p.as_dvec3(), light.as_dvec3())
+                penumbra::geometry::near_plane::segment_blocked(
+                    frame.scene,
+                    p.as_dvec3(),
+                    light.as_dvec3(),
+                )
             })
         })
         .collect()

@@ -5,9 +5,10 @@
 //! fragment that would have changed a buffer), and rejections where the passes use it.
 
 use penumbra::gpu::counters::Counters;
-use penumbra::methods::{self, output::Visibility};
+use penumbra::methods;
 use penumbra::render::{render_scene, MethodRun};
 use penumbra::scene::builtin;
+use penumbra::visibility::Visibility;
 
 /// Every method `scene` (built-in, at 48²) supports, rendered with `hiz = on|off`.
 fn runs(scene: &str, hiz: &str) -> Vec<MethodRun> {
@@ -20,8 +21,7 @@ fn runs_with(scene: &str, size: u32, opts: &[String]) -> Vec<MethodRun> {
     let mut s = builtin::load(scene).unwrap();
     s.resize(Some(size), Some(size));
     s.methods = Some(
-        methods::ALL
-            .iter()
+        methods::names()
             .filter(|m| methods::supports_scene(m, &s))
             .map(|m| m.to_string())
             .collect(),

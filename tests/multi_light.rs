@@ -5,12 +5,12 @@
 use penumbra::frame::{Frame, GpuSettings};
 use penumbra::geometry::penumbra_wedge::li_amount;
 use penumbra::methods::light_average;
-use penumbra::methods::output::Visibility;
 use penumbra::methods::pw2002::{self, SidePlanes};
 use penumbra::methods::pw_restructured::{self, Culling, Passes, RestructuredSettings, WedgeTest};
 use penumbra::render::{render_scene, MethodRun};
 use penumbra::scene::OptionValue;
 use penumbra::scene::{builtin, Scene};
+use penumbra::visibility::Visibility;
 
 /// `two-lights` at `size`², with the near plane pinned to the two-light frame's default so
 /// that single-light copies of the scene get the same projection.

@@ -249,7 +249,7 @@ fn render(scene: &str, size: u32, opts: &[(&str, &str)]) -> (Vec<f32>, u64) {
     let runs = penumbra::render::render_scene(&s).unwrap();
     let out = &runs[0].output;
     match &out.visibility {
-        penumbra::methods::output::Visibility::Gray(v) => (v.clone(), out.stats.clamped_pixels),
+        penumbra::visibility::Visibility::Gray(v) => (v.clone(), out.stats.clamped_pixels),
         v => panic!("expected gray visibility, got {} values", v.len()),
     }
 }
@@ -357,9 +357,7 @@ fn visibility_and_shaded(scene: &str, size: u32, method: &str, wedge: &str) -> (
     let runs = penumbra::render::render_scene(&s).unwrap();
     let out = &runs[0].output;
     match &out.visibility {
-        penumbra::methods::output::Visibility::Gray(v) => {
-            (v.clone(), out.stats.totals.fragments_shaded)
-        }
+        penumbra::visibility::Visibility::Gray(v) => (v.clone(), out.stats.totals.fragments_shaded),
         _ => unreachable!(),
     }
 }

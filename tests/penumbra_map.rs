@@ -219,7 +219,8 @@ fn aliasing_falls_as_the_map_grows() {
                 continue;
             }
             let p = rcv.point.as_dvec3() + glam::DVec3::Y * 1e-4;
-            let blocked = penumbra::plan::segment_blocked(&scene, p, light.as_dvec3());
+            let blocked =
+                penumbra::geometry::near_plane::segment_blocked(&scene, p, light.as_dvec3());
             let lit = view.lit(&shadow_map, view.window(rcv.point).unwrap());
             count += (blocked == lit) as usize;
         }
@@ -339,7 +340,7 @@ fn the_slope_scaled_bias_removes_shadow_acne() {
         let mut black = 0;
         for i in floor_pixels(&r) {
             let p = r.receivers[i].unwrap().point.as_dvec3() + glam::DVec3::Y * 1e-4;
-            if !penumbra::plan::segment_blocked(&scene, p, light) {
+            if !penumbra::geometry::near_plane::segment_blocked(&scene, p, light) {
                 lit += 1;
                 black += (vis[i] == 0.0) as usize;
             }

@@ -45,7 +45,7 @@ fn nsample_1024_agrees_with_raycast_on_single_quad() {
     );
     // The test is not vacuous: there is a penumbra (values strictly between 0 and 1).
     let vis = match &ns.output.visibility {
-        penumbra::methods::output::Visibility::Gray(v) => v.clone(),
+        penumbra::visibility::Visibility::Gray(v) => v.clone(),
         _ => unreachable!(),
     };
     assert!(vis.iter().filter(|v| **v > 0.05 && **v < 0.95).count() > 50);
@@ -256,7 +256,7 @@ fn the_reference_noise_floor_is_the_full_second_run() {
     let first = penumbra::methods::run("raycast", &frame)
         .unwrap()
         .visibility;
-    let floor = penumbra::methods::reference_noise_floor(&frame, &first).unwrap();
+    let floor = penumbra::methods::raycast::reference_noise_floor(&frame, &first).unwrap();
     let mut seed1 = s.clone();
     seed1
         .options

@@ -10,9 +10,9 @@ use glam::DVec3;
 use penumbra::geometry::penumbra_wedge::{li_amount, shader_li_amount, Plane};
 use penumbra::gpu::shader_float::{FloatFormat, Fp16, Fp24, Fp32, ShaderFloat, FP16, FP24, FP32};
 use penumbra::gpu::shader_vec::SVec3;
-use penumbra::methods::output::Visibility;
 use penumbra::render::render_scene;
 use penumbra::scene::builtin;
+use penumbra::visibility::Visibility;
 
 /// The visibility of `method` on the built-in `scene` at `size`² with `opts` (`--opt` form).
 fn visibility(scene: &str, method: &str, size: u32, opts: &[&str]) -> Vec<f32> {

@@ -8,8 +8,8 @@
 
 use penumbra::frame::{Frame, GpuSettings};
 use penumbra::gpu::shader_float::ShaderPrecision;
-use penumbra::methods::output::Visibility;
 use penumbra::scene::{builtin, Scene};
+use penumbra::visibility::Visibility;
 
 /// The built-in scene `name` at `size`×`size`.
 fn small(name: &str, size: u32) -> Scene {

@@ -27,11 +27,11 @@ use penumbra::light::coverage_texture::{
     coverage_texture, lookup_error_bound, CoverageFilter, CoverageTextureKey,
 };
 use penumbra::methods::hard_sv::ShadowTest;
-use penumbra::methods::output::Visibility;
 use penumbra::methods::ssv::{read_settings, render, CoverageMode, SsvSettings};
 use penumbra::render::render_scene;
 use penumbra::scene::procedural::two_sided_quad;
 use penumbra::scene::{builtin, OptionValue, Scene};
+use penumbra::visibility::Visibility;
 use proptest::prelude::*;
 use std::sync::Arc;
 

@@ -5,11 +5,11 @@
 
 use glam::{DVec3, Vec3};
 use penumbra::frame::{Frame, GpuSettings};
-use penumbra::methods::output::Visibility;
 use penumbra::methods::wedge_blending::{options, render, BlendingRender};
 use penumbra::metrics::compare_where;
 use penumbra::scene::procedural::{box_mesh, two_sided_quad};
 use penumbra::scene::{builtin, Camera, Light, LightShape, OptionValue, Scene};
+use penumbra::visibility::Visibility;
 
 /// `scene` with `[options.wedge-blending]` set to `opts`.
 fn with_options(mut scene: Scene, opts: &[(&str, &str)]) -> Scene {

@@ -8,7 +8,7 @@ use std::time::Duration;
 /// minutes on a shared two-core machine. The HTML report
 /// (`target/criterion/report/index.html`) is drawn by plotters with the crate's embedded font.
 pub fn config() -> Criterion {
-    penumbra::experiment::plotting::register_font().expect("the embedded font");
+    penumbra::drawing::register_font().expect("the embedded font");
     Criterion::default()
         .sample_size(10)
         .warm_up_time(Duration::from_millis(500))

@@ -9,7 +9,6 @@
 //! bug the fuzzer found, not bad input).
 
 use glam::{DVec2, DVec3, Vec3};
-use penumbra::geometry::adjacency;
 use penumbra::geometry::loops::{silhouette_loops, vertex_degrees};
 use penumbra::geometry::penumbra_wedge::{
     build_wedges, cap_triangles, far_distance, li_amount, light_intensity, screen_wedge,
@@ -38,6 +37,7 @@ use penumbra::light::coverage_texture::{
 use penumbra::light::lookup_tables::TableFilter;
 use penumbra::light::radial_parts::{edge_in_parts, NEAR_FRACTION, PART_COUNT};
 use penumbra::methods::ssv_optimized::{CoverageMode, LightModel};
+use penumbra::scene::adjacency;
 use penumbra::scene::file::{parse_scene_str, Format};
 use penumbra::scene::obj::parse_obj;
 use penumbra::scene::validate::{light_shape_touches, validate, validate_light};

@@ -45,11 +45,12 @@ pub mod plot;
 use super::configured;
 use crate::error::InputError;
 use crate::frame::Frame;
-use crate::methods::{self, output::Visibility};
+use crate::methods;
 use crate::metrics::error_report::error_report;
 use crate::metrics::ErrorStats;
 use crate::render::gpu_settings;
 use crate::scene::Scene;
+use crate::visibility::Visibility;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -529,7 +530,7 @@ pub fn run(
         references.push(Reference {
             scene: scene.source.clone(),
             seconds,
-            noise_floor: methods::reference_noise_floor(&frame, &vis)?,
+            noise_floor: methods::raycast::reference_noise_floor(&frame, &vis)?,
         });
         reference_vis[si] = Some(vis);
     }

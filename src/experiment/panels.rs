@@ -61,7 +61,7 @@ pub fn labelled_grid_png(
             }
         }
     }
-    super::plotting::register_font()?;
+    crate::drawing::register_font()?;
     {
         let root = BitMapBackend::with_buffer(&mut rgb, total).into_drawing_area();
         let title = TextStyle::from(("sans-serif", 17)).color(&BLACK);

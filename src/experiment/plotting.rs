@@ -1,26 +1,9 @@
-//! What every experiment plot shares: the embedded font and drawing one chart into both a PNG
-//! and an SVG ([`png_and_svg`]), with `plotters`. Text uses DejaVu Sans, embedded (its
-//! licence is in `src/experiment/font/LICENSE`), so no system font library is needed.
+//! What every experiment plot shares: the palette and drawing one chart into both a PNG and an
+//! SVG ([`png_and_svg`]), with `plotters`, in the embedded font ([`crate::drawing`]).
 
+use crate::drawing::register_font;
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use std::sync::OnceLock;
-
-/// The embedded font (DejaVu Sans 2.37).
-const FONT: &[u8] = include_bytes!("font/DejaVuSans.ttf");
-
-/// Registers the embedded font (DejaVu Sans) as plotters' `sans-serif` once per process. Every plot of this crate
-/// calls it (also the legends of buffer dumps, [`crate::output::dump`]); a program that draws
-/// with plotters through another crate (the benchmarks' criterion HTML reports) calls it
-/// first, since no system font is looked up.
-pub fn register_font() -> Result<(), String> {
-    static DONE: OnceLock<Result<(), String>> = OnceLock::new();
-    DONE.get_or_init(|| {
-        plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
-            .map_err(|_| "the embedded font cannot be read".to_string())
-    })
-    .clone()
-}
 
 /// The colours of every plot's series, in order (Tableau 10).
 pub const PALETTE: [RGBColor; 10] = [

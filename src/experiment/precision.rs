@@ -44,12 +44,13 @@ use crate::frame::{Frame, GpuSettings};
 use crate::gpu::depth::DepthFormat;
 use crate::gpu::shader_float::{ShaderPrecision, FP16, FP24, FP32};
 use crate::methods::dump::BufferDump;
-use crate::methods::output::{MethodOutput, Visibility};
+use crate::methods::output::MethodOutput;
 use crate::metrics::error_report::{in_penumbra, signed_error_map};
 use crate::metrics::{compare, compare_where, ErrorStats};
 use crate::options::OptionType;
 use crate::scene::builtin::overlap_stack;
 use crate::scene::{LightShape, Scene};
+use crate::visibility::Visibility;
 use glam::Vec3;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -73,18 +74,12 @@ pub const NO_SHADER_ARITHMETIC: [&str; 3] = ["raycast", "nsample", "hard-sv"];
 
 /// The soft methods, whose fragment programs the shader precision rounds.
 pub fn shader_methods() -> impl Iterator<Item = &'static str> {
-    crate::methods::ALL
-        .iter()
-        .copied()
-        .filter(|m| !NO_SHADER_ARITHMETIC.contains(m))
+    crate::methods::names().filter(|m| !NO_SHADER_ARITHMETIC.contains(m))
 }
 
 /// The rasterized methods whose depth formats are compared (every method but the ray tracer).
 pub fn depth_methods() -> impl Iterator<Item = &'static str> {
-    crate::methods::ALL
-        .iter()
-        .copied()
-        .filter(|m| *m != crate::methods::REFERENCE)
+    crate::methods::names().filter(|m| *m != crate::methods::REFERENCE)
 }
 
 /// The narrow shader precisions, each measured against f64.

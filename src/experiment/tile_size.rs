@@ -11,13 +11,13 @@
 use crate::error::InputError;
 use crate::experiment::plotting::{png_and_svg, Plot, PALETTE};
 use crate::frame::{Frame, GpuSettings};
+use crate::geometry::near_plane::{eye_in_shadow, representative_light_points};
 use crate::limits::DEFAULT_HIZ_TILE_SIZE;
 use crate::methods::pw2002::frame_wedges;
 use crate::methods::pw_restructured::{
     render_li, Culling, Passes, PwRestructuredOptions, RestructuredSettings, WedgeTest,
 };
 use crate::options::OptionTable;
-use crate::plan::{eye_in_shadow, representative_light_points};
 use crate::scene::Scene;
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -32,14 +32,14 @@
 use super::{configured, sized};
 use crate::error::InputError;
 use crate::frame::{Frame, GpuSettings};
+use crate::geometry::near_plane::segment_hits_mesh;
 use crate::gpu::probe;
 use crate::light::coverage::RectLight;
 use crate::light::radial_parts::{PART_COUNT, PART_SIGNS};
-use crate::methods::output::Visibility;
 use crate::methods::wedge_blending::{self, blend_steps, BlendStep};
 use crate::metrics::{compare_where, ErrorStats};
-use crate::plan::segment_hits_mesh;
 use crate::scene::{builtin, Scene};
+use crate::visibility::Visibility;
 use glam::DVec3;
 use std::fmt::Write as _;
 use std::path::Path;

@@ -46,9 +46,9 @@
 //! cone of the edge's start vertex (the first time the vertex is met in its mesh), then the
 //! edge's sheet.
 
-use super::adjacency::Adjacency;
 use super::loops::{silhouette_loops, vertex_degrees};
 use super::silhouette::{light_facing, possible_silhouettes, SilhouetteEdge};
+use crate::scene::adjacency::Adjacency;
 use crate::scene::Mesh;
 use glam::{DVec3, Vec3};
 use std::collections::BTreeSet;
@@ -255,7 +255,7 @@ fn push_sheet(g: &mut PenumbraGeometry, light: &ConeLight, a: DVec3, b: DVec3) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::adjacency;
+    use crate::scene::adjacency;
     use crate::scene::procedural::box_mesh;
 
     fn light() -> ConeLight {

@@ -65,12 +65,12 @@
 //! rounded. The functions without `shader_` are their f64 instances; the construction above is
 //! CPU work (Paper I §4.1) and stays f64.
 
-use super::adjacency::Adjacency;
 use super::loops::silhouette_loops;
 use super::silhouette::{light_facing, possible_silhouettes};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::shader_vec::SVec3;
 use crate::gpu::transform::{ClipVertex, Projection};
+use crate::scene::adjacency::Adjacency;
 use crate::scene::{Mesh, Scene};
 use glam::{DMat3, DVec3, DVec4};
 

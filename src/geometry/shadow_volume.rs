@@ -11,11 +11,11 @@
 //! scene order; per mesh the front cap (triangle order), then the quads (adjacency edge order,
 //! two triangles each: `(b, a, a∞)`, `(b, a∞, b∞)`), then the back cap (triangle order).
 
-use super::adjacency::Adjacency;
 use super::silhouette::{away_from_light, light_facing, possible_silhouettes};
 use crate::gpu::probe::{PrimitiveKind, ProbeEvent};
 use crate::gpu::setup::RasterTriangle;
 use crate::gpu::transform::{ClipVertex, Projection};
+use crate::scene::adjacency::Adjacency;
 use crate::scene::Mesh;
 use glam::Vec3;
 

@@ -6,7 +6,7 @@
 //! each triangle's facing is computed once and shared by its three edges, the silhouette is
 //! always consistent: every silhouette vertex has even degree (Paper V).
 
-use super::adjacency::Adjacency;
+use crate::scene::adjacency::Adjacency;
 use crate::scene::Mesh;
 use glam::{DVec3, Vec3};
 

@@ -134,10 +134,10 @@
 //! corner vertex), the middle of the edge for the meeting point P of a quad's two sides —
 //! which is what eq. 2's "dist(c, e)" and "dir(c, e)" are evaluated at in the vertex program.
 
-use super::adjacency::Adjacency;
 use super::loops::silhouette_loops;
 use super::silhouette::SilhouetteEdge;
 use crate::light::sampling::orthonormal_basis;
+use crate::scene::adjacency::Adjacency;
 use crate::scene::Mesh;
 use glam::{DVec2, DVec3, Vec3};
 use serde::Serialize;
@@ -712,7 +712,7 @@ pub fn build_volumes(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::adjacency;
+    use crate::scene::adjacency;
     use crate::scene::procedural::box_mesh;
 
     fn disk(r: f32) -> Disk {

@@ -621,8 +621,8 @@ mod tests {
     #[test]
     fn every_method_has_a_golden() {
         let all = cases();
-        for m in crate::methods::ALL {
-            assert!(all.iter().any(|c| c.method == *m), "{m} has no golden case");
+        for m in crate::methods::names() {
+            assert!(all.iter().any(|c| c.method == m), "{m} has no golden case");
         }
     }
 }

@@ -33,13 +33,14 @@
 //!   silently: there is no tolerance.
 
 use crate::methods::dump::{BufferDump, DumpValues};
-use crate::methods::output::{MethodOutput, Visibility};
+use crate::methods::output::MethodOutput;
 use crate::metrics::{diff_mask, diff_mask_u8};
 use crate::output::dump::raw_file_name;
 use crate::output::{
     decode_gray8_png, encode_gray8_png, encode_pfm, encode_side_by_side_png, read_pfm,
     visibility_to_srgb8, write_files_all_or_nothing,
 };
+use crate::visibility::Visibility;
 use std::path::{Path, PathBuf};
 
 pub mod cases;

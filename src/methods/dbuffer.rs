@@ -135,7 +135,7 @@
 
 use super::dump::{color_values, row_major, BufferDump, DumpValues, ElementFormat};
 use super::dump::{EventKind, EventMap};
-use super::output::{MethodOutput, PassStats, Visibility};
+use super::output::MethodOutput;
 use super::penumbra_map::ShadowMapKeys;
 use crate::error::InputError;
 use crate::frame::Frame;
@@ -153,9 +153,11 @@ use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::shader_vec::SVec3;
 use crate::gpu::texture::Filter;
 use crate::gpu::transform::ClipVertex;
+use crate::methods::output::BufferPlan;
 use crate::options::{option_names, option_table, OptionTable};
-use crate::plan::BufferPlan;
+use crate::pass::PassStats;
 use crate::scene::LightShape;
+use crate::visibility::Visibility;
 use glam::DVec3;
 use serde::Serialize;
 use std::time::Instant;
@@ -966,6 +968,21 @@ fn screen_pass<T: ShaderFloat>(
     let (values, shades) = pixels.into_iter().unzip();
     (Visibility::Gray(values), shades, stats, counters)
 }
+
+/// `dbuffer` in the registry ([`crate::methods::ALL`]).
+pub const METHOD: crate::methods::Method = crate::methods::Method {
+    name: "dbuffer",
+    paper: "CGI 2004: umbra and penumbra volumes, D-buffer",
+    // CGI 2004 §2: "the light source is approximated by a circular disk".
+    supports: |s| matches!(s, LightShape::Disk { .. }),
+    lights: crate::methods::SeveralLights::PerLight,
+    options: crate::methods::OptionTableSpec::of::<DBufferOptions>(),
+    // Not measured: the largest method's figure (wedge-blending's).
+    bytes_per_pixel: 384,
+    default_run: crate::methods::DefaultRun::EveryScene,
+    check: |frame| read_settings(frame).map(drop),
+    run,
+};
 
 /// Run `dbuffer` on a rendered frame (one light: [`super::run`] averages several).
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {

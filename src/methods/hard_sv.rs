@@ -19,7 +19,7 @@
 //! its wraps or clamps per pixel under `--dump-buffers`.
 
 use super::dump::{row_major, BufferDump, DumpValues, ElementFormat, EventKind, EventMap};
-use super::output::{MethodOutput, PassStats, Visibility};
+use super::output::MethodOutput;
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, BACKGROUND};
 use crate::geometry::shadow_volume::{
@@ -32,10 +32,37 @@ use crate::gpu::probe::Raw;
 use crate::gpu::raster::{bin, draw_probed};
 use crate::gpu::setup::CullMode;
 use crate::gpu::stencil::{StencilFace, StencilOp, StencilState};
+use crate::methods::output::{BufferPlan, MethodPlan};
 use crate::options::{option_names, option_table, OptionTable, OptionType};
-use crate::plan::{BufferPlan, CountMode, MethodPlan};
+use crate::pass::PassStats;
+use crate::visibility::Visibility;
 use glam::Vec3;
 use std::time::Instant;
+
+option_names! {
+    /// The `mode` option of the methods that count shadow-volume boundaries: z-pass, z-fail, or
+    /// `auto`, decided from the frame ([`CountMode::zfail`]).
+    pub enum CountMode {
+        /// z-fail when the near plane is in shadow ([`crate::geometry::near_plane::eye_in_shadow`]), else z-pass.
+        Auto = "auto",
+        /// Count between the eye and the receiver.
+        ZPass = "zpass",
+        /// Count between the receiver and infinity (caps needed).
+        ZFail = "zfail",
+    }
+}
+
+impl CountMode {
+    /// Whether to count z-fail: as asked, or with `Auto` when the near plane at distance `near`
+    /// is in the shadow of one of `lights` ([`crate::geometry::near_plane::eye_in_shadow`]).
+    pub fn zfail(self, scene: &crate::scene::Scene, near: f64, lights: &[Vec3]) -> bool {
+        match self {
+            CountMode::ZPass => false,
+            CountMode::ZFail => true,
+            CountMode::Auto => crate::geometry::near_plane::eye_in_shadow(scene, near, lights),
+        }
+    }
+}
 
 /// Counting direction of the stencil passes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -273,6 +300,20 @@ pub fn stencil_dump(
         dump
     }
 }
+
+/// `hard-sv` in the registry ([`crate::methods::ALL`]).
+pub const METHOD: crate::methods::Method = crate::methods::Method {
+    name: "hard-sv",
+    paper: "Paper I §3, II §5: hard shadow volumes",
+    // The light center of any shape.
+    supports: |_| true,
+    lights: crate::methods::SeveralLights::PerLight,
+    options: crate::methods::OptionTableSpec::of::<HardSvOptions>(),
+    bytes_per_pixel: 72,
+    default_run: crate::methods::DefaultRun::EveryScene,
+    check: |frame| HardSvOptions::read(frame.scene).map(drop),
+    run,
+};
 
 /// Run `hard-sv` on a rendered frame.
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {

@@ -10,11 +10,12 @@
 //! light k is named `light<k>/<pass>`; buffer dumps are named `<name>-light<k>`; the plan lists
 //! the per-light plans (their buffers are allocated once per light, in turn).
 
-use super::output::{MethodOutput, Visibility};
+use super::output::MethodOutput;
 use crate::error::InputError;
 use crate::frame::Frame;
-use crate::plan::MethodPlan;
+use crate::methods::output::MethodPlan;
 use crate::scene::Scene;
+use crate::visibility::Visibility;
 use std::time::Instant;
 
 /// Run `method` (through `run_one`, the single-light dispatch) once per light of `frame`'s

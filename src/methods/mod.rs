@@ -39,51 +39,134 @@ use crate::gpu::probe::{PassProbe, Tap};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::texture::Filter;
 use crate::gpu::tiling::Tiling;
-use crate::options::{option_names, option_table, KeyDoc, OptionTable, OptionType};
-use crate::plan::{BufferPlan, MethodPlan};
+use crate::methods::output::{BufferPlan, MethodPlan};
+use crate::options::{option_names, KeyDoc, OptionTable};
+use crate::pass::PassStats;
 use crate::scene::{LightShape, Scene};
-use output::{MethodOutput, MethodStats, PassStats, Visibility};
+use output::{MethodOutput, MethodStats};
 use std::time::Instant;
 
-/// Every method penumbra implements, in the order the default run shows them.
-pub const ALL: &[&str] = &[
-    "raycast",
-    "nsample",
-    "hard-sv",
-    "pw2002",
-    "pw-restructured",
-    "ssv-optimized",
-    "ssv",
-    "wedge-blending",
-    "penumbra-map",
-    "dbuffer",
-];
+/// One method as the rest of the crate knows it (`docs/architecture.md` "How to add a
+/// method"): each method's module declares one (`METHOD`) and [`ALL`] lists them, so that the
+/// CLI, the memory estimate, the option listing, the goldens, the experiments and the report
+/// ask the list instead of matching on names.
+#[derive(Clone, Copy)]
+pub struct Method {
+    /// The name scene files, `--methods`, `--opt METHOD.KEY` and the output folders use.
+    pub name: &'static str,
+    /// The paper it reproduces, in a few words (`docs/papers.md`; Papers I–V are those of
+    /// Assarsson's thesis), for captions.
+    pub paper: &'static str,
+    /// Whether it can render a light of this shape.
+    pub supports: fn(&LightShape) -> bool,
+    /// How it renders a scene with several lights.
+    pub lights: SeveralLights,
+    /// Its option table `[options.NAME]`.
+    pub options: OptionTableSpec,
+    /// Its peak memory per pixel while it runs, in bytes ([`crate::memory`]: measured, then
+    /// rounded up by at least 10 %).
+    pub bytes_per_pixel: u64,
+    /// Which of the default run's scenes it renders.
+    pub default_run: DefaultRun,
+    /// Check its options against a rendered frame without running it (what needs the frame:
+    /// a sample count the light's shape cannot take, an option that cannot act with the
+    /// others, …): for one light, or for every light with [`SeveralLights::OnePass`].
+    pub check: fn(&Frame) -> Result<(), InputError>,
+    /// Run it on a rendered frame: of one light, or of every light with
+    /// [`SeveralLights::OnePass`].
+    pub run: fn(&Frame) -> Result<MethodOutput, InputError>,
+}
 
-/// The reference every other method's error is measured against.
-pub const REFERENCE: &str = "raycast";
-
-/// The paper `method` reproduces, in a few words (`../shared/papers/README.md`; Papers I–V
-/// are those of Assarsson's thesis), for captions; an empty string for an unknown name.
-pub fn paper(method: &str) -> &'static str {
-    match method {
-        "raycast" => "reference: shadow rays per pixel",
-        "nsample" => "Paper III §5.1: N hard shadows",
-        "hard-sv" => "Paper I §3, II §5: hard shadow volumes",
-        "pw2002" => "Paper I: penumbra wedges, EGWR 2002",
-        "pw-restructured" => "Paper II: restructured penumbra wedges",
-        "ssv-optimized" => "Paper IV: optimized soft shadow volumes, GH 2003",
-        "ssv" => "Paper III: soft shadow volumes, SIGGRAPH 2003",
-        "wedge-blending" => "Forest et al., GH 2006: penumbra-wedges blending",
-        "penumbra-map" => "Wyman & Hansen, EGSR 2003: penumbra maps",
-        "dbuffer" => "CGI 2004: umbra and penumbra volumes, D-buffer",
-        _ => "",
+impl std::fmt::Debug for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name)
     }
 }
 
-/// Methods that render every light of a scene in one pass structure: Paper I §7 scales the
-/// LI amounts by 255/n into one LI buffer (also used by Paper II's restructured algorithm).
-/// Every other method runs once per light ([`light_average`]).
-pub const RENDERS_SEVERAL_LIGHTS: &[&str] = &["pw2002", "pw-restructured"];
+impl PartialEq for Method {
+    fn eq(&self, other: &Self) -> bool {
+        self.name == other.name
+    }
+}
+
+/// How a method renders a scene with several lights.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SeveralLights {
+    /// Every light in one pass structure: Paper I §7 scales the LI amounts by 255/n into one
+    /// LI buffer (also used by Paper II's restructured algorithm).
+    OnePass,
+    /// Once per light on the same frame, the visibilities averaged in light order
+    /// ([`light_average`]).
+    PerLight,
+}
+
+/// Which of the default run's scenes (`cargo run --release` with no arguments) a method
+/// renders.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DefaultRun {
+    /// Every scene whose lights it supports.
+    EveryScene,
+    /// Only the first, `cube-of-spheres` (`nsample`, the slowest: its companions are
+    /// rendered without it).
+    FirstSceneOnly,
+}
+
+/// What the registry knows of an option table: its name, its keys documented, and its check
+/// (the table read from a scene, [`OptionTable::read`]).
+#[derive(Clone, Copy)]
+pub struct OptionTableSpec {
+    /// The table's name: a method, or `gpu`.
+    pub name: &'static str,
+    /// Its keys, documented ([`OptionTable::keys`]).
+    pub keys: fn() -> Vec<KeyDoc>,
+    /// Reads the table from a scene and drops it: the first bad key or value is an error.
+    pub check: fn(&Scene) -> Result<(), InputError>,
+}
+
+impl OptionTableSpec {
+    /// The entry of table `O`.
+    pub const fn of<O: OptionTable>() -> Self {
+        Self {
+            name: O::NAME,
+            keys: O::keys,
+            check: O::check,
+        }
+    }
+}
+
+/// Every method penumbra implements, in the order the default run shows them: the one list
+/// (adding a method = its module and one line here).
+pub const ALL: &[Method] = &[
+    raycast::METHOD,
+    nsample::METHOD,
+    hard_sv::METHOD,
+    pw2002::METHOD,
+    pw_restructured::METHOD,
+    ssv_optimized::METHOD,
+    ssv::METHOD,
+    wedge_blending::METHOD,
+    penumbra_map::METHOD,
+    dbuffer::METHOD,
+];
+
+/// The reference every other method's error is measured against.
+pub const REFERENCE: &str = raycast::METHOD.name;
+
+/// The names of [`ALL`], in its order.
+pub fn names() -> impl Iterator<Item = &'static str> {
+    ALL.iter().map(|m| m.name)
+}
+
+/// The method called `name`, if there is one.
+pub fn find(name: &str) -> Option<&'static Method> {
+    ALL.iter().find(|m| m.name == name)
+}
+
+/// The paper `method` reproduces, in a few words ([`Method::paper`]), for captions; an empty
+/// string for an unknown name.
+pub fn paper(method: &str) -> &'static str {
+    find(method).map_or("", |m| m.paper)
+}
 
 /// Whether `method` can render every light of `scene`.
 pub fn supports_scene(method: &str, scene: &Scene) -> bool {
@@ -104,40 +187,17 @@ fn unsupported_light(method: &str, scene: &Scene) -> Option<String> {
         })
 }
 
-/// Whether `method` can render a light of this shape.
+/// Whether `method` can render a light of this shape ([`Method::supports`]); false for an
+/// unknown name.
 pub fn supports(method: &str, shape: &LightShape) -> bool {
-    match method {
-        // hard-sv uses the light center; nsample and raycast sample any shape.
-        "hard-sv" | "nsample" | "raycast" => {
-            let _ = shape;
-            true
-        }
-        // Penumbra wedges are built for spherical lights only (Paper I §4); penumbra maps
-        // use spherical lights (Wyman & Hansen §4).
-        "pw2002" | "pw-restructured" | "penumbra-map" => {
-            matches!(shape, LightShape::Sphere { .. })
-        }
-        // Paper IV §4.2: the rectangular and the spherical shader.
-        "ssv-optimized" => matches!(shape, LightShape::Rect { .. } | LightShape::Sphere { .. }),
-        // Paper III §3.2.2, §3.3: rectangular and textured rectangular lights; §5.3: spheres.
-        "ssv" => matches!(
-            shape,
-            LightShape::Rect { .. } | LightShape::TexturedRect { .. } | LightShape::Sphere { .. }
-        ),
-        // Forest et al. 2006 §4.2: rectangular lights, in light space [−1, 1]².
-        "wedge-blending" => matches!(shape, LightShape::Rect { .. }),
-        // CGI 2004 §2: "the light source is approximated by a circular disk".
-        "dbuffer" => matches!(shape, LightShape::Disk { .. }),
-        _ => false,
-    }
+    find(method).is_some_and(|m| (m.supports)(shape))
 }
 
 /// The methods to run for `scene`: its `methods` list (validated), else every method that
 /// supports its light shape.
 pub fn selected(scene: &Scene) -> Result<Vec<String>, InputError> {
     match &scene.methods {
-        None => Ok(ALL
-            .iter()
+        None => Ok(names()
             .filter(|m| supports_scene(m, scene))
             .map(|m| m.to_string())
             .collect()),
@@ -152,11 +212,12 @@ pub fn selected(scene: &Scene) -> Result<Vec<String>, InputError> {
 
 /// Check that `method` is a known method that can render every light of `scene`.
 pub fn check_method(method: &str, scene: &Scene) -> Result<(), InputError> {
-    if !ALL.contains(&method) {
+    if find(method).is_none() {
+        let known: Vec<&str> = names().collect();
         return Err(InputError::at(
             &scene.source,
             "methods",
-            format!("unknown method {method:?}; known: {}", ALL.join(", ")),
+            format!("unknown method {method:?}; known: {}", known.join(", ")),
         ));
     }
     match unsupported_light(method, scene) {
@@ -165,43 +226,15 @@ pub fn check_method(method: &str, scene: &Scene) -> Result<(), InputError> {
     }
 }
 
-/// An option table as the registry holds it: its name, its keys documented, and its check
-/// (the table read from a scene, [`OptionTable::read`]).
-type Table = (
-    &'static str,
-    fn() -> Vec<KeyDoc>,
-    fn(&Scene) -> Result<(), InputError>,
-);
-
-/// The registry entry of table `O`.
-fn table<O: OptionTable>() -> Table {
-    (O::NAME, O::keys, |scene| O::read(scene).map(drop))
-}
-
-/// Every option table: `gpu`, then the methods in [`ALL`] order.
-fn tables() -> [Table; 11] {
-    [
-        table::<GpuOptions>(),
-        table::<RaycastOptions>(),
-        table::<nsample::NsampleOptions>(),
-        table::<hard_sv::HardSvOptions>(),
-        table::<pw2002::Pw2002Options>(),
-        table::<pw_restructured::PwRestructuredOptions>(),
-        table::<ssv_optimized::SsvOptimizedOptions>(),
-        table::<ssv::SsvOptions>(),
-        table::<wedge_blending::WedgeBlendingOptions>(),
-        table::<penumbra_map::PenumbraMapOptions>(),
-        table::<dbuffer::DBufferOptions>(),
-    ]
+/// Every option table: `gpu`, then the methods' in [`ALL`] order.
+fn tables() -> impl Iterator<Item = OptionTableSpec> {
+    std::iter::once(OptionTableSpec::of::<GpuOptions>()).chain(ALL.iter().map(|m| m.options))
 }
 
 /// Every option table's name and keys, documented: `gpu`, then the methods in [`ALL`] order
 /// (what `penumbra list --options` prints, [`crate::options::listing`]).
 pub fn option_docs() -> Vec<(&'static str, Vec<KeyDoc>)> {
-    tables()
-        .iter()
-        .map(|(name, keys, _)| (*name, keys()))
-        .collect()
+    tables().map(|t| (t.name, (t.keys)())).collect()
 }
 
 /// Check every `[options.X]` table of `scene` before anything is rendered: X must be `gpu` or a
@@ -210,11 +243,10 @@ pub fn option_docs() -> Vec<(&'static str, Vec<KeyDoc>)> {
 /// lights (else its options could never act). The checks that need the rendered frame follow
 /// in [`check_options`].
 pub fn check_option_tables(scene: &Scene) -> Result<(), InputError> {
-    let tables = tables();
     for (name, written) in &scene.options {
         let first_key = written.keys().next();
-        let Some((_, _, read)) = tables.iter().find(|t| t.0 == name) else {
-            let known: Vec<&str> = tables.iter().map(|t| t.0).collect();
+        let Some(table) = tables().find(|t| t.name == name) else {
+            let known: Vec<&str> = tables().map(|t| t.name).collect();
             let message = format!("unknown method {name:?}; known: {}", known.join(", "));
             return Err(match first_key {
                 Some(key) if scene.cli_options.contains_key(&(name.clone(), key.clone())) => {
@@ -223,7 +255,7 @@ pub fn check_option_tables(scene: &Scene) -> Result<(), InputError> {
                 _ => InputError::at(&scene.source, format!("options.{name}"), message),
             });
         };
-        read(scene)?;
+        (table.check)(scene)?;
         if name == GpuOptions::NAME {
             continue;
         }
@@ -238,35 +270,26 @@ pub fn check_option_tables(scene: &Scene) -> Result<(), InputError> {
     Ok(())
 }
 
-/// Run one method on a rendered frame: directly for a single light or a method in
-/// [`RENDERS_SEVERAL_LIGHTS`], else once per light, averaged ([`light_average`]).
-pub fn run(method: &str, frame: &Frame) -> Result<MethodOutput, InputError> {
-    if frame.scene.is_multi_light() && !RENDERS_SEVERAL_LIGHTS.contains(&method) {
-        return light_average::run(method, frame, run_one_light);
-    }
-    run_one_light(method, frame)
-}
-
-/// Run one method on a frame whose scene has one light (or on any frame for a method in
-/// [`RENDERS_SEVERAL_LIGHTS`]).
-fn run_one_light(method: &str, frame: &Frame) -> Result<MethodOutput, InputError> {
-    match method {
-        "hard-sv" => hard_sv::run(frame),
-        "nsample" => nsample::run(frame),
-        "raycast" => run_raycast(frame),
-        "ssv-optimized" => ssv_optimized::run(frame),
-        "ssv" => ssv::run(frame),
-        "pw2002" => pw2002::run(frame),
-        "pw-restructured" => pw_restructured::run(frame),
-        "wedge-blending" => wedge_blending::run(frame),
-        "penumbra-map" => penumbra_map::run(frame),
-        "dbuffer" => dbuffer::run(frame),
-        _ => Err(InputError::at(
+/// The method called `method`, or an error naming the scene's `methods`.
+fn known(method: &str, frame: &Frame) -> Result<&'static Method, InputError> {
+    find(method).ok_or_else(|| {
+        InputError::at(
             &frame.scene.source,
             "methods",
             format!("unknown method {method:?}"),
-        )),
+        )
+    })
+}
+
+/// Run one method on a rendered frame: directly for a single light or a method that renders
+/// every light in one pass ([`SeveralLights::OnePass`]), else once per light, averaged
+/// ([`light_average`]).
+pub fn run(method: &str, frame: &Frame) -> Result<MethodOutput, InputError> {
+    let m = known(method, frame)?;
+    if frame.scene.is_multi_light() && m.lights == SeveralLights::PerLight {
+        return light_average::run(method, frame, |_, f| (m.run)(f));
     }
+    (m.run)(frame)
 }
 
 /// How a visibility parameter in [0, 1] becomes a visibility: each method accepts the falloffs
@@ -452,238 +475,21 @@ pub fn method_stats(
     }
 }
 
-/// `raycast` (the ground truth by definition): per pixel, the fraction of the light visible
-/// from the receiver point, with `samples` jittered stratified samples (default 1024, a perfect
-/// square) and `seed`. A sphere light is the disk facing each receiver (`sphere =
-/// facing-receiver`, the papers' definition) or, with `sphere = fixed-disk`, `nsample`'s one
-/// disk facing the center of the mesh bounds, so the two references can be compared on one
-/// definition. `receiver = "depth-buffer"` (default) uses the depth-buffer point the
-/// rasterized methods see; `"primary-ray"` the exact hit of the ray through the pixel center
-/// with the visible triangle's plane.
-fn run_raycast(frame: &Frame) -> Result<MethodOutput, InputError> {
-    let start = Instant::now();
-    let scene = frame.scene;
-    let (settings, receiver) = raycast_options(scene)?;
-    let pass_start = Instant::now();
-    let primary;
-    let receivers = if receiver == ReceiverPoint::PrimaryRay {
-        primary = frame.primary_ray_receivers();
-        &primary[..]
-    } else {
-        frame.receivers()
-    };
-    let probe = frame.probe_pass("raycast");
-    let visibility =
-        raycast::raycast_visibility_probed(scene, receivers, &settings, probe.as_ref());
-    let pass = PassStats {
-        name: "raycast".into(),
-        wall_seconds: pass_start.elapsed().as_secs_f64(),
-        runs: 1,
-        counters: Counters::default(),
-    };
-    let plan = MethodPlan {
-        method: "raycast".into(),
-        passes: vec![frame.pass.name.clone(), "raycast".into()],
-        // The frame's scene pass writes the depth buffer whatever the receivers are read from.
-        buffers: vec![BufferPlan::depth(&frame.gpu)],
-        settings: serde_json::json!({
-            "samples": settings.samples,
-            "seed": settings.seed,
-            "pattern": "jittered",
-            "receiver": receiver.written(),
-            "sphere": match settings.sphere_disk {
-                raycast::SphereDisk::FacingReceiver => "the disk facing each receiver".to_string(),
-                raycast::SphereDisk::Facing(p) => format!("one disk facing ({}, {}, {})", p.x, p.y, p.z),
-            },
-        }),
-    };
-    let passes = vec![frame.pass.clone(), pass];
-    let mut stats = method_stats("raycast", frame, start, &plan, passes);
-    let snapped = frame.snapped_receivers();
-    if snapped > 0 && receiver == ReceiverPoint::DepthBuffer {
-        stats.warnings.push(format!(
-            "{snapped} pixels: the depth buffer cannot hold the surface there (a near plane too \
-             close for the depth format?); their receivers, for every method, are the exact \
-             hits of the pixel rays with the visible triangles"
-        ));
-    }
-    Ok(MethodOutput {
-        visibility,
-        dumps: vec![],
-        stats,
-    })
-}
-
-/// The reference's own sampling noise (issue 15: the "% > 1/255" column is dominated by it for
-/// exact methods): `raycast` evaluated again with the next seed (`seed + 1`, every other
-/// setting the same) and compared with `reference`, its run with `seed`. Only pixels that can
-/// differ are evaluated again — those whose 3×3 neighbourhood holds a reference value strictly
-/// between 0 and 1 (a penumbra and its one-pixel border); elsewhere every sample of the run
-/// saw the light, or none did, and the second run is taken to agree (so the result is a lower
-/// bound, and costs a fraction of the reference's time). Several lights are averaged like the
-/// reference ([`light_average`]).
-pub fn reference_noise_floor(
-    frame: &Frame,
-    reference: &Visibility,
-) -> Result<crate::metrics::ErrorStats, InputError> {
-    let (w, h) = (frame.scene.width as usize, frame.scene.height as usize);
-    let fractional = |i: usize| reference.rgb(i).iter().any(|&v| v > 0.0 && v < 1.0);
-    let again: Vec<bool> = (0..w * h)
-        .map(|i| {
-            let (x, y) = (i % w, i / w);
-            (y.saturating_sub(1)..(y + 2).min(h))
-                .any(|yy| (x.saturating_sub(1)..(x + 2).min(w)).any(|xx| fractional(yy * w + xx)))
-        })
-        .collect();
-    let second = raycast_where(frame, &again, 1)?;
-    let merged = match (reference, &second) {
-        (Visibility::Gray(r), Visibility::Gray(s)) => Visibility::Gray(
-            (0..r.len())
-                .map(|i| if again[i] { s[i] } else { r[i] })
-                .collect(),
-        ),
-        _ => Visibility::Rgb(
-            (0..reference.len())
-                .map(|i| {
-                    if again[i] {
-                        second.rgb(i)
-                    } else {
-                        reference.rgb(i)
-                    }
-                })
-                .collect(),
-        ),
-    };
-    Ok(crate::metrics::compare(&merged, reference))
-}
-
-option_names! {
-    /// How `raycast` sees a sphere light (`[options.raycast] sphere`).
-    pub enum SphereAs {
-        /// The disk through the center facing each receiver (the papers' definition).
-        FacingReceiver = "facing-receiver",
-        /// `nsample`'s one disk, facing the center of the mesh bounds.
-        FixedDisk = "fixed-disk",
-    }
-}
-
-option_names! {
-    /// Which point of a pixel `raycast` computes the visibility of (`[options.raycast] receiver`).
-    pub enum ReceiverPoint {
-        /// The pixel center un-projected at its stored depth, the point the rasterized methods see.
-        DepthBuffer = "depth-buffer",
-        /// The exact hit of the ray through the pixel center with the visible triangle's plane.
-        PrimaryRay = "primary-ray",
-    }
-}
-
-option_table! {
-    /// `[options.raycast]`: the reference's samples and definitions.
-    pub struct RaycastOptions["raycast"] {
-        /// light samples per pixel, jittered in √n×√n strata (a perfect square)
-        samples: u32 [1..=65536] = raycast::DEFAULT_SAMPLES;
-        /// seed of the jitter
-        seed: u64 [0..=u64::MAX >> 1] = 0;
-        /// the pixel's point: the depth buffer's (what the rasterized methods see) or the pixel ray's exact hit
-        receiver: ReceiverPoint = ReceiverPoint::DepthBuffer;
-        /// a sphere light as the disk facing each receiver (the papers'), or as nsample's one disk facing the center of the mesh bounds
-        sphere: SphereAs = SphereAs::FacingReceiver;
-    }
-}
-
-/// `raycast` with its options but the seed advanced by `seed_offset`, evaluated only at the
-/// pixels where `mask` (row-major) is true (1 elsewhere); several lights averaged like the
-/// reference ([`light_average`]).
-pub fn raycast_where(
-    frame: &Frame,
-    mask: &[bool],
-    seed_offset: u64,
-) -> Result<Visibility, InputError> {
-    let one_light = |f: &Frame| -> Result<Visibility, InputError> {
-        let (mut settings, receiver) = raycast_options(f.scene)?;
-        settings.seed = settings.seed.wrapping_add(seed_offset);
-        let all = if receiver == ReceiverPoint::PrimaryRay {
-            f.primary_ray_receivers()
-        } else {
-            f.receivers().to_vec()
-        };
-        let some: Vec<_> = all
-            .iter()
-            .zip(mask)
-            .map(|(r, &a)| r.filter(|_| a))
-            .collect();
-        Ok(raycast::raycast_visibility(f.scene, &some, &settings))
-    };
-    if frame.scene.is_multi_light() {
-        let mut per_light = Vec::new();
-        for k in 0..frame.scene.lights.len() {
-            let scene = frame.scene.with_only_light(k);
-            per_light.push(one_light(&frame.lit_by(&scene))?);
-        }
-        Ok(light_average::average(per_light.iter()))
-    } else {
-        one_light(frame)
-    }
-}
-
-/// The light samples per pixel of the reference (`[options.raycast]`'s `samples`).
-pub fn reference_samples(scene: &Scene) -> Result<u32, InputError> {
-    Ok(raycast_options(scene)?.0.samples)
-}
-
-/// Read and check `[options.raycast]`: the settings and the receiver choice.
-fn raycast_options(scene: &Scene) -> Result<(raycast::RaycastSettings, ReceiverPoint), InputError> {
-    let o = RaycastOptions::read(scene)?;
-    let settings = raycast::RaycastSettings {
-        samples: o.samples,
-        seed: o.seed,
-        sphere_disk: match o.sphere {
-            SphereAs::FixedDisk => raycast::SphereDisk::Facing(nsample::sphere_disk_target(scene)),
-            SphereAs::FacingReceiver => raycast::SphereDisk::FacingReceiver,
-        },
-    };
-    settings
-        .validate()
-        .map_err(|e| scene.option_error(RaycastOptions::NAME, "samples", e))?;
-    Ok((settings, o.receiver))
-}
-
-/// Check `method`'s options against the rendered `frame` without running it (what needs the
-/// frame: a sample count the light's shape cannot take, an option that cannot act with the
-/// others, …), so that a bad option is reported even for a method this run does not render.
-/// A method that runs once per light is checked for each light. A method that cannot render
-/// the scene's lights is skipped: [`check_option_tables`] refused any key of its table.
+/// Check `method`'s options against the rendered `frame` without running it
+/// ([`Method::check`]), so that a bad option is reported even for a method this run does not
+/// render. A method that runs once per light is checked for each light. A method that cannot
+/// render the scene's lights is skipped: [`check_option_tables`] refused any key of its table.
 pub fn check_options(method: &str, frame: &Frame) -> Result<(), InputError> {
     if unsupported_light(method, frame.scene).is_some() {
         return Ok(());
     }
-    if frame.scene.is_multi_light() && !RENDERS_SEVERAL_LIGHTS.contains(&method) {
+    let m = known(method, frame)?;
+    if frame.scene.is_multi_light() && m.lights == SeveralLights::PerLight {
         for k in 0..frame.scene.lights.len() {
             let scene = frame.scene.with_only_light(k);
-            check_options_one_light(method, &frame.lit_by(&scene))?;
+            (m.check)(&frame.lit_by(&scene))?;
         }
         return Ok(());
     }
-    check_options_one_light(method, frame)
-}
-
-/// [`check_options`] for a frame with one light (or a method in [`RENDERS_SEVERAL_LIGHTS`]).
-fn check_options_one_light(method: &str, frame: &Frame) -> Result<(), InputError> {
-    match method {
-        "hard-sv" => hard_sv::HardSvOptions::read(frame.scene).map(drop),
-        "nsample" => nsample::options(frame).map(drop),
-        "raycast" => raycast_options(frame.scene).map(drop),
-        "pw2002" => pw2002::options(frame).map(drop),
-        "pw-restructured" => pw_restructured::read_settings(frame).map(drop),
-        "ssv" => ssv::read_settings(frame).map(drop),
-        "ssv-optimized" => ssv_optimized::options(frame).map(drop),
-        "wedge-blending" => wedge_blending::options(frame).map(drop),
-        "penumbra-map" => penumbra_map::read_settings(frame).map(drop),
-        "dbuffer" => dbuffer::read_settings(frame).map(drop),
-        _ => Err(InputError::at(
-            &frame.scene.source,
-            "methods",
-            format!("unknown method {method:?}"),
-        )),
-    }
+    (m.check)(frame)
 }

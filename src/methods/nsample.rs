@@ -22,21 +22,25 @@
 //!
 //! Options: `n` (a perfect square, 1…4096, default 1024), and `mode`, `stencil`, `submission` as
 //! for `hard-sv`; `mode = auto` chooses z-fail when the near plane is in the shadow of the
-//! light center or of the shape's extreme points ([`crate::plan::representative_light_points`]).
+//! light center or of the shape's extreme points ([`crate::geometry::near_plane::representative_light_points`]).
 
 use super::dump::{row_major, BufferDump, DumpValues, ElementFormat, EventMap};
 use super::hard_sv::{
     stencil_event_kind, stencil_shadow, HardSvOptions, ShadowTest, StencilShadowSettings,
 };
-use super::output::{MethodOutput, PassStats, Visibility};
+use super::output::MethodOutput;
 use crate::error::InputError;
 use crate::frame::{Frame, BACKGROUND};
+use crate::geometry::near_plane::representative_light_points;
 use crate::gpu::counters::Counters;
 use crate::gpu::probe::{Overflow, PrimitiveKind, Raw};
 use crate::light::sampling::{stratified, LightSample, Pattern};
+use crate::methods::hard_sv::CountMode;
+use crate::methods::output::{BufferPlan, MethodPlan};
 use crate::options::{option_table, OptionTable, OptionType};
-use crate::plan::{representative_light_points, BufferPlan, CountMode, MethodPlan};
+use crate::pass::PassStats;
 use crate::scene::{LightShape, Scene};
+use crate::visibility::Visibility;
 use glam::Vec3;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -89,6 +93,23 @@ pub fn options(
     .map_err(|e| scene.option_error(NsampleOptions::NAME, "n", e))?;
     Ok((samples, settings, o.shadow.mode))
 }
+
+/// `nsample` in the registry ([`crate::methods::ALL`]).
+pub const METHOD: crate::methods::Method = crate::methods::Method {
+    name: "nsample",
+    paper: "Paper III §5.1: N hard shadows",
+    // Stratified samples of any shape.
+    supports: |_| true,
+    lights: crate::methods::SeveralLights::PerLight,
+    options: crate::methods::OptionTableSpec::of::<NsampleOptions>(),
+    // Up to `MAX_CONCURRENT_SAMPLES` stencil passes at once, each with its own stencil and
+    // scratch: 92 bytes per pixel on one thread, 185 on eight (n = 16, `cube-of-spheres`,
+    // 512² and 1024²).
+    bytes_per_pixel: 208,
+    default_run: crate::methods::DefaultRun::FirstSceneOnly,
+    check: |frame| options(frame).map(drop),
+    run,
+};
 
 /// Run `nsample` on a rendered frame.
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {

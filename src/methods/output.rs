@@ -4,80 +4,9 @@
 
 use super::dump::BufferDump;
 use crate::gpu::counters::Counters;
+use crate::pass::PassStats;
+use crate::visibility::Visibility;
 use serde::Serialize;
-
-/// Per-pixel visibility of the light, row 0 at the top, row-major.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Visibility {
-    /// One value per pixel in [0, 1].
-    Gray(Vec<f32>),
-    /// One value per pixel and RGB channel in [0, 1] (textured/coloured lights).
-    Rgb(Vec<[f32; 3]>),
-}
-
-impl Visibility {
-    /// Number of pixels.
-    pub fn len(&self) -> usize {
-        match self {
-            Visibility::Gray(v) => v.len(),
-            Visibility::Rgb(v) => v.len(),
-        }
-    }
-
-    /// True when there are no pixels.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// The visibility of pixel `i` as RGB (gray replicated).
-    pub fn rgb(&self, i: usize) -> [f32; 3] {
-        match self {
-            Visibility::Gray(v) => [v[i]; 3],
-            Visibility::Rgb(v) => v[i],
-        }
-    }
-
-    /// The visibility of pixel `i` per stored channel: one value for gray, three for RGB.
-    pub fn channels(&self, i: usize) -> Vec<f32> {
-        match self {
-            Visibility::Gray(v) => vec![v[i]],
-            Visibility::Rgb(v) => v[i].to_vec(),
-        }
-    }
-
-    /// The visibility of pixel `i` as one value (RGB averaged with equal weights).
-    pub fn gray(&self, i: usize) -> f32 {
-        match self {
-            Visibility::Gray(v) => v[i],
-            Visibility::Rgb(v) => (v[i][0] + v[i][1] + v[i][2]) / 3.0,
-        }
-    }
-}
-
-/// Time and counters of one pass.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct PassStats {
-    /// The pass name, e.g. `scene-depth`, `shadow-volume-zpass`, `sample-17` (summed per kind).
-    pub name: String,
-    /// Wall-clock seconds the pass took (informational; never decides a test).
-    pub wall_seconds: f64,
-    /// How many times the pass ran (e.g. N for the per-sample passes of `nsample`).
-    pub runs: u64,
-    /// Counters summed over all tiles and runs.
-    pub counters: Counters,
-}
-
-impl PassStats {
-    /// The stats of one run of pass `name` that started at `start` with `counters`.
-    pub fn since(name: &str, start: std::time::Instant, counters: Counters) -> Self {
-        Self {
-            name: name.into(),
-            wall_seconds: start.elapsed().as_secs_f64(),
-            runs: 1,
-            counters,
-        }
-    }
-}
 
 /// Everything `stats.json` holds for one method.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -116,4 +45,123 @@ pub struct MethodOutput {
     pub dumps: Vec<BufferDump>,
     /// Stats for `stats.json`.
     pub stats: MethodStats,
+}
+
+/// One buffer a pass uses.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct BufferPlan {
+    /// Buffer name.
+    pub name: String,
+    /// Storage format, e.g. `D24`, `S8`, `f64x3 accumulator`.
+    pub format: String,
+    /// Bytes per sample.
+    pub bytes_per_sample: u32,
+}
+
+impl BufferPlan {
+    /// The hierarchical-Z unit's per-tile zmin and zmax of the scene depth
+    /// ([`crate::gpu::hiz`]): two values in the depth format per tile, as whole bytes per
+    /// sample rounded up.
+    pub fn hiz_zmin_zmax(gpu: &crate::frame::GpuSettings) -> Self {
+        Self::zmin_zmax("", gpu.depth, gpu.hiz_tile_size)
+    }
+
+    /// [`BufferPlan::hiz_zmin_zmax`] of a depth target seen from the light (`target`, e.g.
+    /// "shadow map": its early Z, [`crate::gpu::light_view::LightView::render_depth_probed`]),
+    /// in its `depth` format with HiZ tiles of edge `hiz_tile`.
+    pub fn hiz_zmin_zmax_of(
+        target: &str,
+        depth: crate::gpu::depth::DepthFormat,
+        hiz_tile: u32,
+    ) -> Self {
+        Self::zmin_zmax(&format!(" of the {target}"), depth, hiz_tile)
+    }
+
+    fn zmin_zmax(of: &str, depth: crate::gpu::depth::DepthFormat, hiz_tile: u32) -> Self {
+        Self {
+            name: format!("tile zmin/zmax{of} (2 per {hiz_tile}×{hiz_tile} HiZ tile)"),
+            format: format!("{depth:?}"),
+            bytes_per_sample: (2 * depth.bytes() as u32).div_ceil(hiz_tile * hiz_tile),
+        }
+    }
+
+    /// The hierarchical-Z unit's per-tile stencil summary (`ssv-optimized`: the last half
+    /// that marked the tile, [`crate::gpu::hiz`]): one byte per tile, as whole bytes per
+    /// sample rounded up.
+    pub fn hiz_stencil_summary(gpu: &crate::frame::GpuSettings) -> Self {
+        Self {
+            name: format!("tile stencil summary (1 per {0}×{0} tile)", gpu.tile_size),
+            format: "u8".into(),
+            bytes_per_sample: 1u32.div_ceil(gpu.tile_size * gpu.tile_size),
+        }
+    }
+
+    /// The hierarchical-Z unit's per-tile receiver bounds ([`crate::gpu::hiz::TileReceiverBounds`]):
+    /// six f32 per tile and per block of tiles, as whole bytes per sample rounded up.
+    pub fn hiz_receiver_bounds(gpu: &crate::frame::GpuSettings) -> Self {
+        let tile_len = gpu.tile_size * gpu.tile_size;
+        Self {
+            name: format!(
+                "tile receiver bounds (6 per {0}×{0} tile and per {1}×{1} tiles)",
+                gpu.tile_size,
+                crate::gpu::hiz::BLOCK_TILES
+            ),
+            format: "f32x6".into(),
+            bytes_per_sample: (crate::gpu::hiz::TileReceiverBounds::READ_BYTES as u32)
+                .div_ceil(tile_len),
+        }
+    }
+
+    /// The frame's scene depth buffer, in the format the frame uses.
+    pub fn depth(gpu: &crate::frame::GpuSettings) -> Self {
+        Self {
+            name: "depth".into(),
+            format: format!("{:?}", gpu.depth),
+            bytes_per_sample: gpu.depth.bytes() as u32,
+        }
+    }
+
+    /// A depth target named `name` (a shadow map, a map's depth channel) in `format`.
+    pub fn depth_target(name: String, format: crate::gpu::depth::DepthFormat) -> Self {
+        Self {
+            name,
+            format: format!("{format:?}"),
+            bytes_per_sample: format.bytes() as u32,
+        }
+    }
+
+    /// A colour target named `name` with `channels` channels, each in `format`.
+    pub fn color_target(
+        name: String,
+        format: crate::gpu::color::ColorFormat,
+        channels: u32,
+    ) -> Self {
+        Self {
+            name,
+            format: format!("{format:?}"),
+            bytes_per_sample: channels * format.bytes() as u32,
+        }
+    }
+
+    /// An 8-bit stencil buffer.
+    pub fn stencil8() -> Self {
+        Self {
+            name: "stencil".into(),
+            format: "S8".into(),
+            bytes_per_sample: 1,
+        }
+    }
+}
+
+/// What one method will do for this frame.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct MethodPlan {
+    /// Method name.
+    pub method: String,
+    /// Pass names in execution order.
+    pub passes: Vec<String>,
+    /// Buffers allocated.
+    pub buffers: Vec<BufferPlan>,
+    /// Method settings after option parsing and automatic decisions.
+    pub settings: serde_json::Value,
 }

@@ -114,7 +114,7 @@
 use super::dump::{
     color_values, depth_values, row_major, BufferDump, ElementFormat, EventKind, EventMap,
 };
-use super::output::{MethodOutput, PassStats, Visibility};
+use super::output::MethodOutput;
 use crate::error::InputError;
 use crate::frame::Frame;
 use crate::geometry::penumbra_cones::{
@@ -130,9 +130,11 @@ use crate::gpu::raster::{bin, draw_probed, no_tile_culling, Fragment};
 use crate::gpu::setup::{setup_all_barycentric, CullMode};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::texture::Filter;
+use crate::methods::output::BufferPlan;
 use crate::options::{option_names, option_table, OptionTable};
-use crate::plan::BufferPlan;
+use crate::pass::PassStats;
 use crate::scene::{LightShape, Scene};
+use crate::visibility::Visibility;
 use serde::Serialize;
 use std::time::Instant;
 
@@ -729,6 +731,21 @@ fn color_raw(tile: &ColorTile, i: usize) -> Raw {
         ColorFormat::F32 => Raw::F32(stored),
     }
 }
+
+/// `penumbra-map` in the registry ([`crate::methods::ALL`]).
+pub const METHOD: crate::methods::Method = crate::methods::Method {
+    name: "penumbra-map",
+    paper: "Wyman & Hansen, EGSR 2003: penumbra maps",
+    // Penumbra maps use spherical lights (Wyman & Hansen §4).
+    supports: |s| matches!(s, LightShape::Sphere { .. }),
+    lights: crate::methods::SeveralLights::PerLight,
+    options: crate::methods::OptionTableSpec::of::<PenumbraMapOptions>(),
+    // Not measured: the largest method's figure (wedge-blending's).
+    bytes_per_pixel: 384,
+    default_run: crate::methods::DefaultRun::EveryScene,
+    check: |frame| read_settings(frame).map(drop),
+    run,
+};
 
 /// Run `penumbra-map` on a rendered frame (one light: [`super::run`] averages several).
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {

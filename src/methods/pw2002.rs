@@ -46,10 +46,11 @@
 //! its wraps or saturations per pixel and the pixels the resolve clamps ([`li_dump`]).
 
 use super::dump::{li_values, row_major, BufferDump, ElementFormat, EventKind, EventMap};
-use super::output::{MethodOutput, PassStats, Visibility};
+use super::output::MethodOutput;
 use super::Falloff;
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, BACKGROUND};
+use crate::geometry::near_plane::{eye_in_shadow, representative_light_points};
 use crate::geometry::penumbra_wedge::{
     build_wedges, far_distance, li_amount, shader_li_amount, shader_light_intensity, wedge_radius,
     wedge_triangles, FaceKind, WedgeOptions, WedgeSet,
@@ -63,9 +64,11 @@ use crate::gpu::raster::{bin, draw_probed, TileDraw};
 use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::shader_vec::SVec3;
+use crate::methods::output::{BufferPlan, MethodPlan};
 use crate::options::{option_names, option_table, OptionTable, Switch};
-use crate::plan::{eye_in_shadow, representative_light_points, BufferPlan, MethodPlan};
+use crate::pass::PassStats;
 use crate::scene::{LightShape, Scene};
+use crate::visibility::Visibility;
 use std::time::Instant;
 
 /// How `pw2002` values the points where an eye ray enters or leaves a wedge.
@@ -467,6 +470,20 @@ pub fn options(frame: &Frame) -> Result<WedgeSettings, InputError> {
         ..o.wedges.settings(frame)?
     })
 }
+
+/// `pw2002` in the registry ([`crate::methods::ALL`]).
+pub const METHOD: crate::methods::Method = crate::methods::Method {
+    name: "pw2002",
+    paper: "Paper I: penumbra wedges, EGWR 2002",
+    // Penumbra wedges are built for spherical lights only (Paper I §4).
+    supports: |s| matches!(s, LightShape::Sphere { .. }),
+    lights: crate::methods::SeveralLights::OnePass,
+    options: crate::methods::OptionTableSpec::of::<Pw2002Options>(),
+    bytes_per_pixel: 88,
+    default_run: crate::methods::DefaultRun::EveryScene,
+    check: |frame| options(frame).map(drop),
+    run,
+};
 
 /// Run `pw2002` on a rendered frame.
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {

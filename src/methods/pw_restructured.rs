@@ -57,7 +57,7 @@
 //!   tile's zmax — or `zmin+zmax` — that, the wedge's zmax in front of the tile's zmin, then the
 //!   n/p-vertex test of the tile's screen-space box against the wedge's five screen-space
 //!   planes. `off` culls nothing.
-//! * z-pass or z-fail: `mode = auto` picks z-fail when [`crate::plan::eye_in_shadow`] finds the
+//! * z-pass or z-fail: `mode = auto` picks z-fail when [`crate::geometry::near_plane::eye_in_shadow`] finds the
 //!   near plane in the shadow of a point of the light.
 //!
 //! * **Shader precision** (`[options.gpu] shader`, [`crate::gpu::shader_float`]): the penumbra
@@ -77,13 +77,14 @@
 //! algorithm never visits side planes, it is the `cancel` form by construction) plus `passes = single|three`, `culling = zmin-zmax|zmax|off`,
 //! `mode = auto|zpass|zfail`.
 
-use super::output::{MethodOutput, PassStats};
+use super::output::MethodOutput;
 use super::pw2002::{
     frame_wedges, li_buffer_plan, li_dump, li_row_major, resolve, wedge_primitive, MultiLight,
     WedgeKeys, WedgeSettings,
 };
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame};
+use crate::geometry::near_plane::representative_light_points;
 use crate::geometry::penumbra_wedge::{
     cap_triangles, li_amount, screen_wedge, shader_li_amount, shader_light_intensity,
     wedge_triangles, FaceKind, ScreenWedge, WedgeSet, WedgeTriangle,
@@ -98,8 +99,11 @@ use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::shader_vec::SVec3;
 use crate::gpu::stencil::{StencilFace, StencilOp, StencilState};
+use crate::methods::hard_sv::CountMode;
+use crate::methods::output::{BufferPlan, MethodPlan};
 use crate::options::{option_names, option_table, OptionTable, OptionType};
-use crate::plan::{representative_light_points, BufferPlan, CountMode, MethodPlan};
+use crate::pass::PassStats;
+use crate::scene::LightShape;
 use std::time::Instant;
 
 /// Counting direction.
@@ -665,6 +669,20 @@ fn stencil_pass(
         },
     )
 }
+
+/// `pw-restructured` in the registry ([`crate::methods::ALL`]).
+pub const METHOD: crate::methods::Method = crate::methods::Method {
+    name: "pw-restructured",
+    paper: "Paper II: restructured penumbra wedges",
+    // Penumbra wedges are built for spherical lights only (Paper I §4).
+    supports: |s| matches!(s, LightShape::Sphere { .. }),
+    lights: crate::methods::SeveralLights::OnePass,
+    options: crate::methods::OptionTableSpec::of::<PwRestructuredOptions>(),
+    bytes_per_pixel: 96,
+    default_run: crate::methods::DefaultRun::EveryScene,
+    check: |frame| read_settings(frame).map(drop),
+    run,
+};
 
 /// Run `pw-restructured` on a rendered frame.
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {

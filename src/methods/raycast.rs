@@ -98,15 +98,22 @@
 //! jitter (a pure function of `seed` and the stratum), hence the error of the estimate is
 //! correlated between neighbouring pixels rather than noisy.
 
+use super::output::{BufferPlan, MethodOutput, MethodPlan};
+use crate::error::InputError;
+use crate::frame::Frame;
+use crate::gpu::counters::Counters;
 use crate::gpu::probe::{PassProbe, PrimitiveKind};
 use crate::light::sampling::{self, LightSample, Pattern};
-use crate::methods::output::Visibility;
+use crate::options::{option_names, option_table, OptionTable, OptionType};
+use crate::pass::PassStats;
 use crate::scene::{Light, LightShape, Scene};
+use crate::visibility::Visibility;
 use bvh::aabb::{Aabb, Bounded};
 use bvh::bounding_hierarchy::BHShape;
 use bvh::bvh::{Bvh, BvhNode};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
+use std::time::Instant;
 
 /// Ray-origin offset along the receiver normal, relative to the scene diagonal (module doc,
 /// "Shadow rays").
@@ -987,6 +994,215 @@ pub fn raycast_visibility_probed(
                 .collect(),
         ),
     }
+}
+
+/// `raycast` in the registry ([`super::ALL`]).
+pub const METHOD: super::Method = super::Method {
+    name: "raycast",
+    paper: "reference: shadow rays per pixel",
+    // Shadow rays sample any light shape.
+    supports: |_| true,
+    lights: super::SeveralLights::PerLight,
+    options: super::OptionTableSpec::of::<RaycastOptions>(),
+    bytes_per_pixel: 72,
+    default_run: super::DefaultRun::EveryScene,
+    check: |frame| raycast_options(frame.scene).map(drop),
+    run,
+};
+
+/// `raycast` (the ground truth by definition): per pixel, the fraction of the light visible
+/// from the receiver point, with `samples` jittered stratified samples (default 1024, a perfect
+/// square) and `seed`. A sphere light is the disk facing each receiver (`sphere =
+/// facing-receiver`, the papers' definition) or, with `sphere = fixed-disk`, `nsample`'s one
+/// disk facing the center of the mesh bounds, so the two references can be compared on one
+/// definition. `receiver = "depth-buffer"` (default) uses the depth-buffer point the
+/// rasterized methods see; `"primary-ray"` the exact hit of the ray through the pixel center
+/// with the visible triangle's plane.
+fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
+    let start = Instant::now();
+    let scene = frame.scene;
+    let (settings, receiver) = raycast_options(scene)?;
+    let pass_start = Instant::now();
+    let primary;
+    let receivers = if receiver == ReceiverPoint::PrimaryRay {
+        primary = frame.primary_ray_receivers();
+        &primary[..]
+    } else {
+        frame.receivers()
+    };
+    let probe = frame.probe_pass("raycast");
+    let visibility = raycast_visibility_probed(scene, receivers, &settings, probe.as_ref());
+    let pass = PassStats {
+        name: "raycast".into(),
+        wall_seconds: pass_start.elapsed().as_secs_f64(),
+        runs: 1,
+        counters: Counters::default(),
+    };
+    let plan = MethodPlan {
+        method: "raycast".into(),
+        passes: vec![frame.pass.name.clone(), "raycast".into()],
+        // The frame's scene pass writes the depth buffer whatever the receivers are read from.
+        buffers: vec![BufferPlan::depth(&frame.gpu)],
+        settings: serde_json::json!({
+            "samples": settings.samples,
+            "seed": settings.seed,
+            "pattern": "jittered",
+            "receiver": receiver.written(),
+            "sphere": match settings.sphere_disk {
+                SphereDisk::FacingReceiver => "the disk facing each receiver".to_string(),
+                SphereDisk::Facing(p) => format!("one disk facing ({}, {}, {})", p.x, p.y, p.z),
+            },
+        }),
+    };
+    let passes = vec![frame.pass.clone(), pass];
+    let mut stats = super::method_stats("raycast", frame, start, &plan, passes);
+    let snapped = frame.snapped_receivers();
+    if snapped > 0 && receiver == ReceiverPoint::DepthBuffer {
+        stats.warnings.push(format!(
+            "{snapped} pixels: the depth buffer cannot hold the surface there (a near plane too \
+             close for the depth format?); their receivers, for every method, are the exact \
+             hits of the pixel rays with the visible triangles"
+        ));
+    }
+    Ok(MethodOutput {
+        visibility,
+        dumps: vec![],
+        stats,
+    })
+}
+
+/// The reference's own sampling noise (issue 15: the "% > 1/255" column is dominated by it for
+/// exact methods): `raycast` evaluated again with the next seed (`seed + 1`, every other
+/// setting the same) and compared with `reference`, its run with `seed`. Only pixels that can
+/// differ are evaluated again — those whose 3×3 neighbourhood holds a reference value strictly
+/// between 0 and 1 (a penumbra and its one-pixel border); elsewhere every sample of the run
+/// saw the light, or none did, and the second run is taken to agree (so the result is a lower
+/// bound, and costs a fraction of the reference's time). Several lights are averaged like the
+/// reference ([`light_average`]).
+pub fn reference_noise_floor(
+    frame: &Frame,
+    reference: &Visibility,
+) -> Result<crate::metrics::ErrorStats, InputError> {
+    let (w, h) = (frame.scene.width as usize, frame.scene.height as usize);
+    let fractional = |i: usize| reference.rgb(i).iter().any(|&v| v > 0.0 && v < 1.0);
+    let again: Vec<bool> = (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            (y.saturating_sub(1)..(y + 2).min(h))
+                .any(|yy| (x.saturating_sub(1)..(x + 2).min(w)).any(|xx| fractional(yy * w + xx)))
+        })
+        .collect();
+    let second = raycast_where(frame, &again, 1)?;
+    let merged = match (reference, &second) {
+        (Visibility::Gray(r), Visibility::Gray(s)) => Visibility::Gray(
+            (0..r.len())
+                .map(|i| if again[i] { s[i] } else { r[i] })
+                .collect(),
+        ),
+        _ => Visibility::Rgb(
+            (0..reference.len())
+                .map(|i| {
+                    if again[i] {
+                        second.rgb(i)
+                    } else {
+                        reference.rgb(i)
+                    }
+                })
+                .collect(),
+        ),
+    };
+    Ok(crate::metrics::compare(&merged, reference))
+}
+
+option_names! {
+    /// How `raycast` sees a sphere light (`[options.raycast] sphere`).
+    pub enum SphereAs {
+        /// The disk through the center facing each receiver (the papers' definition).
+        FacingReceiver = "facing-receiver",
+        /// `nsample`'s one disk, facing the center of the mesh bounds.
+        FixedDisk = "fixed-disk",
+    }
+}
+
+option_names! {
+    /// Which point of a pixel `raycast` computes the visibility of (`[options.raycast] receiver`).
+    pub enum ReceiverPoint {
+        /// The pixel center un-projected at its stored depth, the point the rasterized methods see.
+        DepthBuffer = "depth-buffer",
+        /// The exact hit of the ray through the pixel center with the visible triangle's plane.
+        PrimaryRay = "primary-ray",
+    }
+}
+
+option_table! {
+    /// `[options.raycast]`: the reference's samples and definitions.
+    pub struct RaycastOptions["raycast"] {
+        /// light samples per pixel, jittered in √n×√n strata (a perfect square)
+        samples: u32 [1..=65536] = DEFAULT_SAMPLES;
+        /// seed of the jitter
+        seed: u64 [0..=u64::MAX >> 1] = 0;
+        /// the pixel's point: the depth buffer's (what the rasterized methods see) or the pixel ray's exact hit
+        receiver: ReceiverPoint = ReceiverPoint::DepthBuffer;
+        /// a sphere light as the disk facing each receiver (the papers'), or as nsample's one disk facing the center of the mesh bounds
+        sphere: SphereAs = SphereAs::FacingReceiver;
+    }
+}
+
+/// `raycast` with its options but the seed advanced by `seed_offset`, evaluated only at the
+/// pixels where `mask` (row-major) is true (1 elsewhere); several lights averaged like the
+/// reference ([`light_average`]).
+pub fn raycast_where(
+    frame: &Frame,
+    mask: &[bool],
+    seed_offset: u64,
+) -> Result<Visibility, InputError> {
+    let one_light = |f: &Frame| -> Result<Visibility, InputError> {
+        let (mut settings, receiver) = raycast_options(f.scene)?;
+        settings.seed = settings.seed.wrapping_add(seed_offset);
+        let all = if receiver == ReceiverPoint::PrimaryRay {
+            f.primary_ray_receivers()
+        } else {
+            f.receivers().to_vec()
+        };
+        let some: Vec<_> = all
+            .iter()
+            .zip(mask)
+            .map(|(r, &a)| r.filter(|_| a))
+            .collect();
+        Ok(raycast_visibility(f.scene, &some, &settings))
+    };
+    if frame.scene.is_multi_light() {
+        let mut per_light = Vec::new();
+        for k in 0..frame.scene.lights.len() {
+            let scene = frame.scene.with_only_light(k);
+            per_light.push(one_light(&frame.lit_by(&scene))?);
+        }
+        Ok(super::light_average::average(per_light.iter()))
+    } else {
+        one_light(frame)
+    }
+}
+
+/// The light samples per pixel of the reference (`[options.raycast]`'s `samples`).
+pub fn reference_samples(scene: &Scene) -> Result<u32, InputError> {
+    Ok(raycast_options(scene)?.0.samples)
+}
+
+/// Read and check `[options.raycast]`: the settings and the receiver choice.
+fn raycast_options(scene: &Scene) -> Result<(RaycastSettings, ReceiverPoint), InputError> {
+    let o = RaycastOptions::read(scene)?;
+    let settings = RaycastSettings {
+        samples: o.samples,
+        seed: o.seed,
+        sphere_disk: match o.sphere {
+            SphereAs::FixedDisk => SphereDisk::Facing(super::nsample::sphere_disk_target(scene)),
+            SphereAs::FacingReceiver => SphereDisk::FacingReceiver,
+        },
+    };
+    settings
+        .validate()
+        .map_err(|e| scene.option_error(RaycastOptions::NAME, "samples", e))?;
+    Ok((settings, o.receiver))
 }
 
 #[cfg(test)]

@@ -67,7 +67,7 @@ use super::dump::{row_major, BufferDump, ElementFormat, EventKind, EventMap, VBu
 use super::hard_sv::stencil_dump;
 use super::hard_sv::{shadow_test, stencil_row_major, stencil_shadow, ShadowTest, StencilOverflow};
 use super::hard_sv::{StencilShadowSettings, Submission};
-use super::output::{MethodOutput, PassStats, Visibility};
+use super::output::MethodOutput;
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, Receiver, FULL_SCREEN};
 use crate::geometry::shadow_volume::{
@@ -94,9 +94,12 @@ use crate::light::coverage::{
 use crate::light::coverage_texture::{
     coverage_texture, CoverageFilter, CoverageTexture, CoverageTextureKey, DEFAULT_N, MAX_N, MIN_N,
 };
+use crate::methods::hard_sv::CountMode;
+use crate::methods::output::{BufferPlan, MethodPlan};
 use crate::options::{option_names, option_table, OptionTable, OptionType};
-use crate::plan::{BufferPlan, CountMode, MethodPlan};
+use crate::pass::PassStats;
 use crate::scene::LightShape;
+use crate::visibility::Visibility;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -735,6 +738,25 @@ fn hard_quads_pass<V: VBufferTile>(frame: &Frame, test: ShadowTest, vbuf: &mut [
     );
     counters
 }
+
+/// `ssv` in the registry ([`crate::methods::ALL`]).
+pub const METHOD: crate::methods::Method = crate::methods::Method {
+    name: "ssv",
+    paper: "Paper III: soft shadow volumes, SIGGRAPH 2003",
+    // Paper III §3.2.2, §3.3: rectangular and textured rectangular lights; §5.3: spheres.
+    supports: |s| {
+        matches!(
+            s,
+            LightShape::Rect { .. } | LightShape::TexturedRect { .. } | LightShape::Sphere { .. }
+        )
+    },
+    lights: crate::methods::SeveralLights::PerLight,
+    options: crate::methods::OptionTableSpec::of::<SsvOptions>(),
+    bytes_per_pixel: 160,
+    default_run: crate::methods::DefaultRun::EveryScene,
+    check: |frame| read_settings(frame).map(drop),
+    run,
+};
 
 /// Run `ssv` on a rendered frame.
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {

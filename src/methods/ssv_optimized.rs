@@ -99,7 +99,7 @@
 use super::dump::{
     receiver_pixels, row_major, BufferDump, DumpValues, ElementFormat, EventKind, EventMap,
 };
-use super::output::{MethodOutput, PassStats, Visibility};
+use super::output::MethodOutput;
 use crate::error::InputError;
 use crate::frame::{Frame, BACKGROUND};
 use crate::geometry::loops::silhouette_loops;
@@ -123,9 +123,12 @@ use crate::gpu::stencil::{StencilFace, StencilFunc, StencilOp, StencilState};
 use crate::gpu::transform::ClipVertex;
 use crate::light::coverage::{self, RectLight};
 use crate::light::lookup_tables::{AreaShape, AreaTable, Atan2CubeMap, SplitTable, TableFilter};
+use crate::methods::hard_sv::CountMode;
+use crate::methods::output::{BufferPlan, MethodPlan};
 use crate::options::{option_names, option_table, OptionTable};
-use crate::plan::{BufferPlan, CountMode, MethodPlan};
+use crate::pass::PassStats;
 use crate::scene::LightShape;
+use crate::visibility::Visibility;
 use glam::{DVec2, DVec3, Vec3};
 use std::time::Instant;
 
@@ -1055,6 +1058,20 @@ fn piece_visibility<T: ShaderFloat>(
 pub fn overlap_combine(a: f32, b: f32) -> f32 {
     a.max(b) + 0.5 * a.min(b)
 }
+
+/// `ssv-optimized` in the registry ([`crate::methods::ALL`]).
+pub const METHOD: crate::methods::Method = crate::methods::Method {
+    name: "ssv-optimized",
+    paper: "Paper IV: optimized soft shadow volumes, GH 2003",
+    // Paper IV §4.2: the rectangular and the spherical shader.
+    supports: |s| matches!(s, LightShape::Rect { .. } | LightShape::Sphere { .. }),
+    lights: crate::methods::SeveralLights::PerLight,
+    options: crate::methods::OptionTableSpec::of::<SsvOptimizedOptions>(),
+    bytes_per_pixel: 96,
+    default_run: crate::methods::DefaultRun::EveryScene,
+    check: |frame| options(frame).map(drop),
+    run,
+};
 
 /// Run `ssv-optimized` on a rendered frame.
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {

@@ -4,7 +4,7 @@
 //! `error.png`) on one fixed scale, so that two runs can be compared by eye.
 
 use super::{compare, compare_where, ErrorStats};
-use crate::methods::output::Visibility;
+use crate::visibility::Visibility;
 use serde::Serialize;
 
 /// A method's error against the reference, as `stats.json` holds it under `"error"`.

@@ -5,7 +5,7 @@
 //! inputs) and accumulated sequentially in pixel order, channel order inside a pixel, so the
 //! result does not depend on threads or scheduling.
 
-use crate::methods::output::Visibility;
+use crate::visibility::Visibility;
 use serde::{Deserialize, Serialize};
 
 pub mod error_report;

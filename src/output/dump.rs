@@ -334,7 +334,7 @@ impl Canvas {
 
     /// The PNG of the canvas with its texts.
     fn png(mut self) -> io::Result<Vec<u8>> {
-        crate::experiment::plotting::register_font().map_err(io::Error::other)?;
+        crate::drawing::register_font().map_err(io::Error::other)?;
         {
             let root = BitMapBackend::with_buffer(&mut self.rgb, (self.width, self.height))
                 .into_drawing_area();

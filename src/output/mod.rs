@@ -23,9 +23,10 @@
 
 pub mod dump;
 
-use crate::methods::output::{MethodOutput, Visibility};
+use crate::methods::output::MethodOutput;
 use crate::metrics::error_report::ErrorReport;
 use crate::metrics::ErrorStats;
+use crate::visibility::Visibility;
 use image::codecs::openexr::OpenExrEncoder;
 use image::codecs::png::PngEncoder;
 use image::{ExtendedColorType, ImageEncoder};

@@ -1,4 +1,4 @@
-//! The frame plans of a scene's methods ([`crate::plan::MethodPlan`], as `stats.json` holds
+//! The frame plans of a scene's methods ([`crate::methods::output::MethodPlan`], as `stats.json` holds
 //! it) in one collapsible `<details>`: per method its passes in order with their time and
 //! counters, the buffers it allocated, and its settings after option parsing and automatic
 //! decisions; and the one-line summary of those settings that the table shows.

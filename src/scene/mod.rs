@@ -12,6 +12,7 @@
 //! [`Scene`] has been validated ([`validate`]): finite numbers, non-degenerate light and
 //! camera, closed two-manifold meshes.
 
+pub mod adjacency;
 pub mod builtin;
 pub mod file;
 pub mod input_file;

@@ -235,7 +235,7 @@ pub(crate) fn check_transform(m: &Mat4) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::adjacency;
+    use crate::scene::adjacency;
     use crate::scene::procedural::signed_volume6;
 
     /// A unit cube written as 6 quads in three groups sharing vertices.

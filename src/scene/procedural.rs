@@ -300,7 +300,7 @@ pub fn signed_volume6(mesh: &Mesh) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::adjacency;
+    use crate::scene::adjacency;
 
     const C: [f32; 3] = [0.5; 3];
 

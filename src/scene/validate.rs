@@ -8,7 +8,7 @@
 //! non-zero, not parallel, the light at least [`MIN_RECT_LIGHT_WIDTH`] of its length wide;
 //! disk normal non-zero; a non-empty texture of `width·height`
 //! texels in `[0, 1]`, emitting in every channel); at least one mesh, each a closed, consistently wound two-manifold
-//! ([`crate::geometry::adjacency::build`], the message names the offending edge) that is not
+//! ([`crate::scene::adjacency::build`], the message names the offending edge) that is not
 //! inside out (signed volume not negative; flat two-sided meshes have volume 0); every light
 //! centre strictly outside every mesh (bounding box, then ray parity), and every light's
 //! shape (sphere, disk, rectangle) apart from every mesh ([`light_shape_touches`]); `ambient` in `[0, 1]`;
@@ -16,8 +16,8 @@
 
 use super::{Camera, Light, LightShape, Mesh, Scene};
 use crate::error::InputError;
-use crate::geometry::adjacency;
 use crate::limits::{MAX_IMAGE_SIZE, MAX_LIGHTS, MIN_RECT_LIGHT_WIDTH, MIN_VFOV_DEG};
+use crate::scene::adjacency;
 use glam::{DVec3, Vec3};
 
 /// Checks every invariant a [`Scene`] promises (see the module docs); the first violation is

@@ -1,8 +1,8 @@
 //! Helpers shared by the `ssv` integration tests (`soft_shadow_volumes`, `ssv_sphere`).
 
-use penumbra::methods::output::Visibility;
 use penumbra::render::render_scene;
 use penumbra::scene::Scene;
+use penumbra::visibility::Visibility;
 
 /// Jittered strata per side of the `raycast` reference (1024 samples).
 pub const K: f64 = 32.0;

@@ -5,8 +5,8 @@
 //! silhouette edges nearly parallel to the light direction, geometry far from the origin — and the
 //! scene and buffer helpers those tests share.
 
-use penumbra::methods::output::Visibility;
 use penumbra::scene::{builtin, LightShape, Scene};
+use penumbra::visibility::Visibility;
 
 /// The values of a gray visibility buffer.
 pub fn gray(v: &Visibility) -> Vec<f32> {

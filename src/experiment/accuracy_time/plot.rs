@@ -27,9 +27,8 @@ pub const MARKERS: usize = 8;
 
 /// The colour of `method` (Tableau 10, by its position in [`methods::ALL`]).
 pub fn method_colour(method: &str) -> RGBColor {
-    let k = methods::ALL
-        .iter()
-        .position(|m| *m == method)
+    let k = methods::names()
+        .position(|m| m == method)
         .unwrap_or(PALETTE.len() - 1);
     PALETTE[k % PALETTE.len()]
 }

@@ -130,7 +130,7 @@ pub mod vbuffer;
 
 use super::dump::{row_major, BufferDump, DumpValues, ElementFormat, EventKind, EventMap};
 use super::hard_sv::{shadow_test, volume_stencil_state, ShadowTest, StencilOverflow};
-use super::output::{MethodOutput, PassStats, Visibility};
+use super::output::MethodOutput;
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, FULL_SCREEN};
 use crate::geometry::loops::silhouette_loops;
@@ -151,9 +151,12 @@ use crate::gpu::tiling::Tiling;
 use crate::gpu::transform::{ClipVertex, WindowPlane};
 use crate::light::coverage::{quad_side, RectLight};
 use crate::light::radial_parts::{edge_in_parts, read, stored, PART_COUNT};
+use crate::methods::hard_sv::CountMode;
+use crate::methods::output::{BufferPlan, MethodPlan};
 use crate::options::{option_names, option_table, OptionTable, OptionType, Switch};
-use crate::plan::{BufferPlan, CountMode, MethodPlan};
+use crate::pass::PassStats;
 use crate::scene::LightShape;
+use crate::visibility::Visibility;
 use blend::{blend_part, BlendCase, InnerAdjust, PartState, Rules};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -1238,6 +1241,21 @@ fn blending_dumps<S: VBufferStorage>(
     dumps.push(stencil);
     dumps
 }
+
+/// `wedge-blending` in the registry ([`crate::methods::ALL`]).
+pub const METHOD: crate::methods::Method = crate::methods::Method {
+    name: "wedge-blending",
+    paper: "Forest et al., GH 2006: penumbra-wedges blending",
+    // Forest et al. 2006 §4.2: rectangular lights, in light space [−1, 1]².
+    supports: |s| matches!(s, LightShape::Rect { .. }),
+    lights: crate::methods::SeveralLights::PerLight,
+    options: crate::methods::OptionTableSpec::of::<WedgeBlendingOptions>(),
+    // Sized for packing = f32 (two RGBA32F targets per vBuffer; 8bit needs about a third).
+    bytes_per_pixel: 384,
+    default_run: crate::methods::DefaultRun::EveryScene,
+    check: |frame| options(frame).map(drop),
+    run,
+};
 
 /// Run `wedge-blending` on a rendered frame.
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {

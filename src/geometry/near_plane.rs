@@ -1,36 +1,10 @@
-//! The frame plan (`docs/architecture.md` "Only the effects a scene calls
-//! for"): derived from the scene
-//! before anything is allocated — which methods run, which passes and buffers each needs, and
-//! whether z-fail is needed because the eye sits inside a shadow volume (detected, not asked).
+//! Whether the eye or the near plane lies in a hard shadow volume — the z-fail decision
+//! (`docs/architecture.md` "Only the effects a scene calls for": detected, not asked) — and
+//! the exact f64 segment–mesh tests it is made of, which tests also use as hard-shadow ground
+//! truth.
 
-use crate::options::option_names;
 use crate::scene::{LightShape, Scene};
 use glam::{DVec3, Vec3};
-
-option_names! {
-    /// The `mode` option of the methods that count shadow-volume boundaries: z-pass, z-fail, or
-    /// `auto`, decided from the frame ([`CountMode::zfail`]).
-    pub enum CountMode {
-        /// z-fail when the near plane is in shadow ([`eye_in_shadow`]), else z-pass.
-        Auto = "auto",
-        /// Count between the eye and the receiver.
-        ZPass = "zpass",
-        /// Count between the receiver and infinity (caps needed).
-        ZFail = "zfail",
-    }
-}
-
-impl CountMode {
-    /// Whether to count z-fail: as asked, or with `Auto` when the near plane at distance `near`
-    /// is in the shadow of one of `lights` ([`eye_in_shadow`]).
-    pub fn zfail(self, scene: &Scene, near: f64, lights: &[Vec3]) -> bool {
-        match self {
-            CountMode::ZPass => false,
-            CountMode::ZFail => true,
-            CountMode::Auto => eye_in_shadow(scene, near, lights),
-        }
-    }
-}
 
 /// Grid of near-plane points tested for shadow (per side).
 const NEAR_GRID: u32 = 9;
@@ -265,125 +239,6 @@ fn segment_hits_triangle(p: DVec3, d: DVec3, a: DVec3, b: DVec3, c: DVec3) -> bo
     }
     let t = e2.dot(q) * inv;
     t > 0.0 && t < 1.0
-}
-
-/// One buffer a pass uses.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct BufferPlan {
-    /// Buffer name.
-    pub name: String,
-    /// Storage format, e.g. `D24`, `S8`, `f64x3 accumulator`.
-    pub format: String,
-    /// Bytes per sample.
-    pub bytes_per_sample: u32,
-}
-
-impl BufferPlan {
-    /// The hierarchical-Z unit's per-tile zmin and zmax of the scene depth
-    /// ([`crate::gpu::hiz`]): two values in the depth format per tile, as whole bytes per
-    /// sample rounded up.
-    pub fn hiz_zmin_zmax(gpu: &crate::frame::GpuSettings) -> Self {
-        Self::zmin_zmax("", gpu.depth, gpu.hiz_tile_size)
-    }
-
-    /// [`BufferPlan::hiz_zmin_zmax`] of a depth target seen from the light (`target`, e.g.
-    /// "shadow map": its early Z, [`crate::gpu::light_view::LightView::render_depth_probed`]),
-    /// in its `depth` format with HiZ tiles of edge `hiz_tile`.
-    pub fn hiz_zmin_zmax_of(
-        target: &str,
-        depth: crate::gpu::depth::DepthFormat,
-        hiz_tile: u32,
-    ) -> Self {
-        Self::zmin_zmax(&format!(" of the {target}"), depth, hiz_tile)
-    }
-
-    fn zmin_zmax(of: &str, depth: crate::gpu::depth::DepthFormat, hiz_tile: u32) -> Self {
-        Self {
-            name: format!("tile zmin/zmax{of} (2 per {hiz_tile}×{hiz_tile} HiZ tile)"),
-            format: format!("{depth:?}"),
-            bytes_per_sample: (2 * depth.bytes() as u32).div_ceil(hiz_tile * hiz_tile),
-        }
-    }
-
-    /// The hierarchical-Z unit's per-tile stencil summary (`ssv-optimized`: the last half
-    /// that marked the tile, [`crate::gpu::hiz`]): one byte per tile, as whole bytes per
-    /// sample rounded up.
-    pub fn hiz_stencil_summary(gpu: &crate::frame::GpuSettings) -> Self {
-        Self {
-            name: format!("tile stencil summary (1 per {0}×{0} tile)", gpu.tile_size),
-            format: "u8".into(),
-            bytes_per_sample: 1u32.div_ceil(gpu.tile_size * gpu.tile_size),
-        }
-    }
-
-    /// The hierarchical-Z unit's per-tile receiver bounds ([`crate::gpu::hiz::TileReceiverBounds`]):
-    /// six f32 per tile and per block of tiles, as whole bytes per sample rounded up.
-    pub fn hiz_receiver_bounds(gpu: &crate::frame::GpuSettings) -> Self {
-        let tile_len = gpu.tile_size * gpu.tile_size;
-        Self {
-            name: format!(
-                "tile receiver bounds (6 per {0}×{0} tile and per {1}×{1} tiles)",
-                gpu.tile_size,
-                crate::gpu::hiz::BLOCK_TILES
-            ),
-            format: "f32x6".into(),
-            bytes_per_sample: (crate::gpu::hiz::TileReceiverBounds::READ_BYTES as u32)
-                .div_ceil(tile_len),
-        }
-    }
-
-    /// The frame's scene depth buffer, in the format the frame uses.
-    pub fn depth(gpu: &crate::frame::GpuSettings) -> Self {
-        Self {
-            name: "depth".into(),
-            format: format!("{:?}", gpu.depth),
-            bytes_per_sample: gpu.depth.bytes() as u32,
-        }
-    }
-
-    /// A depth target named `name` (a shadow map, a map's depth channel) in `format`.
-    pub fn depth_target(name: String, format: crate::gpu::depth::DepthFormat) -> Self {
-        Self {
-            name,
-            format: format!("{format:?}"),
-            bytes_per_sample: format.bytes() as u32,
-        }
-    }
-
-    /// A colour target named `name` with `channels` channels, each in `format`.
-    pub fn color_target(
-        name: String,
-        format: crate::gpu::color::ColorFormat,
-        channels: u32,
-    ) -> Self {
-        Self {
-            name,
-            format: format!("{format:?}"),
-            bytes_per_sample: channels * format.bytes() as u32,
-        }
-    }
-
-    /// An 8-bit stencil buffer.
-    pub fn stencil8() -> Self {
-        Self {
-            name: "stencil".into(),
-            format: "S8".into(),
-            bytes_per_sample: 1,
-        }
-    }
-}
-
-/// What one method will do for this frame.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct MethodPlan {
-    /// Method name.
-    pub method: String,
-    /// Pass names in execution order.
-    pub passes: Vec<String>,
-    /// Buffers allocated.
-    pub buffers: Vec<BufferPlan>,
-    /// Method settings after option parsing and automatic decisions.
-    pub settings: serde_json::Value,
 }
 
 #[cfg(test)]
