@@ -62,7 +62,7 @@ pub const ALL: &[&str] = &[
 /// The reference every other method's error is measured against.
 pub const REFERENCE: &str = "raycast";
 
-/// The paper `method` reproduces, in a few words (`../shared/papers/README.md`; Papers I–V
+/// The paper `method` reproduces, in a few words (`docs/papers.md`; Papers I–V
 /// are those of Assarsson's thesis), for captions; an empty string for an unknown name.
 pub fn paper(method: &str) -> &'static str {
     match method {
