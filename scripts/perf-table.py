@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The performance table of docs/performance.md, measured again.
+"""The performance table of docs/experiments.md ("Performance"), measured again.
 
     scripts/perf-table.py [--bin target/release/penumbra] [--vs OTHER_BINARY] [--runs 5]
                           [--rows hard-sv,wedges,optimized,forest,culling,threads,default]

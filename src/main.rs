@@ -49,6 +49,9 @@ enum Cmd {
         /// Print instead every option table's keys: values, default and meaning.
         #[arg(long)]
         options: bool,
+        /// With --options: print the listing as Markdown, the page docs/options.md.
+        #[arg(long, requires = "options")]
+        markdown: bool,
     },
     /// Run an experiment, or merge the shards of an accuracy–time sweep.
     #[command(subcommand)]
@@ -602,14 +605,19 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
         Some(Cmd::Render(a)) => render(&a, dumps).map(|_| ()),
         Some(Cmd::Report(a)) => report(&a, dumps),
         Some(Cmd::Probe(a)) => probe(a),
-        Some(Cmd::List { options: true }) => {
-            print!(
-                "{}",
-                penumbra::options::listing(&penumbra::methods::option_docs())
-            );
+        Some(Cmd::List {
+            options: true,
+            markdown,
+        }) => {
+            let tables = penumbra::methods::option_docs();
+            if markdown {
+                print!("{}", penumbra::options::markdown(&tables));
+            } else {
+                print!("{}", penumbra::options::listing(&tables));
+            }
             Ok(())
         }
-        Some(Cmd::List { options: false }) => {
+        Some(Cmd::List { options: false, .. }) => {
             println!("# built-in scenes");
             for n in builtin::names() {
                 println!("{n}");

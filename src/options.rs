@@ -4,8 +4,9 @@
 //! Each table is declared once, with the crate's `option_table!` macro: the declaration is the
 //! struct a method reads (a field per key, with its type, the values it accepts, its default
 //! and a doc line), the parser that fills it ([`OptionTable::read`]) and what
-//! `penumbra list --options` prints ([`listing`]), so the three cannot disagree. Choices are
-//! enums whose spellings are declared once with `option_names!`.
+//! `penumbra list --options` prints ([`listing`]; as Markdown, the page `docs/options.md`:
+//! [`markdown`]), so they cannot disagree. Choices are enums whose spellings are declared once
+//! with `option_names!`.
 //!
 //! * **Keys** are kebab-case: the field `slope_bias` is the key `slope-bias` ([`key_name`]). An
 //!   unknown key is an error that names the valid keys, and the one meant when it is close
@@ -491,6 +492,44 @@ pub fn listing(tables: &[(&str, Vec<KeyDoc>)]) -> String {
                 key.key,
                 key.accepted.listed(),
                 key.meaning
+            );
+        }
+    }
+    out
+}
+
+/// `docs/options.md`: what [`listing`] prints for `tables`, as Markdown (`penumbra list
+/// --options --markdown`), under a header saying how the page is made and where the keys'
+/// syntax and their meaning in each method are described: a section per table, a row per key
+/// (key, values accepted, default, meaning). A `|` in a cell is escaped (`\|`), so that it
+/// does not end the cell (GitHub-flavoured Markdown).
+pub fn markdown(tables: &[(&str, Vec<KeyDoc>)]) -> String {
+    let cell = |text: &str| text.replace('|', "\\|");
+    let mut out = String::from(concat!(
+        "# Options\n\n",
+        "<!-- Generated from the option tables' declarations by ",
+        "`cargo run --release -- list --options --markdown > docs/options.md`. ",
+        "Do not edit: tests/options.rs fails when this file differs from the code. -->\n\n",
+        "Every key of every option table, as `penumbra list --options` prints it. A method's ",
+        "keys are set with `[options.METHOD]` in a scene file or `--opt METHOD.KEY=VALUE` on ",
+        "the command line, those of every pass with `[options.gpu]`; how values are written ",
+        "and checked: [scene-format.md](scene-format.md#options) and [cli.md](cli.md). What ",
+        "each method's options do, with their findings: [methods.md](methods.md).\n",
+    ));
+    for (name, keys) in tables {
+        out += &format!(
+            "\n## `[options.{name}]`\n\n| key | accepts | default | meaning |\n|---|---|---|---|\n"
+        );
+        for key in keys {
+            let default = match &key.default {
+                DefaultValue::Written(v) => format!("`{v}`"),
+                DefaultValue::FromScene(rule) => cell(rule),
+            };
+            out += &format!(
+                "| `{}` | {} | {default} | {} |\n",
+                key.key,
+                cell(&key.accepted.listed()),
+                cell(&key.meaning)
             );
         }
     }

@@ -1,7 +1,7 @@
-//! The command line on bad input (README "Command line", `docs/architecture.md` "Bad input"): every
-//! bad scene file and bad argument gets exactly one line on stderr naming the file and the problem,
-//! exit status 2, and no output at all — the `--out` directory is not created, and an existing one
-//! is left untouched. Plus the good path: one small render writes every documented file and a
+//! The command line on bad input (`docs/cli.md` "Errors and exit codes",
+//! `docs/architecture.md` "Bad input"): every bad scene file and bad argument gets exactly one
+//! line on stderr naming the file and the problem, exit status 2, and no output at all — the
+//! `--out` directory is not created, and an existing one is left untouched. Plus the good path: one small render writes every documented file and a
 //! `stats.json` with the documented keys, and `penumbra list` prints the built-in scenes and the
 //! methods one per line.
 //!
@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// The crate root (the binary runs there, so relative scene paths match the README).
+/// The crate root (the binary runs there, so relative scene paths match the docs' examples).
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }

@@ -1,13 +1,15 @@
-//! The option tables as users see them (README "Options"): `penumbra list --options` is
-//! generated from the tables' declarations, README reproduces it exactly (so the two cannot
-//! drift), README spells no key in snake case, `render --help` points to the listing, and the
-//! default the listing prints for every key reads back as that default.
+//! The option tables as users see them: `penumbra list --options` is generated from the
+//! tables' declarations, `docs/options.md` is exactly its Markdown form (`list --options
+//! --markdown`, so the two cannot drift), no page (README, CONTRIBUTING, docs/) spells a key
+//! in snake case, `render --help` points to the listing, and the default the listing prints
+//! for every key reads back as that default. Also the pages' relative links: each points to a
+//! file of the repository and, with `#anchor`, to one of its headings.
 
 use penumbra::frame::GpuOptions;
 use penumbra::methods::raycast::RaycastOptions;
 use penumbra::methods::{self, dbuffer, hard_sv, nsample, penumbra_map, pw2002, pw_restructured};
 use penumbra::methods::{ssv, ssv_optimized, wedge_blending};
-use penumbra::options::{listing, DefaultValue, OptionTable};
+use penumbra::options::{listing, markdown, DefaultValue, OptionTable};
 use penumbra::scene::{builtin, OptionValue};
 use std::collections::BTreeSet;
 use std::fmt::Debug;
@@ -24,27 +26,31 @@ fn penumbra(args: &[&str]) -> String {
     String::from_utf8(out.stdout).expect("UTF-8")
 }
 
-fn readme() -> String {
-    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md"))
-        .expect("README.md")
+/// The crate root: README.md, docs/ and CONTRIBUTING.md are read from there.
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// The first fenced block after the heading `### Options` of README.
-fn readme_listing() -> String {
-    let text = readme();
-    let section = text
-        .split_once("\n### Options\n")
-        .expect("README has a section \"### Options\"")
-        .1;
-    let block = section
-        .split_once("```text\n")
-        .expect("a ```text block in README \"Options\"")
-        .1;
-    block
-        .split_once("```")
-        .expect("the block is closed")
-        .0
-        .to_string()
+/// The hand-written and generated Markdown pages users read: README.md, CONTRIBUTING.md and
+/// every `docs/*.md`, as (path relative to the root, text), sorted by path.
+fn pages() -> Vec<(String, String)> {
+    let mut names = vec!["README.md".to_string(), "CONTRIBUTING.md".to_string()];
+    for entry in std::fs::read_dir(root().join("docs")).expect("docs/") {
+        let name = entry.expect("docs/ entry").file_name();
+        let name = name.to_str().expect("UTF-8 file name");
+        if name.ends_with(".md") {
+            names.push(format!("docs/{name}"));
+        }
+    }
+    names.sort();
+    names
+        .into_iter()
+        .map(|n| {
+            let text =
+                std::fs::read_to_string(root().join(&n)).unwrap_or_else(|e| panic!("{n}: {e}"));
+            (n, text)
+        })
+        .collect()
 }
 
 /// The (table, key) pairs a listing names: `[options.TABLE]` headers and `  KEY = …` lines.
@@ -64,24 +70,62 @@ fn keys_of(listing: &str) -> BTreeSet<(String, String)> {
 }
 
 #[test]
-fn readme_lists_exactly_the_keys_the_program_lists() {
+fn the_listing_has_every_table_and_is_what_the_program_prints() {
     let printed = penumbra(&["list", "--options"]);
     assert_eq!(printed, listing(&methods::option_docs()));
-    let documented = readme_listing();
-    let (code, readme) = (keys_of(&printed), keys_of(&documented));
-    let missing: Vec<_> = code.difference(&readme).collect();
-    let stale: Vec<_> = readme.difference(&code).collect();
-    assert!(
-        missing.is_empty() && stale.is_empty(),
-        "README \"Options\" lacks {missing:?} and names keys that do not exist: {stale:?}"
-    );
     // Every table, every key: at least one key per table and the tables the registry has.
+    let code = keys_of(&printed);
     let tables: BTreeSet<&str> = code.iter().map(|(t, _)| t.as_str()).collect();
     let expected: BTreeSet<&str> = ["gpu"].into_iter().chain(methods::names()).collect();
     assert_eq!(tables, expected);
-    assert_eq!(
-        documented, printed,
-        "README \"Options\" is not the output of `penumbra list --options`: paste it"
+    let declared: usize = methods::option_docs().iter().map(|(_, k)| k.len()).sum();
+    assert_eq!(code.len(), declared, "a key is listed twice or not at all");
+}
+
+/// The command that regenerates docs/options.md, as the failure message says it.
+const REGENERATE: &str = "cargo run --release -- list --options --markdown > docs/options.md";
+
+#[test]
+fn docs_options_md_is_what_the_code_generates() {
+    let printed = penumbra(&["list", "--options", "--markdown"]);
+    assert_eq!(printed, markdown(&methods::option_docs()));
+    let page = std::fs::read_to_string(root().join("docs/options.md")).expect("docs/options.md");
+    assert!(
+        page == printed,
+        "docs/options.md is not what the code generates: run `{REGENERATE}` and commit it"
+    );
+    // The page names every key of every table, each in its table's section.
+    for (table, keys) in methods::option_docs() {
+        let section = page
+            .split_once(&format!("\n## `[options.{table}]`\n"))
+            .unwrap_or_else(|| panic!("docs/options.md has no section [options.{table}]"))
+            .1;
+        let section = section.split_once("\n## ").map_or(section, |(s, _)| s);
+        for k in keys {
+            assert!(
+                section.contains(&format!("\n| `{}` | ", k.key)),
+                "docs/options.md [options.{table}] lacks {}",
+                k.key
+            );
+        }
+    }
+}
+
+#[test]
+fn markdown_escapes_the_bar_in_cells() {
+    // dbuffer's eq3 meaning writes |cx| and ssv's filter values are `a | b | c`: each `|`
+    // inside a cell is `\|`, so every key's row has exactly the table's five separators.
+    let page = markdown(&methods::option_docs());
+    let rows: Vec<&str> = page.lines().filter(|l| l.starts_with("| `")).collect();
+    let declared: usize = methods::option_docs().iter().map(|(_, k)| k.len()).sum();
+    assert_eq!(rows.len(), declared);
+    for row in rows {
+        let unescaped = row.replace("\\|", "");
+        assert_eq!(unescaped.matches('|').count(), 5, "{row}");
+    }
+    assert!(
+        page.contains("(\\|cx\\| − \\|cx_s\\|)"),
+        "dbuffer eq3's meaning"
     );
 }
 
@@ -110,9 +154,11 @@ fn keys_are_kebab_case_unique_and_documented() {
     }
 }
 
+/// A paragraph may write a key's old snake-case spelling only to say what it is now: beside
+/// the kebab-case key (docs/accuracy-time.md on its plots' labels).
 #[test]
-fn readme_spells_no_key_in_snake_case() {
-    let text = readme();
+fn no_page_spells_a_key_in_snake_case_but_beside_its_name() {
+    let pages = pages();
     for (table, keys) in methods::option_docs() {
         for k in keys.iter().filter(|k| k.key.contains('-')) {
             let snake = k.key.replace('-', "_");
@@ -121,14 +167,141 @@ fn readme_spells_no_key_in_snake_case() {
                 format!("{snake} ="),
                 format!("{snake}="),
             ] {
-                assert!(
-                    !text.contains(&written),
-                    "README writes {written:?}; [options.{table}] spells it {}",
-                    k.key
-                );
+                for (name, text) in &pages {
+                    for paragraph in text.split("\n\n") {
+                        assert!(
+                            !paragraph.contains(&written) || paragraph.contains(&k.key),
+                            "{name} writes {written:?}; [options.{table}] spells it {}",
+                            k.key
+                        );
+                    }
+                }
             }
         }
     }
+}
+
+/// Pages that other branches add, linked before they are merged: a link to one of these may
+/// point to a missing file. Once a file exists, the test fails until it is removed here.
+const ARRIVING: &[&str] = &["docs/mesh-formats.md", "docs/mesh-repair.md"];
+
+/// The lines of a Markdown text outside fenced code blocks.
+fn prose_lines(text: &str) -> Vec<&str> {
+    let mut lines = Vec::new();
+    let mut in_code = false;
+    for line in text.lines() {
+        if line.trim_start().starts_with("```") {
+            in_code = !in_code;
+        } else if !in_code {
+            lines.push(line);
+        }
+    }
+    lines
+}
+
+/// The anchors of a Markdown text's headings, as GitHub makes them: the heading's text in
+/// lower case, letters, digits, `-` and `_` kept, spaces made `-`, everything else dropped.
+fn anchors(text: &str) -> BTreeSet<String> {
+    prose_lines(text)
+        .into_iter()
+        .filter_map(|l| {
+            l.trim_start_matches('#')
+                .strip_prefix(' ')
+                .filter(|_| l.starts_with('#'))
+        })
+        .map(|heading| {
+            heading
+                .trim()
+                .to_lowercase()
+                .chars()
+                .filter_map(|c| match c {
+                    ' ' => Some('-'),
+                    '-' | '_' => Some(c),
+                    c if c.is_alphanumeric() => Some(c),
+                    _ => None,
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// The targets of the inline links `](TARGET)` of a Markdown text, outside code blocks.
+fn link_targets(text: &str) -> Vec<String> {
+    let mut targets = Vec::new();
+    for line in prose_lines(text) {
+        let mut rest = line;
+        while let Some(at) = rest.find("](") {
+            let after = &rest[at + 2..];
+            let Some(end) = after.find(')') else { break };
+            targets.push(after[..end].to_string());
+            rest = &after[end..];
+        }
+    }
+    targets
+}
+
+#[test]
+fn every_relative_link_of_the_pages_points_to_a_file_and_heading() {
+    let mut broken = Vec::new();
+    for (name, text) in pages() {
+        let dir = Path::new(&name).parent().expect("a page's directory");
+        for target in link_targets(&text) {
+            if target.contains("://") || target.starts_with("mailto:") {
+                continue;
+            }
+            let (file, anchor) = target.split_once('#').unwrap_or((&target, ""));
+            if file.is_empty() {
+                if !anchors(&text).contains(anchor) {
+                    broken.push(format!("{name}: ({target}): no such heading"));
+                }
+                continue;
+            }
+            let path = dir.join(file);
+            let normal: String = path
+                .components()
+                .fold(Vec::<&str>::new(), |mut parts, c| {
+                    match c {
+                        std::path::Component::ParentDir => {
+                            parts.pop();
+                        }
+                        std::path::Component::Normal(p) => parts.push(p.to_str().expect("UTF-8")),
+                        _ => {}
+                    }
+                    parts
+                })
+                .join("/");
+            if ARRIVING.contains(&normal.as_str()) {
+                continue;
+            }
+            match std::fs::read_to_string(root().join(&normal)) {
+                Err(_) if !root().join(&normal).exists() => {
+                    broken.push(format!("{name}: ({target}) -> {normal}: no such file"));
+                }
+                Ok(linked) if !anchor.is_empty() && !anchors(&linked).contains(anchor) => {
+                    broken.push(format!("{name}: ({target}): no such heading in {normal}"));
+                }
+                _ => {}
+            }
+        }
+    }
+    assert!(broken.is_empty(), "broken links: {broken:#?}");
+    for arriving in ARRIVING {
+        assert!(
+            !root().join(arriving).exists(),
+            "{arriving} exists now: remove it from ARRIVING in tests/options.rs"
+        );
+    }
+}
+
+#[test]
+fn link_targets_and_anchors_read_markdown_outside_code() {
+    let text = "see [a](a.md) and [b](../b.md#x)\n```\n[c](c.md)\n# Not\n```\n![d](d.png)\n\
+                ## The GPU: `[options.gpu]`\n### Errors and exit_codes\n#hashtag";
+    assert_eq!(link_targets(text), ["a.md", "../b.md#x", "d.png"]);
+    let expected: BTreeSet<String> = ["the-gpu-optionsgpu", "errors-and-exit_codes"]
+        .map(String::from)
+        .into();
+    assert_eq!(anchors(text), expected);
 }
 
 #[test]
