@@ -1023,6 +1023,7 @@ mod tests {
             triangles,
             color: [0.8; 3],
             receiver_only: false,
+            repairs: Default::default(),
         }
     }
 
@@ -1067,6 +1068,7 @@ mod tests {
             triangles,
             color: [0.8; 3],
             receiver_only: false,
+            repairs: Default::default(),
         }
     }
 
