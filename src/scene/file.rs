@@ -978,6 +978,42 @@ f = 0.5
         assert!(e.contains("ambient"), "{e}");
     }
 
+    /// The repair keys: bad values name `meshes[I].open` / `.weld_tolerance`; an open mesh
+    /// is capped by default and refused with `open = "refuse"`.
+    #[test]
+    fn repair_keys() {
+        let dir = fixture();
+        std::fs::write(
+            dir.join("open.obj"),
+            "v 0 1 0\nv 0 2 0\nv 1 1 0\nv 0 1 1\nf 1 3 4\nf 1 2 3\nf 1 4 2\n",
+        )
+        .unwrap();
+        let with =
+            |keys: &str| GOOD.replace("obj = \"tet.obj\"", &format!("obj = \"open.obj\"\n{keys}"));
+        let s = toml_in(&dir, &with("")).unwrap();
+        assert_eq!(s.meshes[1].repairs.holes_closed, 1);
+        assert_eq!(s.meshes[1].triangles.len(), 4);
+        let e = toml_in(&dir, &with("open = \"refuse\""))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("open.obj): open mesh: edge "), "{e}");
+        let e = toml_in(&dir, &with("open = \"seal\""))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "s.toml: meshes[1].open: unknown treatment \"seal\" (expected \"close\", \"shell\" \
+             or \"refuse\")"
+        );
+        let e = toml_in(&dir, &with("weld_tolerance = -1.0"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("s.toml: meshes[1].weld_tolerance: -1 must be"),
+            "{e}"
+        );
+    }
+
     #[test]
     fn texture_light() {
         let dir = fixture();

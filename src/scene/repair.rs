@@ -253,6 +253,9 @@ pub fn repair_notes(scene: &Scene) -> Vec<String> {
 /// clipping and its simplicity test are quadratic to cubic in the loop length).
 pub const MAX_EAR_CLIP_LOOP: usize = 256;
 
+/// What [`repair`] returns: the positions and triangles to render, and what was changed.
+pub type Repaired = (Vec<Vec3>, Vec<[u32; 3]>, MeshRepairs);
+
 /// Repairs one mesh (module docs): returns the positions and triangles to render and what
 /// was changed. Errors (one sentence, without the mesh's name, which the caller adds): an
 /// index out of range, a non-finite position, no triangle left, a non-manifold edge whose
@@ -261,7 +264,7 @@ pub fn repair(
     positions: Vec<Vec3>,
     triangles: Vec<[u32; 3]>,
     options: &RepairOptions,
-) -> Result<(Vec<Vec3>, Vec<[u32; 3]>, MeshRepairs), String> {
+) -> Result<Repaired, String> {
     let mut r = MeshRepairs::default();
     if positions.len() >= u32::MAX as usize || triangles.len() > (u32::MAX / 3) as usize {
         return Err(format!(
