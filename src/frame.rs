@@ -707,6 +707,7 @@ mod tests {
             triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
             color: [0.5; 3],
             receiver_only: false,
+            repairs: Default::default(),
         });
         crate::scene::validate::validate(&s).unwrap();
         // Outside the tetrahedron, looking along its face x = 1 toward −z; the near plane's

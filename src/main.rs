@@ -239,6 +239,12 @@ fn prepare(
     if let Some(w) = validate::f32_rounding_warning(&scene) {
         eprintln!("penumbra: {w}");
     }
+    for line in penumbra::scene::repair::repair_notes(&scene) {
+        eprintln!(
+            "penumbra: {}: warning: {line}",
+            penumbra::error::shortened(&scene.source)
+        );
+    }
     Ok(scene)
 }
 

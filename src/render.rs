@@ -249,6 +249,9 @@ pub fn table_notes(scene: &Scene, runs: &[MethodRun]) -> Vec<String> {
             methods::REFERENCE
         ));
     }
+    for line in crate::scene::repair::repair_notes(scene) {
+        notes.push(format!("warning: {line}"));
+    }
     for r in runs {
         for w in &r.output.stats.warnings {
             notes.push(format!("warning: {}: {w}", r.method));

@@ -273,6 +273,7 @@ fn l_slab() -> Mesh {
         triangles,
         color: [0.5; 3],
         receiver_only: false,
+        repairs: Default::default(),
     }
 }
 

@@ -207,3 +207,149 @@ fn a_directory_is_not_a_scene_file() {
         )
     );
 }
+
+/// A scene in a fresh temporary folder: a floor (the unit cube flattened) and one mesh from
+/// `obj` (an absolute path) with the extra mesh keys `keys`, lit by a rectangle from above.
+fn repair_scene(obj: &Path, keys: &str, size: u32, methods: &str) -> PathBuf {
+    static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("penumbra-repair-{}-{n}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cube = scenes_dir().join("models/cube.obj");
+    let text = format!(
+        r#"width = {size}
+height = {size}
+{methods}
+[camera]
+eye = [0.0, 2.5, 4.0]
+target = [0.0, 0.4, 0.0]
+up = [0, 1, 0]
+vfov_deg = 45
+[light]
+type = "rect"
+center = [0.5, 3.5, 0.3]
+u = [0.4, 0, 0]
+v = [0, 0, 0.4]
+[[meshes]]
+obj = {cube:?}
+transform = [6, 0, 0, 0,   0, 0.1, 0, 0,   0, 0, 6, 0,   0, -0.05, 0, 1]
+[[meshes]]
+obj = {obj:?}
+{keys}
+"#
+    );
+    let path = dir.join("scene.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// The real spider model (assimp's test model, corners duplicated per group, holes, some
+/// flipped faces) loads with its repairs counted and named, and renders.
+#[test]
+fn a_real_model_is_repaired_and_reported() {
+    let spider = scenes_dir().join("models/spider.obj");
+    let keys = "scale = 0.01\ntranslate = [0, 0.45, 0]";
+    let path = repair_scene(&spider, keys, 32, "methods = [\"hard-sv\", \"ssv\"]");
+    let scene = load_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
+    let r = &scene.meshes[1].repairs;
+    let notes = penumbra::scene::repair::repair_notes(&scene);
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    assert_eq!(
+        notes[0],
+        format!(
+            "meshes[1] ({}): {}",
+            spider.display(),
+            "dropped 56 degenerate triangles, flipped 4 triangles to agree with their \
+             neighbours, closed 6 holes with 60 triangles"
+        )
+    );
+    assert_eq!(scene.meshes[0].repairs.summary(), None);
+    // tobj's welding (scene/obj.rs) already joined the corners; 72 boundary edges in 6 loops.
+    assert_eq!(r.degenerate_dropped, 56);
+    assert_eq!(r.boundary_edges, 72);
+    assert_eq!(r.became, "closed (6 holes capped)");
+    let runs = penumbra::render::render_scene(&scene).unwrap();
+    assert_eq!(runs.len(), 2);
+    for run in &runs {
+        let stats = &run.output.stats;
+        assert_eq!(stats.meshes.len(), 2);
+        assert_eq!(stats.meshes[1].repairs, *r);
+        assert_eq!(
+            stats.meshes[1].triangles,
+            scene.meshes[1].triangles.len() as u64
+        );
+    }
+    let notes = penumbra::render::table_notes(&scene, &runs);
+    assert!(notes.contains(&format!(
+        "warning: {}",
+        penumbra::scene::repair::repair_notes(&scene)[0]
+    )));
+}
+
+/// The mean |visibility − raycast| of each method of a 48×48 render of `path`, with every
+/// value finite and in [0, 1].
+fn errors_against_raycast(path: &Path) -> Vec<(String, f64)> {
+    let scene = load_scene_file(path).unwrap_or_else(|e| panic!("{e}"));
+    let runs = penumbra::render::render_scene(&scene).unwrap();
+    let mut out = Vec::new();
+    for run in &runs {
+        let values: Vec<f32> = match &run.output.visibility {
+            penumbra::methods::output::Visibility::Gray(v) => v.clone(),
+            penumbra::methods::output::Visibility::Rgb(v) => v.iter().flatten().copied().collect(),
+        };
+        assert!(
+            values
+                .iter()
+                .all(|v| v.is_finite() && (0.0..=1.0).contains(v)),
+            "{}: {}",
+            path.display(),
+            run.method
+        );
+        if let Some(e) = &run.error {
+            out.push((run.method.clone(), e.all.mean_abs));
+        }
+    }
+    out
+}
+
+/// A box without its top face, rendered by every method of the rectangle light: capped
+/// (`open = "close"`) it is the closed box again, so each method's mean error against
+/// raycast matches its error on the closed box within 0.002 (what a different
+/// triangulation of the cap can move); as a two-sided shell (`open = "shell"`) the methods
+/// see a surface that folds at the rim, and each one's mean error stays within 0.05 of its
+/// error on the closed box (the V-buffer methods' overlap where the shell folds,
+/// docs/mesh-repair.md).
+#[test]
+fn a_mesh_with_a_hole_renders_with_every_method() {
+    let open_box = scenes_dir().join("bad/models/open-box.obj");
+    let closed_box = scenes_dir().join("models/cube.obj");
+    // Both span [−0.4, 0.4] × [0.4, 1.2] × [−0.4, 0.4] (cube.obj is centred, open-box.obj
+    // spans [0, 1]³).
+    let place = "scale = 0.8\ntranslate = [0, 0.8, 0]";
+    let closed = errors_against_raycast(&repair_scene(&closed_box, place, 48, ""));
+    let place = "scale = 0.8\ntranslate = [-0.4, 0.4, -0.4]";
+    // Every method of the rectangle light besides the reference.
+    let names: Vec<&str> = closed.iter().map(|(m, _)| m.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "nsample",
+            "hard-sv",
+            "ssv-optimized",
+            "ssv",
+            "wedge-blending"
+        ]
+    );
+    for (open, bound) in [("close", 0.002), ("shell", 0.05)] {
+        let keys = format!("{place}\nopen = \"{open}\"");
+        let repaired = errors_against_raycast(&repair_scene(&open_box, &keys, 48, ""));
+        assert_eq!(repaired.len(), closed.len());
+        for ((m, e), (m0, e0)) in repaired.iter().zip(&closed) {
+            assert_eq!(m, m0);
+            assert!(
+                (e - e0).abs() <= bound,
+                "open = {open}: {m}: mean error {e} vs {e0} on the closed box"
+            );
+        }
+    }
+}

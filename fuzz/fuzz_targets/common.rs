@@ -756,6 +756,7 @@ impl EdgeInput {
             triangles: vec![[0, 1, 1]],
             color: [0.8; 3],
             receiver_only: false,
+            repairs: Default::default(),
         };
         let apart = light_shape_touches(&edge, &light).is_none();
         let [e0, e1] = ends.map(|e| e.as_dvec3());
@@ -1153,6 +1154,7 @@ pub fn tight_wedge(data: &[u8]) {
             triangles: Vec::new(),
             color: [0.8; 3],
             receiver_only: false,
+            repairs: Default::default(),
         }],
         methods: None,
         options: Default::default(),
@@ -1316,6 +1318,7 @@ pub fn pw_wedges(data: &[u8]) {
             triangles,
             color: [0.8; 3],
             receiver_only: false,
+            repairs: Default::default(),
         }],
         methods: None,
         options: Default::default(),

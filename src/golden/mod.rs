@@ -631,6 +631,7 @@ mod tests {
                 totals: Counters::default(),
                 warnings: vec![],
                 clamped_pixels: 0,
+                meshes: vec![],
             },
         }
     }

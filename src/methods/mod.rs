@@ -472,6 +472,12 @@ pub fn method_stats(
         totals,
         warnings: Vec::new(),
         clamped_pixels: 0,
+        meshes: frame
+            .scene
+            .meshes
+            .iter()
+            .map(crate::scene::repair::MeshReport::of)
+            .collect(),
     }
 }
 

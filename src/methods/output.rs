@@ -32,6 +32,9 @@ pub struct MethodStats {
     /// computed there was outside); 0 for methods whose result cannot leave [0, 1]. Summed over
     /// the lights of a scene with several lights.
     pub clamped_pixels: u64,
+    /// Each mesh of the scene: its name, triangle count and what repair changed
+    /// ([`crate::scene::repair::MeshReport`]), so that a result names the geometry it saw.
+    pub meshes: Vec<crate::scene::repair::MeshReport>,
 }
 
 /// The result of running one method on one scene.

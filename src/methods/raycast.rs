@@ -1239,6 +1239,7 @@ mod tests {
             triangles,
             color: [0.8; 3],
             receiver_only: false,
+            repairs: Default::default(),
         }
     }
 
@@ -1283,6 +1284,7 @@ mod tests {
             triangles,
             color: [0.8; 3],
             receiver_only: false,
+            repairs: Default::default(),
         }
     }
 

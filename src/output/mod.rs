@@ -11,7 +11,7 @@
 //! | `visibility.pfm` | PFM with the exact f32 bits (`Pf` gray / `PF` RGB) — what goldens compare |
 //! | `<name>.png`, `<name>.bin`, … | each buffer dump ([`dump`]): in every run the raw file of the dumps a method always hands back (`hard-sv`'s `stencil.png`, `wedge-blending`'s `penumbrae.png`, 8-bit grayscale, values as stored); with `--dump-buffers` every dump with its sidecar, viewable image and event map |
 //! | `error.png` | when the reference ran: the signed error against it, on the fixed scale of [`error_colour`](crate::metrics::error_report::error_colour) (white 0, red too bright, blue too dark) |
-//! | `stats.json` | [`MethodStats`](crate::methods::output::MethodStats) as pretty-printed JSON, plus `"error"`: the [`ErrorReport`] against the reference (whole image and penumbra only), or null with `"error_note"` when no reference ran; the reference itself has `"reference_noise_floor"` |
+//! | `stats.json` | [`MethodStats`](crate::methods::output::MethodStats) as pretty-printed JSON (its `"meshes"`: each mesh's name, triangle count and repairs), plus `"error"`: the [`ErrorReport`] against the reference (whole image and penumbra only), or null with `"error_note"` when no reference ran; the reference itself has `"reference_noise_floor"` |
 //!
 //! **No partial output** (`docs/architecture.md` "Bad input"): a run's method folders are
 //! written into a hidden staging folder inside the output directory and moved into place only
@@ -715,6 +715,7 @@ mod tests {
                 totals: Counters::default(),
                 warnings: vec![],
                 clamped_pixels: 0,
+                meshes: vec![],
             },
         }
     }

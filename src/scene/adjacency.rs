@@ -266,6 +266,7 @@ mod tests {
             triangles,
             color: [1.0; 3],
             receiver_only: false,
+            repairs: Default::default(),
         }
     }
 

@@ -567,6 +567,7 @@ fn heightfield(name: &str, heights: &[Vec<f64>], size: f64, base_y: f64) -> Mesh
         triangles,
         color: OCCLUDER,
         receiver_only: false,
+        repairs: Default::default(),
     }
 }
 

@@ -33,6 +33,12 @@
 //! # world axes, X first, then Y, then Z); translate = [tx, ty, tz]
 //! color = [0.8, 0.8, 0.8]     # optional, linear RGB albedo
 //! receiver_only = true        # optional: casts no shadow in any method, may be open
+//! # Repair (docs/mesh-repair.md; every repair is reported): all optional.
+//! weld = true                 # merge corners at equal positions (default true)
+//! weld_tolerance = 1e-6       # also within this fraction of the bounding-box diagonal (default 0)
+//! open = "close"              # open parts: "close" (cap the holes), "shell" (two-sided
+//!                             # surface) or "refuse"; default: close where every hole
+//!                             # ear-clips, else shell
 //!
 //! [options.nsample]           # per-method options, checked later by each method
 //! n = 256
@@ -47,6 +53,7 @@
 
 use super::input_file::read_input_file;
 use super::obj::{check_transform, load_obj};
+use super::repair::{repair, OpenTreatment, RepairOptions};
 use super::validate::validate;
 use super::{builtin, Camera, Light, LightShape, Mesh, OptionValue, RawOptions, RgbTexture, Scene};
 use crate::error::InputError;
@@ -134,6 +141,9 @@ struct MeshDef {
     translate: Option<Three>,
     color: Option<Three>,
     receiver_only: Option<bool>,
+    weld: Option<bool>,
+    weld_tolerance: Option<f64>,
+    open: Option<String>,
 }
 
 /// `scale`: one number for all three axes, or three numbers.
@@ -552,10 +562,46 @@ fn build_mesh(m: &MeshDef, i: usize, source: &str, base_dir: &Path) -> Result<Me
     let color = m.color.map_or(DEFAULT_COLOR, |c| c.0).map(|c| c as f32);
     let path = base_dir.join(&m.obj);
     let display = path.display().to_string();
+    let options = repair_options(m).map_err(|(field, e)| at(field, e))?;
+    let object = format!("meshes[{i}] ({display})");
     let mut mesh = load_obj(&path, &display, transform, color)
-        .map_err(|e| InputError::at(source, format!("meshes[{i}] ({display})"), e.message))?;
-    mesh.receiver_only = m.receiver_only.unwrap_or(false);
+        .map_err(|e| InputError::at(source, &object, e.message))?;
+    mesh.receiver_only = options.receiver_only;
+    let (positions, triangles, repairs) = repair(
+        std::mem::take(&mut mesh.positions),
+        std::mem::take(&mut mesh.triangles),
+        &options,
+    )
+    .map_err(|e| InputError::at(source, &object, e))?;
+    (mesh.positions, mesh.triangles, mesh.repairs) = (positions, triangles, repairs);
     Ok(mesh)
+}
+
+/// The repair options of a mesh table (`weld`, `weld_tolerance`, `open`, `receiver_only`);
+/// the error names the field (`.open`, …).
+fn repair_options(m: &MeshDef) -> Result<RepairOptions, (&'static str, String)> {
+    let weld_tolerance = m.weld_tolerance.unwrap_or(0.0);
+    if !(weld_tolerance.is_finite() && weld_tolerance >= 0.0) {
+        return Err((
+            ".weld_tolerance",
+            format!("{weld_tolerance} must be a finite number ≥ 0 (a fraction of the mesh's bounding-box diagonal)"),
+        ));
+    }
+    let open = match m.open.as_deref() {
+        None => None,
+        Some(name) => Some(OpenTreatment::from_name(name).ok_or_else(|| {
+            (
+                ".open",
+                format!("unknown treatment {name:?} (expected \"close\", \"shell\" or \"refuse\")"),
+            )
+        })?),
+    };
+    Ok(RepairOptions {
+        weld: m.weld.unwrap_or(true),
+        weld_tolerance,
+        open,
+        receiver_only: m.receiver_only.unwrap_or(false),
+    })
 }
 
 /// Loads an image as linear RGB in [0, 1]: 8- and 16-bit images are sRGB-decoded, float
@@ -930,6 +976,42 @@ f = 0.5
         assert!(e.contains("options.nsample.n"), "{e}");
         let e = err(&GOOD.replace("[camera]", "ambient = nan\n[camera]"));
         assert!(e.contains("ambient"), "{e}");
+    }
+
+    /// The repair keys: bad values name `meshes[I].open` / `.weld_tolerance`; an open mesh
+    /// is capped by default and refused with `open = "refuse"`.
+    #[test]
+    fn repair_keys() {
+        let dir = fixture();
+        std::fs::write(
+            dir.join("open.obj"),
+            "v 0 1 0\nv 0 2 0\nv 1 1 0\nv 0 1 1\nf 1 3 4\nf 1 2 3\nf 1 4 2\n",
+        )
+        .unwrap();
+        let with =
+            |keys: &str| GOOD.replace("obj = \"tet.obj\"", &format!("obj = \"open.obj\"\n{keys}"));
+        let s = toml_in(&dir, &with("")).unwrap();
+        assert_eq!(s.meshes[1].repairs.holes_closed, 1);
+        assert_eq!(s.meshes[1].triangles.len(), 4);
+        let e = toml_in(&dir, &with("open = \"refuse\""))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("open.obj): open mesh: edge "), "{e}");
+        let e = toml_in(&dir, &with("open = \"seal\""))
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "s.toml: meshes[1].open: unknown treatment \"seal\" (expected \"close\", \"shell\" \
+             or \"refuse\")"
+        );
+        let e = toml_in(&dir, &with("weld_tolerance = -1.0"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("s.toml: meshes[1].weld_tolerance: -1 must be"),
+            "{e}"
+        );
     }
 
     #[test]

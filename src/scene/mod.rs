@@ -8,7 +8,8 @@
 //! ([`Scene::with_only_light`]) and averages ([`crate::methods::run`]).
 //!
 //! Files are TOML or JSON with one schema ([`mod@file`]); built-in scenes are generated in code
-//! ([`builtin`]); OBJ meshes are loaded with `tobj` ([`obj`]). Everything that reaches a
+//! ([`builtin`]); OBJ meshes are loaded with `tobj` ([`obj`]) and repaired, every repair
+//! counted ([`repair`]). Everything that reaches a
 //! [`Scene`] has been validated ([`validate`]): finite numbers, non-degenerate light and
 //! camera, closed two-manifold meshes.
 
@@ -18,6 +19,7 @@ pub mod file;
 pub mod input_file;
 pub mod obj;
 pub mod procedural;
+pub mod repair;
 pub mod validate;
 
 use crate::error::InputError;
@@ -122,6 +124,9 @@ pub struct Mesh {
     /// method (`raycast` included, so that methods stay comparable), and it may be open (a
     /// floor plane): it is exempt from the closed-mesh check.
     pub receiver_only: bool,
+    /// What [`repair::repair`] changed to make the file's triangles this mesh (nothing for a
+    /// built-in mesh); reported on the terminal, in the table notes and in `stats.json`.
+    pub repairs: repair::MeshRepairs,
 }
 
 /// Raw per-method options as written in `[options.METHOD]` or with `--opt METHOD.KEY=VALUE`.

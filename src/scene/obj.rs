@@ -140,6 +140,7 @@ pub fn parse_obj(
         triangles,
         color,
         receiver_only: false,
+        repairs: Default::default(),
     })
 }
 

@@ -70,6 +70,7 @@ pub fn uv_sphere(
         triangles,
         color,
         receiver_only: false,
+        repairs: Default::default(),
     }
 }
 
@@ -103,6 +104,7 @@ pub fn box_mesh(name: &str, min: Vec3, max: Vec3, color: [f32; 3]) -> Mesh {
         triangles,
         color,
         receiver_only: false,
+        repairs: Default::default(),
     }
 }
 
@@ -150,6 +152,7 @@ pub fn cylinder(
         triangles,
         color,
         receiver_only: false,
+        repairs: Default::default(),
     }
 }
 
@@ -197,6 +200,7 @@ pub fn torus(
         triangles,
         color,
         receiver_only: false,
+        repairs: Default::default(),
     }
 }
 
@@ -238,6 +242,7 @@ pub fn prism(name: &str, base: &[[f32; 2]], y: [f32; 2], color: [f32; 3]) -> Mes
         triangles,
         color,
         receiver_only: false,
+        repairs: Default::default(),
     }
 }
 
@@ -253,6 +258,7 @@ pub fn two_sided_quad(name: &str, corners: [Vec3; 4], color: [f32; 3]) -> Mesh {
         triangles: vec![[0, 1, 2], [0, 2, 3], [1, 0, 3], [1, 3, 2]],
         color,
         receiver_only: false,
+        repairs: Default::default(),
     }
 }
 
@@ -278,6 +284,7 @@ pub fn transformed(mesh: &Mesh, m: Mat4) -> Mesh {
         triangles,
         color: mesh.color,
         receiver_only: mesh.receiver_only,
+        repairs: mesh.repairs.clone(),
     }
 }
 

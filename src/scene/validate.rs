@@ -452,14 +452,26 @@ fn validate_mesh(m: &Mesh) -> Result<(), String> {
         return Ok(());
     }
     adjacency::build(m).map_err(|e| e.to_string())?;
-    // Outward winding: the signed volume (relative to the first vertex, to limit
-    // cancellation) must not be negative beyond rounding; flat closed meshes such as
-    // two-sided quads have volume ≈ 0 and pass.
-    let o = m.positions[m.triangles[0][0] as usize].as_dvec3();
+    if let Some(volume) = inside_out_volume(&m.positions, &m.triangles) {
+        return Err(format!(
+            "inside out: negative volume {volume} (triangles must be counter-clockwise seen \
+             from outside)"
+        ));
+    }
+    Ok(())
+}
+
+/// The signed volume of the closed surface `triangles` when it is inside out, `None` when it
+/// is not: outward winding means the signed volume (relative to the first vertex, to limit
+/// cancellation) is not negative beyond rounding, −10⁻⁹ of the cube of the largest extent;
+/// flat closed meshes such as two-sided quads have volume ≈ 0 and pass. The one rule of
+/// [`validate`] and of mesh repair ([`super::repair`]), which turns such parts right side out.
+pub fn inside_out_volume(positions: &[Vec3], triangles: &[[u32; 3]]) -> Option<f64> {
+    let o = positions[triangles.first()?[0] as usize].as_dvec3();
     let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
     let mut volume6 = 0.0;
-    for t in &m.triangles {
-        let [a, b, c] = t.map(|i| m.positions[i as usize].as_dvec3() - o);
+    for t in triangles {
+        let [a, b, c] = t.map(|i| positions[i as usize].as_dvec3() - o);
         volume6 += a.dot(b.cross(c));
         for p in [a, b, c] {
             lo = lo.min(p);
@@ -467,14 +479,7 @@ fn validate_mesh(m: &Mesh) -> Result<(), String> {
         }
     }
     let extent = (hi - lo).max_element();
-    if volume6 < -1e-9 * extent * extent * extent {
-        return Err(format!(
-            "inside out: negative volume {} (triangles must be counter-clockwise seen from \
-             outside)",
-            volume6 / 6.0
-        ));
-    }
-    Ok(())
+    (volume6 < -1e-9 * extent * extent * extent).then_some(volume6 / 6.0)
 }
 
 /// Whether the point `c` is on or inside the closed mesh `m` (on, for a receiver-only mesh,
