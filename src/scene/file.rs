@@ -26,7 +26,8 @@
 //! # each with the fields of [light]; errors name `lights[K].<field>`.
 //!
 //! [[meshes]]
-//! obj = "models/bunny.obj"    # relative to the scene file
+//! mesh = "models/bunny.ply"   # relative to the scene file: .obj .ply .stl .gltf .glb
+//! # obj = "models/bunny.obj"  # the older key, the same thing; give exactly one of the two
 //! transform = [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]   # optional, column-major, affine
 //! # or instead of transform, its parts (each optional; scaled, then rotated, then moved):
 //! # scale = 2.0 or [sx, sy, sz]; rotate_deg = [x, y, z] (Euler angles in degrees about the
@@ -38,6 +39,11 @@
 //! n = 256
 //! ```
 //!
+//! A mesh file is read by [`read_mesh`] (format by extension, case-insensitive; what each
+//! format accepts is in `docs/mesh-formats.md`), moved by its transform
+//! ([`RawMesh::transformed`](super::mesh_io::RawMesh::transformed)) and its bit-identical
+//! vertices welded ([`weld_identical`]); validation then requires it closed.
+//!
 //! Unknown keys anywhere are errors (`deny_unknown_fields`), as are light fields that do not
 //! belong to the chosen light type and missing ones that do (the error names `light.<field>`),
 //! and a scene with both `light` and `lights`, with neither, or with more than
@@ -46,7 +52,7 @@
 //! naming the file, and for syntax and schema errors the line and column.
 
 use super::input_file::read_input_file;
-use super::obj::{check_transform, load_obj};
+use super::mesh_io::{check_transform, read_mesh, weld_identical};
 use super::validate::validate;
 use super::{builtin, Camera, Light, LightShape, Mesh, OptionValue, RawOptions, RgbTexture, Scene};
 use crate::error::InputError;
@@ -127,7 +133,8 @@ struct LightDef {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields, expecting = "a mesh table")]
 struct MeshDef {
-    obj: String,
+    mesh: Option<String>,
+    obj: Option<String>,
     transform: Option<Vec<f64>>,
     scale: Option<Scale>,
     rotate_deg: Option<Three>,
@@ -550,10 +557,32 @@ fn build_mesh(m: &MeshDef, i: usize, source: &str, base_dir: &Path) -> Result<Me
         }
     };
     let color = m.color.map_or(DEFAULT_COLOR, |c| c.0).map(|c| c as f32);
-    let path = base_dir.join(&m.obj);
+    let file = match (&m.mesh, &m.obj) {
+        (Some(f), None) | (None, Some(f)) => f,
+        (Some(_), Some(_)) => {
+            return Err(at(
+                "",
+                "has both `mesh` and `obj`: give the mesh file once (`mesh`; `obj` is its \
+                 older name)"
+                    .into(),
+            ))
+        }
+        (None, None) => {
+            return Err(at(
+                "",
+                "has no mesh file: give `mesh = \"path\"` (.obj .ply .stl .gltf .glb)".into(),
+            ))
+        }
+    };
+    let path = base_dir.join(file);
     let display = path.display().to_string();
-    let mut mesh = load_obj(&path, &display, transform, color)
-        .map_err(|e| InputError::at(source, format!("meshes[{i}] ({display})"), e.message))?;
+    let in_mesh =
+        |message: String| InputError::at(source, format!("meshes[{i}] ({display})"), message);
+    let mut raw = read_mesh(&path, &display).map_err(|e| in_mesh(e.message))?;
+    if let Some(t) = transform {
+        raw = raw.transformed(t).map_err(in_mesh)?;
+    }
+    let mut mesh = weld_identical(raw, &display, color);
     mesh.receiver_only = m.receiver_only.unwrap_or(false);
     Ok(mesh)
 }
@@ -907,6 +936,67 @@ f = 0.5
         let many: Vec<&str> = vec![sphere; MAX_LIGHTS + 1];
         let e = err(&with_lights(&many));
         assert_eq!(e, "s.toml: lights: has 256 lights, needs 1..=255");
+    }
+
+    /// `mesh = "…"` reads any format (here an STL copy of the tetrahedron); `obj` and `mesh`
+    /// are the same key; both or neither is an error naming the mesh.
+    #[test]
+    fn mesh_key() {
+        let dir = fixture();
+        let corners = [
+            [0, 1, 0],
+            [1, 1, 0],
+            [0, 1, 1],
+            [0, 1, 0],
+            [0, 2, 0],
+            [1, 1, 0],
+        ];
+        let mut stl = String::from("solid tet\n");
+        for tri in [&corners[..3], &corners[3..]] {
+            stl += "facet normal 0 0 0\nouter loop\n";
+            for c in tri {
+                stl += &format!("vertex {} {} {}\n", c[0], c[1], c[2]);
+            }
+            stl += "endloop\nendfacet\n";
+        }
+        for tri in [
+            [[0, 1, 0], [0, 1, 1], [0, 2, 0]],
+            [[0, 2, 0], [0, 1, 1], [1, 1, 0]],
+        ] {
+            stl += "facet normal 0 0 0\nouter loop\n";
+            for c in tri {
+                stl += &format!("vertex {} {} {}\n", c[0], c[1], c[2]);
+            }
+            stl += "endloop\nendfacet\n";
+        }
+        stl += "endsolid tet\n";
+        std::fs::write(dir.join("tet.STL"), stl).unwrap();
+        let by_obj = parse_scene_str(GOOD, Format::Toml, "s.toml", &dir).unwrap();
+        let by_mesh = GOOD.replace("obj = \"tet.obj\"", "mesh = \"tet.STL\"");
+        let s = parse_scene_str(&by_mesh, Format::Toml, "s.toml", &dir).unwrap();
+        assert_eq!(s.meshes[1].positions, by_obj.meshes[1].positions);
+        assert_eq!(s.meshes[1].triangles, by_obj.meshes[1].triangles);
+        let both = GOOD.replace("obj = \"tet.obj\"", "obj = \"tet.obj\"\nmesh = \"tet.obj\"");
+        assert_eq!(
+            parse_scene_str(&both, Format::Toml, "s.toml", &dir)
+                .unwrap_err()
+                .to_string(),
+            "s.toml: meshes[1]: has both `mesh` and `obj`: give the mesh file once (`mesh`; \
+             `obj` is its older name)"
+        );
+        let neither = GOOD.replace("obj = \"tet.obj\"", "receiver_only = false");
+        assert_eq!(
+            parse_scene_str(&neither, Format::Toml, "s.toml", &dir)
+                .unwrap_err()
+                .to_string(),
+            "s.toml: meshes[1]: has no mesh file: give `mesh = \"path\"` (.obj .ply .stl .gltf \
+             .glb)"
+        );
+        let unknown = GOOD.replace("obj = \"tet.obj\"", "mesh = \"tet.3ds\"");
+        let e = parse_scene_str(&unknown, Format::Toml, "s.toml", &dir)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("tet.3ds): unknown mesh file extension"), "{e}");
     }
 
     #[test]
