@@ -12,7 +12,7 @@
 //!   `adjacency` ([`adjacency::build`]), `point-touches` ([`point_touches`]: the light centre
 //!   against every triangle) and `light-shape-touches` ([`light_shape_touches`]).
 //!
-//! Run with `cargo bench --bench repair` (`-- --quick` for one short pass). Budget: flat
+//! Run with `cargo bench --bench repair` (`-- --quick --noplot` for one short pass). Budget: flat
 //! sampling, 10 samples, 3 s of measurement.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, SamplingMode};

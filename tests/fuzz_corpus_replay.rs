@@ -115,6 +115,24 @@ fn obj_corpus() {
     replay("obj", common::obj);
 }
 
+/// `ply`: PLY reading (ASCII, both binary byte orders), then the `obj` path's geometry.
+#[test]
+fn ply_corpus() {
+    replay("ply", common::ply);
+}
+
+/// `stl`: STL reading (ASCII, binary), then the `obj` path's geometry.
+#[test]
+fn stl_corpus() {
+    replay("stl", common::stl);
+}
+
+/// `gltf`: glTF and GLB reading (no external buffers), then the `obj` path's geometry.
+#[test]
+fn gltf_corpus() {
+    replay("gltf", common::gltf);
+}
+
 /// `raster`: setup, binning and traversal of arbitrary clip-space triangles.
 #[test]
 fn raster_corpus() {

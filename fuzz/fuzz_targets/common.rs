@@ -39,7 +39,7 @@ use penumbra::light::radial_parts::{edge_in_parts, NEAR_FRACTION, PART_COUNT};
 use penumbra::methods::ssv_optimized::{CoverageMode, LightModel};
 use penumbra::scene::adjacency;
 use penumbra::scene::file::{parse_scene_str, Format};
-use penumbra::scene::obj::parse_obj;
+use penumbra::scene::mesh_io::{parse_mesh, weld_identical, MeshFormat};
 use penumbra::scene::validate::{light_shape_touches, validate, validate_light};
 use penumbra::scene::{Camera, Light, LightShape, Mesh, RgbTexture, Scene};
 use std::path::{Path, PathBuf};
@@ -160,27 +160,64 @@ fn fixed_camera() -> Camera {
     }
 }
 
-/// The `obj` path: `parse_obj` on the raw bytes (sometimes with a mirroring transform, which
-/// flips winding); if it parses, `adjacency::build`; if the mesh is closed, the light-facing
-/// triangles, possible silhouettes, silhouette loops and both kinds of shadow volume from a
-/// light point derived from the input, then those volumes through setup, binning and
-/// traversal with a fixed camera at 32×32.
-///
-/// The light is one of: a point in [−4, 4)³, a mesh vertex (light on the surface) or the
-/// centre of the mesh bounds (usually inside the mesh).
+/// The `obj` path: `parse_mesh` as OBJ on the raw bytes (sometimes with a mirroring transform,
+/// which flips the winding), the bit-identical weld, then [`mesh_path`].
 pub fn obj(data: &[u8]) {
+    mesh_file(data, MeshFormat::Obj);
+}
+
+/// The `ply` path: `parse_mesh` as PLY (ASCII or binary, either byte order), then as [`obj`].
+pub fn ply(data: &[u8]) {
+    mesh_file(data, MeshFormat::Ply);
+}
+
+/// The `stl` path: `parse_mesh` as STL (ASCII or binary), then as [`obj`].
+pub fn stl(data: &[u8]) {
+    mesh_file(data, MeshFormat::Stl);
+}
+
+/// The `gltf` path: `parse_mesh` as glTF (JSON with `data:` buffers, or GLB; no directory, so an
+/// external buffer is an error), then as [`obj`].
+pub fn gltf(data: &[u8]) {
+    mesh_file(data, MeshFormat::Gltf);
+}
+
+/// A mesh file of `format` in `data`: read (it may fail with an error, never panic; the
+/// reader's promises are checked: indices in range, positions finite), sometimes mirrored,
+/// welded, then [`mesh_path`].
+fn mesh_file(data: &[u8], format: MeshFormat) {
     let h = fnv1a(data);
-    let transform = (h & 1 == 1).then(|| glam::Mat4::from_scale(glam::Vec3::new(-1.0, 1.0, 1.0)));
-    let Ok(mesh) = parse_obj(data, "fuzz.obj", transform, [0.8; 3]) else {
+    let Ok(raw) = parse_mesh(data, format, "fuzz", None) else {
         return;
     };
-    assert!(mesh.positions.iter().all(|p| p.is_finite()));
-    assert!(mesh
+    assert_eq!(raw.format, format);
+    assert!(!raw.triangles.is_empty());
+    assert!(raw.positions.iter().all(|p| p.is_finite()));
+    assert!(raw
         .triangles
         .iter()
         .flatten()
-        .all(|&i| (i as usize) < mesh.positions.len()));
-    let Ok(adj) = adjacency::build(&mesh) else {
+        .all(|&i| (i as usize) < raw.positions.len()));
+    let raw = if h & 1 == 1 {
+        match raw.transformed(glam::Mat4::from_scale(glam::Vec3::new(-1.0, 1.0, 1.0))) {
+            Ok(m) => m,
+            Err(_) => return,
+        }
+    } else {
+        raw
+    };
+    mesh_path(&weld_identical(raw, "fuzz", [0.8; 3]), h);
+}
+
+/// On a mesh as a file reader makes it: `adjacency::build`; if the mesh is closed, the
+/// light-facing triangles, possible silhouettes, silhouette loops and both kinds of shadow
+/// volume from a light point derived from `h` (the input's hash), then those volumes through
+/// setup, binning and traversal with a fixed camera at 32×32.
+///
+/// The light is one of: a point in [−4, 4)³, a mesh vertex (light on the surface) or the
+/// centre of the mesh bounds (usually inside the mesh).
+fn mesh_path(mesh: &Mesh, h: u64) {
+    let Ok(adj) = adjacency::build(mesh) else {
         return;
     };
     assert_eq!(adj.triangle_edges.len(), mesh.triangles.len());
@@ -204,9 +241,9 @@ pub fn obj(data: &[u8]) {
         _ => glam::Vec3::new(coord(8), coord(24), coord(40)),
     };
 
-    let facing = light_facing(&mesh, light);
+    let facing = light_facing(mesh, light);
     assert_eq!(facing.len(), mesh.triangles.len());
-    let sil = possible_silhouettes(&mesh, &adj, &facing);
+    let sil = possible_silhouettes(mesh, &adj, &facing);
     // Paper V: facing decided once per triangle gives even degree at every silhouette vertex,
     // so the edges always split into closed loops that use each edge once.
     assert!(vertex_degrees(&sil).values().all(|d| d % 2 == 0));
@@ -214,9 +251,9 @@ pub fn obj(data: &[u8]) {
     assert_eq!(loops.iter().map(Vec::len).sum::<usize>(), sil.len());
 
     let proj = Projection::new(&fixed_camera(), SIZE, SIZE, 0.1);
-    let open = shadow_volume_triangles(&[(&mesh, &adj)], light, &proj, Capping::Open);
+    let open = shadow_volume_triangles(&[(mesh, &adj)], light, &proj, Capping::Open);
     assert_eq!(open.len(), 2 * sil.len());
-    let capped = shadow_volume_triangles(&[(&mesh, &adj)], light, &proj, Capping::Capped);
+    let capped = shadow_volume_triangles(&[(mesh, &adj)], light, &proj, Capping::Capped);
     assert_eq!(capped.len(), 2 * sil.len() + mesh.triangles.len());
     rasterize(&capped, CullMode::None, 8);
 }

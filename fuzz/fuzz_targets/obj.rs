@@ -1,5 +1,6 @@
-//! Fuzzes the OBJ path: `parse_obj` on arbitrary bytes, then adjacency, silhouettes, loops,
-//! shadow volumes and their rasterization (see [`common::obj`]). It must never panic.
+//! Fuzzes the OBJ path: `parse_mesh` as OBJ on arbitrary bytes, then the welded mesh through
+//! adjacency, silhouettes, loops, shadow volumes and their rasterization (see [`common::obj`]).
+//! It must never panic.
 #![no_main]
 
 #[path = "common.rs"]

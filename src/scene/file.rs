@@ -26,7 +26,8 @@
 //! # each with the fields of [light]; errors name `lights[K].<field>`.
 //!
 //! [[meshes]]
-//! obj = "models/bunny.obj"    # relative to the scene file
+//! mesh = "models/bunny.ply"   # relative to the scene file: .obj .ply .stl .gltf .glb
+//! # obj = "models/bunny.obj"  # the older key, the same thing; give exactly one of the two
 //! transform = [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]   # optional, column-major, affine
 //! # or instead of transform, its parts (each optional; scaled, then rotated, then moved):
 //! # scale = 2.0 or [sx, sy, sz]; rotate_deg = [x, y, z] (Euler angles in degrees about the
@@ -44,6 +45,11 @@
 //! n = 256
 //! ```
 //!
+//! A mesh file is read by [`read_mesh`] (format by extension, case-insensitive; what each
+//! format accepts is in `docs/mesh-formats.md`), moved by its transform
+//! ([`RawMesh::transformed`](super::mesh_io::RawMesh::transformed)) and its bit-identical
+//! vertices welded ([`weld_identical`]); validation then requires it closed.
+//!
 //! Unknown keys anywhere are errors (`deny_unknown_fields`), as are light fields that do not
 //! belong to the chosen light type and missing ones that do (the error names `light.<field>`),
 //! and a scene with both `light` and `lights`, with neither, or with more than
@@ -52,7 +58,7 @@
 //! naming the file, and for syntax and schema errors the line and column.
 
 use super::input_file::read_input_file;
-use super::obj::{check_transform, load_obj};
+use super::mesh_io::{check_transform, read_mesh, weld_identical, MeshFormat};
 use super::repair::{repair, OpenTreatment, RepairOptions};
 use super::validate::validate;
 use super::{builtin, Camera, Light, LightShape, Mesh, OptionValue, RawOptions, RgbTexture, Scene};
@@ -134,7 +140,8 @@ struct LightDef {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields, expecting = "a mesh table")]
 struct MeshDef {
-    obj: String,
+    mesh: Option<String>,
+    obj: Option<String>,
     transform: Option<Vec<f64>>,
     scale: Option<Scale>,
     rotate_deg: Option<Three>,
@@ -560,20 +567,61 @@ fn build_mesh(m: &MeshDef, i: usize, source: &str, base_dir: &Path) -> Result<Me
         }
     };
     let color = m.color.map_or(DEFAULT_COLOR, |c| c.0).map(|c| c as f32);
-    let path = base_dir.join(&m.obj);
+    let file = match (&m.mesh, &m.obj) {
+        (Some(f), None) | (None, Some(f)) => f,
+        (Some(_), Some(_)) => {
+            return Err(at(
+                "",
+                "has both `mesh` and `obj`: give the mesh file once (`mesh`; `obj` is its \
+                 older name)"
+                    .into(),
+            ))
+        }
+        (None, None) => {
+            return Err(at(
+                "",
+                "has no mesh file: give `mesh = \"path\"` (.obj .ply .stl .gltf .glb)".into(),
+            ))
+        }
+    };
+    let path = base_dir.join(file);
     let display = path.display().to_string();
     let options = repair_options(m).map_err(|(field, e)| at(field, e))?;
     let object = format!("meshes[{i}] ({display})");
-    let mut mesh = load_obj(&path, &display, transform, color)
-        .map_err(|e| InputError::at(source, &object, e.message))?;
-    mesh.receiver_only = options.receiver_only;
-    let (positions, triangles, repairs) = repair(
-        std::mem::take(&mut mesh.positions),
-        std::mem::take(&mut mesh.triangles),
-        &options,
-    )
-    .map_err(|e| InputError::at(source, &object, e))?;
-    (mesh.positions, mesh.triangles, mesh.repairs) = (positions, triangles, repairs);
+    let in_mesh = |message: String| InputError::at(source, &object, message);
+    let mut raw = read_mesh(&path, &display).map_err(|e| in_mesh(e.message))?;
+    if let Some(t) = transform {
+        raw = raw.transformed(t).map_err(in_mesh)?;
+    }
+    // Bit-identical corners are welded first, numbered by first appearance (as the OBJ
+    // loader always did, so closed models keep their vertex order and every golden its
+    // bits); repair then welds within the tolerance, cleans, orients and closes. With
+    // `weld = false` the corners reach repair as the file holds them.
+    // The corners OBJ groups repeat are tobj's numbering (per group), not the file's: the
+    // file shares them, so their welding is no repair; STL's and glTF's are the file's own.
+    let format = raw.format;
+    let corners = raw.positions.len();
+    let (positions, triangles) = if options.weld {
+        let welded = weld_identical(raw, &display, color);
+        (welded.positions, welded.triangles)
+    } else {
+        (raw.positions, raw.triangles)
+    };
+    let file_corners_welded = match format {
+        MeshFormat::Obj => 0,
+        _ => (corners - positions.len()) as u64,
+    };
+    let (positions, triangles, mut repairs) =
+        repair(positions, triangles, &options).map_err(in_mesh)?;
+    repairs.corners_welded += file_corners_welded;
+    let mesh = Mesh {
+        name: display.clone(),
+        positions,
+        triangles,
+        color,
+        receiver_only: options.receiver_only,
+        repairs,
+    };
     Ok(mesh)
 }
 
@@ -953,6 +1001,67 @@ f = 0.5
         let many: Vec<&str> = vec![sphere; MAX_LIGHTS + 1];
         let e = err(&with_lights(&many));
         assert_eq!(e, "s.toml: lights: has 256 lights, needs 1..=255");
+    }
+
+    /// `mesh = "…"` reads any format (here an STL copy of the tetrahedron); `obj` and `mesh`
+    /// are the same key; both or neither is an error naming the mesh.
+    #[test]
+    fn mesh_key() {
+        let dir = fixture();
+        let corners = [
+            [0, 1, 0],
+            [1, 1, 0],
+            [0, 1, 1],
+            [0, 1, 0],
+            [0, 2, 0],
+            [1, 1, 0],
+        ];
+        let mut stl = String::from("solid tet\n");
+        for tri in [&corners[..3], &corners[3..]] {
+            stl += "facet normal 0 0 0\nouter loop\n";
+            for c in tri {
+                stl += &format!("vertex {} {} {}\n", c[0], c[1], c[2]);
+            }
+            stl += "endloop\nendfacet\n";
+        }
+        for tri in [
+            [[0, 1, 0], [0, 1, 1], [0, 2, 0]],
+            [[0, 2, 0], [0, 1, 1], [1, 1, 0]],
+        ] {
+            stl += "facet normal 0 0 0\nouter loop\n";
+            for c in tri {
+                stl += &format!("vertex {} {} {}\n", c[0], c[1], c[2]);
+            }
+            stl += "endloop\nendfacet\n";
+        }
+        stl += "endsolid tet\n";
+        std::fs::write(dir.join("tet.STL"), stl).unwrap();
+        let by_obj = parse_scene_str(GOOD, Format::Toml, "s.toml", &dir).unwrap();
+        let by_mesh = GOOD.replace("obj = \"tet.obj\"", "mesh = \"tet.STL\"");
+        let s = parse_scene_str(&by_mesh, Format::Toml, "s.toml", &dir).unwrap();
+        assert_eq!(s.meshes[1].positions, by_obj.meshes[1].positions);
+        assert_eq!(s.meshes[1].triangles, by_obj.meshes[1].triangles);
+        let both = GOOD.replace("obj = \"tet.obj\"", "obj = \"tet.obj\"\nmesh = \"tet.obj\"");
+        assert_eq!(
+            parse_scene_str(&both, Format::Toml, "s.toml", &dir)
+                .unwrap_err()
+                .to_string(),
+            "s.toml: meshes[1]: has both `mesh` and `obj`: give the mesh file once (`mesh`; \
+             `obj` is its older name)"
+        );
+        let neither = GOOD.replace("obj = \"tet.obj\"", "receiver_only = false");
+        assert_eq!(
+            parse_scene_str(&neither, Format::Toml, "s.toml", &dir)
+                .unwrap_err()
+                .to_string(),
+            "s.toml: meshes[1]: has no mesh file: give `mesh = \"path\"` (.obj .ply .stl .gltf \
+             .glb)"
+        );
+        let unknown = GOOD.replace("obj = \"tet.obj\"", "mesh = \"tet.3ds\"");
+        let e = parse_scene_str(&unknown, Format::Toml, "s.toml", &dir)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("tet.3ds): unknown mesh file extension"), "{e}");
     }
 
     #[test]

@@ -8,8 +8,8 @@
 //! ([`Scene::with_only_light`]) and averages ([`crate::methods::run`]).
 //!
 //! Files are TOML or JSON with one schema ([`mod@file`]); built-in scenes are generated in code
-//! ([`builtin`]); OBJ meshes are loaded with `tobj` ([`obj`]) and repaired, every repair
-//! counted ([`repair`]). Everything that reaches a
+//! ([`builtin`]); mesh files (OBJ, PLY, STL, glTF) are read by [`mesh_io`] and repaired,
+//! every repair counted ([`repair`]). Everything that reaches a
 //! [`Scene`] has been validated ([`validate`]): finite numbers, non-degenerate light and
 //! camera, closed two-manifold meshes.
 
@@ -17,7 +17,7 @@ pub mod adjacency;
 pub mod builtin;
 pub mod file;
 pub mod input_file;
-pub mod obj;
+pub mod mesh_io;
 pub mod procedural;
 pub mod repair;
 pub mod validate;
@@ -112,7 +112,7 @@ pub struct Light {
 /// Triangles are counter-clockwise seen from outside (outward normals by the right-hand rule).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Mesh {
-    /// A name for messages: the OBJ path or the built-in part's name.
+    /// A name for messages: the mesh file's path or the built-in part's name.
     pub name: String,
     /// Vertex positions, world space, f32 as a GPU would hold them.
     pub positions: Vec<Vec3>,

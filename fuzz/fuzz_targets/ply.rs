@@ -1,0 +1,13 @@
+//! Fuzzes the PLY path: `parse_mesh` as PLY (ASCII or binary) on arbitrary bytes, then the welded
+//! mesh through the `obj` path's geometry (see [`common::ply`]). It must never panic.
+#![no_main]
+
+#[path = "common.rs"]
+#[allow(dead_code)]
+mod common;
+
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    common::ply(data);
+});
