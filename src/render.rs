@@ -33,7 +33,7 @@ pub struct MethodRun {
     /// reference ran and this is not it.
     pub error: Option<ErrorReport>,
     /// For the reference: its own sampling noise, the reference against itself with the next
-    /// seed ([`methods::reference_noise_floor`]).
+    /// seed ([`methods::raycast::reference_noise_floor`]).
     pub noise_floor: Option<ErrorStats>,
 }
 

@@ -295,8 +295,8 @@ fn errors_against_raycast(path: &Path) -> Vec<(String, f64)> {
     let mut out = Vec::new();
     for run in &runs {
         let values: Vec<f32> = match &run.output.visibility {
-            penumbra::methods::output::Visibility::Gray(v) => v.clone(),
-            penumbra::methods::output::Visibility::Rgb(v) => v.iter().flatten().copied().collect(),
+            penumbra::visibility::Visibility::Gray(v) => v.clone(),
+            penumbra::visibility::Visibility::Rgb(v) => v.iter().flatten().copied().collect(),
         };
         assert!(
             values

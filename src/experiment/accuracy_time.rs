@@ -13,7 +13,7 @@
 //!
 //! **The reference** is [`REFERENCE`] (`raycast` with 1024 samples per pixel, its default
 //! seed), rendered once per scene. Its own sampling noise (the same settings with the next
-//! seed, [`methods::reference_noise_floor`]) is reported next to it and drawn in the plot:
+//! seed, [`methods::raycast::reference_noise_floor`]) is reported next to it and drawn in the plot:
 //! differences of that size are the reference's, not a method's. `raycast` with 1024 samples
 //! is not in the default table: with the reference's seed its error is 0 by construction.
 //!
@@ -329,7 +329,7 @@ pub struct Reference {
     /// Wall seconds of its one render (informational).
     pub seconds: f64,
     /// Its own sampling noise: the reference against itself with the next seed
-    /// ([`methods::reference_noise_floor`]).
+    /// ([`methods::raycast::reference_noise_floor`]).
     pub noise_floor: ErrorStats,
 }
 

@@ -1078,7 +1078,7 @@ fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
 /// between 0 and 1 (a penumbra and its one-pixel border); elsewhere every sample of the run
 /// saw the light, or none did, and the second run is taken to agree (so the result is a lower
 /// bound, and costs a fraction of the reference's time). Several lights are averaged like the
-/// reference ([`light_average`]).
+/// reference ([`super::light_average`]).
 pub fn reference_noise_floor(
     frame: &Frame,
     reference: &Visibility,
@@ -1150,7 +1150,7 @@ option_table! {
 
 /// `raycast` with its options but the seed advanced by `seed_offset`, evaluated only at the
 /// pixels where `mask` (row-major) is true (1 elsewhere); several lights averaged like the
-/// reference ([`light_average`]).
+/// reference ([`super::light_average`]).
 pub fn raycast_where(
     frame: &Frame,
     mask: &[bool],

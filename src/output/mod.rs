@@ -573,7 +573,7 @@ pub enum Comparison<'a> {
     NoReference,
     /// This method is the reference: `"error": null` and `"reference_noise_floor"`, the
     /// reference against itself with the next seed
-    /// ([`reference_noise_floor`](crate::methods::reference_noise_floor)).
+    /// ([`reference_noise_floor`](crate::methods::raycast::reference_noise_floor)).
     Reference {
         /// Its noise floor, when it was measured.
         noise_floor: Option<ErrorStats>,

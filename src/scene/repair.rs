@@ -742,7 +742,7 @@ fn split_sheets(
         .collect();
     let mut cut_vertices = Vec::new();
     for g in &crowded {
-        joined.extend(pair_by_angle(pos, &edges, g)?);
+        joined.extend(pair_by_angle(pos, &edges, g).unwrap_or_default());
         cut_vertices.extend(edges.ends(g[0]));
     }
     for ends in &conflicts {
@@ -801,9 +801,11 @@ fn split_sheets(
 
 /// The pairs of half-edges around the crowded edge `g` that bound one solid wedge: sorted by
 /// the angle of their third vertex about the edge, a triangle traversing `b→a` followed
-/// (counter-clockwise about `a→b`) by one traversing `a→b`. An error when two triangles lie
-/// at one angle (or one has no angle: zero area), where the order is undefined.
-fn pair_by_angle(pos: &[Vec3], edges: &EdgeTable, g: &[u32]) -> Result<Vec<[u32; 2]>, String> {
+/// (counter-clockwise about `a→b`) by one traversing `a→b`. `None` when two triangles lie
+/// at one angle (or one has no angle: zero area), where the order is undefined: then no two
+/// of them are joined, every triangle keeps the edge as a boundary edge of its own sheet, and
+/// the open treatment (close, shell) applies to it — the mesh renders, with the cut counted.
+fn pair_by_angle(pos: &[Vec3], edges: &EdgeTable, g: &[u32]) -> Option<Vec<[u32; 2]>> {
     let [a, b] = edges.ends(g[0]);
     let (pa, pb) = (pos[a as usize].as_dvec3(), pos[b as usize].as_dvec3());
     let d = pb - pa;
@@ -815,26 +817,19 @@ fn pair_by_angle(pos: &[Vec3], edges: &EdgeTable, g: &[u32]) -> Result<Vec<[u32;
     };
     let u = perp(g[0]);
     let v = d.cross(u);
-    let undefined = |why: &str| {
-        format!(
-            "non-manifold edge {} – {} has {} triangles and cannot be split into sheets ({why}); \
-             separate the parts that meet along this edge in a modelling tool",
-            fmt_p(pos[a as usize]),
-            fmt_p(pos[b as usize]),
-            g.len()
-        )
-    };
     let mut around: Vec<(f64, u32)> = Vec::with_capacity(g.len());
     for &h in g {
         let w = perp(h);
         if w == DVec3::ZERO || u == DVec3::ZERO {
-            return Err(undefined("one of them has zero area"));
+            // One of them has zero area: it has no angle about the edge.
+            return None;
         }
         around.push((libm::atan2(w.dot(v), w.dot(u)), h));
     }
     around.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
     if around.windows(2).any(|w| w[0].0 == w[1].0) {
-        return Err(undefined("two of them lie in one plane on the same side"));
+        // Two of them lie in one plane on the same side: their order is undefined.
+        return None;
     }
     let forward = |h: u32| edges.ends(h) == [a, b];
     let n = around.len();
@@ -849,7 +844,7 @@ fn pair_by_angle(pos: &[Vec3], edges: &EdgeTable, g: &[u32]) -> Result<Vec<[u32;
             pairs.push([hj, hi]);
         }
     }
-    Ok(pairs)
+    Some(pairs)
 }
 
 /// Per triangle, the part it belongs to: the lowest triangle index of its class joined
@@ -1448,9 +1443,13 @@ mod tests {
         );
     }
 
+    /// Three triangles on edge 0–1, two of them on the same side in one plane: their order
+    /// about the edge is undefined, so none is joined to another across it; each keeps its own
+    /// copy of the edge (2 vertices duplicated for each triangle beyond the first), the edge
+    /// counts as split, and the three open triangles are then closed (a single triangle's
+    /// hole is capped by its reverse) into a mesh the closed-mesh check accepts.
     #[test]
-    fn coplanar_triangles_on_a_non_manifold_edge_are_an_error() {
-        // Three triangles on edge 0–1, two of them on the same side in one plane.
+    fn coplanar_triangles_on_a_non_manifold_edge_are_cut_apart() {
         let p = vec![
             Vec3::ZERO,
             Vec3::X,
@@ -1458,16 +1457,24 @@ mod tests {
             Vec3::new(0.5, 2.0, 0.0),
             Vec3::Z,
         ];
-        let e = repair(
+        let (p2, t2, r) = run(
             p,
             vec![[0, 1, 2], [1, 0, 3], [0, 1, 4]],
-            &Default::default(),
-        )
-        .unwrap_err();
-        assert!(
-            e.starts_with("non-manifold edge (0, 0, 0) – (1, 0, 0) has 3 triangles and cannot be split into sheets (two of them lie in one plane on the same side)"),
-            "{e}"
+            RepairOptions::default(),
         );
+        assert_eq!((r.nonmanifold_edges_split, r.vertices_split), (1, 4));
+        assert_eq!(r.boundary_edges, 9);
+        assert_eq!((r.holes_closed, r.cap_triangles), (3, 3));
+        assert_eq!((p2.len(), t2.len()), (9, 6));
+        let mesh = crate::scene::Mesh {
+            name: "cut".into(),
+            positions: p2,
+            triangles: t2,
+            color: [0.5; 3],
+            receiver_only: false,
+            repairs: r,
+        };
+        crate::scene::adjacency::build(&mesh).unwrap();
     }
 
     #[test]
