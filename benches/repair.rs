@@ -4,7 +4,7 @@
 //!
 //! Functions (group `sphere-1m`):
 //!
-//! * `parse-obj`: [`parse_obj`] of the same sphere as OBJ text with shared vertices (tobj,
+//! * `parse-obj`: [`parse_mesh`] of the same sphere as OBJ text with shared vertices (tobj,
 //!   the OBJ welding of bit-identical positions);
 //! * `repair`: [`repair`] of the STL soup (weld 2 994 000 corners into 499 002 vertices, clean,
 //!   orient, look for non-manifold and boundary edges);
@@ -18,7 +18,7 @@
 use criterion::{black_box, criterion_group, criterion_main, Criterion, SamplingMode};
 use glam::Vec3;
 use penumbra::scene::adjacency;
-use penumbra::scene::obj::parse_obj;
+use penumbra::scene::mesh_io::{parse_mesh, MeshFormat};
 use penumbra::scene::procedural::uv_sphere;
 use penumbra::scene::repair::{repair, RepairOptions};
 use penumbra::scene::validate::{light_shape_touches, point_touches, validate};
@@ -61,7 +61,15 @@ fn bench(c: &mut Criterion) {
         .measurement_time(Duration::from_secs(3))
         .warm_up_time(Duration::from_millis(500));
     g.bench_function("parse-obj", |b| {
-        b.iter(|| parse_obj(black_box(obj.as_bytes()), "sphere.obj", None, [0.8; 3]).unwrap())
+        b.iter(|| {
+            parse_mesh(
+                black_box(obj.as_bytes()),
+                MeshFormat::Obj,
+                "sphere.obj",
+                None,
+            )
+            .unwrap()
+        })
     });
     g.bench_function("repair", |b| {
         b.iter(|| repair(black_box(soup.clone()), corners.clone(), &options).unwrap())
