@@ -168,6 +168,28 @@ pub const FOUNDATION: &[(&str, &[&str])] = &[
     ("pw-columns", &["pw2002", "pw-restructured", "penumbra-map"]),
     ("pw-fractal", &["pw2002", "pw-restructured", "penumbra-map"]),
     ("pw-2002", &["pw2002", "pw-restructured", "penumbra-map"]),
+    // Real models (scenes/models/README): the open hand, closed by repair on load (one hole
+    // capped); Bob, genus 1 (a hole loop for the wedge methods); the scorpion's thin legs
+    // under a sphere light; Spot under a disk light.
+    (
+        "scenes/real/hand.toml",
+        &["hard-sv", "ssv", "ssv-optimized", "wedge-blending"],
+    ),
+    (
+        "scenes/real/bob.toml",
+        &["hard-sv", "ssv", "ssv-optimized", "wedge-blending"],
+    ),
+    (
+        "scenes/real/scorpion.toml",
+        &[
+            "hard-sv",
+            "pw2002",
+            "pw-restructured",
+            "ssv",
+            "penumbra-map",
+        ],
+    ),
+    ("scenes/real/spot-disk.toml", &["dbuffer"]),
 ];
 
 /// The knobs (module doc).
