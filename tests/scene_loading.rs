@@ -418,3 +418,42 @@ rotate_deg = [0, 30, 0]
         assert_eq!(runs[0].shaded, obj_runs[0].shaded, "{file}");
     }
 }
+
+/// A mesh kept as a two-sided shell is warned about by the methods that sum per silhouette
+/// edge (their coverage is summed twice there) and only by them; capped, by none.
+#[test]
+fn a_shell_is_warned_about_by_the_methods_that_sum_per_silhouette_edge() {
+    let open_box = scenes_dir().join("bad/models/open-box.obj");
+    for (open, warned) in [("shell", true), ("close", false)] {
+        let keys = format!("scale = 0.8\ntranslate = [-0.4, 0.4, -0.4]\nopen = \"{open}\"");
+        let path = repair_scene(
+            &open_box,
+            &keys,
+            16,
+            "methods = [\"hard-sv\", \"nsample\", \"ssv\", \"wedge-blending\"]",
+        );
+        let scene = load_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
+        for run in penumbra::render::render_scene(&scene).unwrap() {
+            let sums = penumbra::methods::find(&run.method)
+                .unwrap()
+                .sums_per_silhouette_edge;
+            let shell_warning = run
+                .output
+                .stats
+                .warnings
+                .iter()
+                .any(|w| w.contains("kept as a two-sided shell"));
+            assert_eq!(shell_warning, warned && sums, "{open}: {}", run.method);
+        }
+    }
+    assert!(
+        penumbra::methods::find("ssv")
+            .unwrap()
+            .sums_per_silhouette_edge
+    );
+    assert!(
+        !penumbra::methods::find("hard-sv")
+            .unwrap()
+            .sums_per_silhouette_edge
+    );
+}

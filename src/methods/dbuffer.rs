@@ -980,6 +980,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     // Not measured: the largest method's figure (wedge-blending's).
     bytes_per_pixel: 384,
     default_run: crate::methods::DefaultRun::EveryScene,
+    sums_per_silhouette_edge: false,
     check: |frame| read_settings(frame).map(drop),
     run,
 };

@@ -311,6 +311,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     options: crate::methods::OptionTableSpec::of::<HardSvOptions>(),
     bytes_per_pixel: 72,
     default_run: crate::methods::DefaultRun::EveryScene,
+    sums_per_silhouette_edge: false,
     check: |frame| HardSvOptions::read(frame.scene).map(drop),
     run,
 };

@@ -107,6 +107,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     // 512² and 1024²).
     bytes_per_pixel: 208,
     default_run: crate::methods::DefaultRun::FirstSceneOnly,
+    sums_per_silhouette_edge: false,
     check: |frame| options(frame).map(drop),
     run,
 };

@@ -481,6 +481,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     options: crate::methods::OptionTableSpec::of::<Pw2002Options>(),
     bytes_per_pixel: 88,
     default_run: crate::methods::DefaultRun::EveryScene,
+    sums_per_silhouette_edge: true,
     check: |frame| options(frame).map(drop),
     run,
 };

@@ -680,6 +680,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     options: crate::methods::OptionTableSpec::of::<PwRestructuredOptions>(),
     bytes_per_pixel: 96,
     default_run: crate::methods::DefaultRun::EveryScene,
+    sums_per_silhouette_edge: true,
     check: |frame| read_settings(frame).map(drop),
     run,
 };

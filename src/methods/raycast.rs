@@ -1006,6 +1006,7 @@ pub const METHOD: super::Method = super::Method {
     options: super::OptionTableSpec::of::<RaycastOptions>(),
     bytes_per_pixel: 72,
     default_run: super::DefaultRun::EveryScene,
+    sums_per_silhouette_edge: false,
     check: |frame| raycast_options(frame.scene).map(drop),
     run,
 };

@@ -1069,6 +1069,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     options: crate::methods::OptionTableSpec::of::<SsvOptimizedOptions>(),
     bytes_per_pixel: 96,
     default_run: crate::methods::DefaultRun::EveryScene,
+    sums_per_silhouette_edge: true,
     check: |frame| options(frame).map(drop),
     run,
 };

@@ -1253,6 +1253,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     // Sized for packing = f32 (two RGBA32F targets per vBuffer; 8bit needs about a third).
     bytes_per_pixel: 384,
     default_run: crate::methods::DefaultRun::EveryScene,
+    sums_per_silhouette_edge: true,
     check: |frame| options(frame).map(drop),
     run,
 };
