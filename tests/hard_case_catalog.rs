@@ -141,7 +141,7 @@ const TABLE: &[(&str, &str, Bound)] = &[
     ("hand-close-rect", "hard-sv", Pin { max_frac: 0.1961, why: "the hard shadow from the light center has no penumbra" }), // 799 px
     ("hand-close-rect", "ssv-optimized", Pin { max_frac: 0.0015, why: "real non-convex mesh (fingers): wedges of neighbouring silhouette edges overlap (Paper III §5.3)" }), // 6 px
     ("hand-close-rect", "ssv", Pin { max_frac: 0.0015, why: "real non-convex mesh (fingers): wedges of neighbouring silhouette edges overlap (Paper III §5.3)" }), // 6 px
-    ("hand-close-rect", "wedge-blending", Pin { max_frac: 0.0381, why: "the silhouette from the light center is several loops of one mesh (6 at 128²), blended with the ε of independent occluders (Forest et al. §5); not separated per pixel" }), // 155 px
+    ("hand-close-rect", "wedge-blending", Pin { max_frac: 0.0381, why: "the silhouette from the light center is several loops of one mesh (6), blended with the ε of independent occluders (Forest et al. §5); not separated per pixel" }), // 155 px
     ("hand-close-sphere", "nsample", NSAMPLE),
     ("hand-close-sphere", "hard-sv", Pin { max_frac: 0.2046, why: "the hard shadow from the light center has no penumbra" }), // 834 px
     ("hand-close-sphere", "pw2002", Pin { max_frac: 0.3049, why: "penumbra wedges fail on real meshes (issue 28): the fingers' short silhouette edges, wedges overlapping; Paper I/II's falloff approximate" }), // 1243 px
@@ -153,7 +153,7 @@ const TABLE: &[(&str, &str, Bound)] = &[
     ("hand-shell-rect", "hard-sv", Pin { max_frac: 0.1961, why: "the hard shadow from the light center has no penumbra; the same 799 px as hand-close-rect (counts of 2 read shadowed)" }), // 799 px
     ("hand-shell-rect", "ssv-optimized", Pin { max_frac: 0.1956, why: "shell: every silhouette edge has a twin on the back sheet, so every penumbra is summed twice, then clamped (docs/mesh-repair.md); 6 px closed" }), // 797 px
     ("hand-shell-rect", "ssv", Pin { max_frac: 0.1956, why: "shell: every silhouette edge has a twin on the back sheet, so every penumbra is summed twice, then clamped (docs/mesh-repair.md); 6 px closed" }), // 797 px
-    ("hand-shell-rect", "wedge-blending", Pin { max_frac: 0.0874, why: "shell: twin silhouette edges on the two sheets, each penumbra counted twice in its loop before blending; 155 px closed" }), // 356 px
+    ("hand-shell-rect", "wedge-blending", Pin { max_frac: 0.0874, why: "shell: twin silhouette edges on the two sheets (11 loops against 6 closed), each penumbra counted twice; 155 px closed" }), // 356 px
     ("hand-shell-sphere", "nsample", Correct { max_frac: 0.002, why: "a shell counts 2 behind both sheets, still nonzero (Bergeron 1986), so each hard shadow is exact; N = 1024 sampling error below the threshold" }),
     ("hand-shell-sphere", "hard-sv", Pin { max_frac: 0.2046, why: "the hard shadow from the light center has no penumbra" }), // 834 px
     ("hand-shell-sphere", "pw2002", Pin { max_frac: 0.2895, why: "fails closed too (issue 28; 1243 px on hand-close-sphere); as a shell every wedge has a twin on the back sheet, the LI buffer sums both (mean |e| 0.164 vs 0.114 closed, 128²)" }), // 1180 px
