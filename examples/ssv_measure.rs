@@ -12,6 +12,7 @@ use penumbra::gpu::counters::Counters;
 use penumbra::gpu::vbuffer::VBufferFormat;
 use penumbra::light::coverage_texture::{CoverageFilter, CoverageTexture, CoverageTextureKey};
 use penumbra::methods::hard_sv::ShadowTest;
+use penumbra::methods::recorder::PassRecorder;
 use penumbra::methods::ssv::{render, CoverageMode, SsvSettings};
 use penumbra::methods::{self};
 use penumbra::metrics::compare;
@@ -125,13 +126,18 @@ fn main() {
             };
             // Warm the coverage-texture cache so the time is the render's (§3.3: the texture
             // is computed once per light shape).
-            render(&frame, &settings);
+            render(&mut PassRecorder::new(&frame, "ssv"), &settings);
             let t = Instant::now();
-            let r = render(&frame, &settings);
+            let mut rec = PassRecorder::new(&frame, "ssv");
+            let r = render(&mut rec, &settings);
             let secs = t.elapsed().as_secs_f64();
-            let e = compare(&r.visibility, &reference.visibility);
-            let mut c = r.pass1;
-            c += r.pass2;
+            let out = rec.finish(r.visibility, serde_json::Value::Null);
+            let e = compare(&out.visibility, &reference.visibility);
+            // The two passes after the scene pass.
+            let mut c = Counters::default();
+            for p in out.stats.passes.iter().skip(1) {
+                c += p.counters;
+            }
             if label == "exact, f32" {
                 ssv_bytes = c.total_bytes();
             }

@@ -56,6 +56,31 @@
 //! in the code) and `docs/papers.md` (the full reference of every paper cited as "Paper III
 //! §3.2.2" and so on).
 
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+// The library's API (issue 30, item 4): what a user needs to load a scene, render its methods
+// and read the results, re-exported here; `examples/library.rs` uses only these. The modules
+// below stay public for the project's own tests, benches, fuzz targets and experiments, which
+// reach the emulated GPU's internals (`docs/architecture.md` "The public API").
+pub use error::InputError;
+pub use gpu::counters::Counters;
+pub use methods::dump::BufferDump;
+pub use methods::output::{BufferPlan, MethodOutput, MethodPlan, MethodStats};
+pub use metrics::error_report::ErrorReport;
+pub use metrics::ErrorStats;
+pub use pass::PassStats;
+pub use render::{render_scene, render_scene_dumping, MethodRun};
+pub use scene::file::{load_scene_file, parse_scene_str, resolve as load_scene, Format};
+pub use scene::Scene;
+pub use visibility::Visibility;
+
+/// The names of every method, in the registry's order ([`methods::ALL`]): what
+/// [`Scene::methods`] may list.
+pub fn method_names() -> impl Iterator<Item = &'static str> {
+    methods::names()
+}
+
 pub mod drawing;
 pub mod error;
 pub mod experiment;

@@ -27,13 +27,19 @@ use penumbra::light::coverage_texture::{
     coverage_texture, lookup_error_bound, CoverageFilter, CoverageTextureKey,
 };
 use penumbra::methods::hard_sv::ShadowTest;
-use penumbra::methods::ssv::{read_settings, render, CoverageMode, SsvSettings};
+use penumbra::methods::recorder::PassRecorder;
+use penumbra::methods::ssv::{read_settings, CoverageMode, SsvRender, SsvSettings};
 use penumbra::render::render_scene;
 use penumbra::scene::procedural::two_sided_quad;
 use penumbra::scene::{builtin, OptionValue, Scene};
 use penumbra::visibility::Visibility;
 use proptest::prelude::*;
 use std::sync::Arc;
+
+/// `ssv`'s two passes on `frame` with `s`, through a recorder of their own.
+fn render(frame: &Frame, s: &SsvSettings) -> SsvRender {
+    penumbra::methods::ssv::render(&mut PassRecorder::new(frame, "ssv"), s)
+}
 
 fn small(name: &str) -> Scene {
     let mut s = builtin::load(name).unwrap();

@@ -31,11 +31,20 @@ use penumbra::geometry::ssv_wedge::{SsvWedge, WedgeLight};
 use penumbra::gpu::vbuffer::VBufferFormat;
 use penumbra::light::coverage::{polygon_area, sphere_edge_coverage_exact};
 use penumbra::methods::hard_sv::ShadowTest;
-use penumbra::methods::ssv::{read_settings, render, CoverageMode, SsvSettings};
+use penumbra::methods::output::MethodOutput;
+use penumbra::methods::recorder::PassRecorder;
+use penumbra::methods::ssv::{read_settings, CoverageMode, SsvSettings};
 use penumbra::render::render_scene;
 use penumbra::scene::procedural::two_sided_quad;
 use penumbra::scene::{builtin, LightShape, OptionValue, Scene};
 use proptest::prelude::*;
+
+/// `ssv`'s two passes on `frame` with `s`, through a recorder of their own.
+fn render(frame: &Frame, s: &SsvSettings) -> MethodOutput {
+    let mut rec = PassRecorder::new(frame, "ssv");
+    let r = penumbra::methods::ssv::render(&mut rec, s);
+    rec.finish(r.visibility, serde_json::Value::Null)
+}
 
 /// `single-quad` at 64² with its 1×1 rectangle replaced by a sphere of radius 0.5 (same
 /// center, 3 above the floor, 2 above the quad).
@@ -156,7 +165,7 @@ fn sphere_hard_cases_stay_in_unit_interval() {
                 ("cube-of-spheres-sphere", _) => 159,
                 _ => 0,
             };
-            assert_eq!(r.clamped_pixels, pinned, "{} {vbuffer:?}", s.source);
+            assert_eq!(r.stats.clamped_pixels, pinned, "{} {vbuffer:?}", s.source);
         }
     }
     // The large light leaves no umbra on the floor under the quad.

@@ -154,6 +154,7 @@ use crate::gpu::shader_vec::SVec3;
 use crate::gpu::texture::Filter;
 use crate::gpu::transform::ClipVertex;
 use crate::methods::output::BufferPlan;
+use crate::methods::recorder::PassRecorder;
 use crate::options::{option_names, option_table, OptionTable};
 use crate::pass::PassStats;
 use crate::scene::LightShape;
@@ -987,61 +988,48 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
 
 /// Run `dbuffer` on a rendered frame (one light: [`super::run`] averages several).
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
-    let start = Instant::now();
+    let mut rec = PassRecorder::new(frame, "dbuffer");
     let s = read_settings(frame)?;
-    let r = render(frame, &s)?;
     let n = s.map_size;
-    let mut buffers = vec![
-        BufferPlan::depth(&frame.gpu),
-        BufferPlan::color_target(
-            format!("D-buffer RGBA {n}x{n} (R |cx_o|, G |cx_uv|, B |cx_pv|, A |cx_s|)"),
-            s.storage,
-            4,
-        ),
-        BufferPlan::depth_target(format!("D-buffer depth {n}x{n}"), s.depth),
-    ];
+    rec.uses(BufferPlan::color_target(
+        format!("D-buffer RGBA {n}x{n} (R |cx_o|, G |cx_uv|, B |cx_pv|, A |cx_s|)"),
+        s.storage,
+        4,
+    ));
+    rec.uses(BufferPlan::depth_target(
+        format!("D-buffer depth {n}x{n}"),
+        s.depth,
+    ));
     if let Some(hiz_tile) = early_z_applies(&frame.gpu, s.distances) {
-        buffers.push(BufferPlan::hiz_zmin_zmax_of(
+        rec.uses(BufferPlan::hiz_zmin_zmax_of(
             "D-buffer depth",
             s.depth,
             hiz_tile,
         ));
     }
-    let mut stats = super::stats_after_scene_pass(
-        "dbuffer",
-        frame,
-        start,
-        &r.passes,
-        buffers,
-        serde_json::json!({
-            "settings": s,
-            "light_view": {
-                "axis": r.view.axis.to_array(),
-                "distance_range": r.range,
-            },
-            "volumes": r.volumes,
-            "dbuffer": r.program,
-            "channel_writes": {
-                "R": r.program.r_writes,
-                "G": r.program.g_writes,
-                "B": r.program.b_writes,
-                "A": r.program.a_writes,
-            },
-            "screen": r.screen,
-            "gpu": frame.gpu,
-        }),
-    );
-    stats.clamped_pixels = r.screen.t_out_of_range;
-    let dumps = if frame.dump_buffers {
-        dbuffer_dumps(frame, &r, &s)
-    } else {
-        vec![]
-    };
-    Ok(MethodOutput {
-        visibility: r.visibility,
-        dumps,
-        stats,
-    })
+    // The passes time and count themselves ([`render`]), as the tests read them.
+    let r = render(frame, &s)?;
+    r.passes.iter().cloned().for_each(|p| rec.record_pass(p));
+    rec.clamped(r.screen.t_out_of_range);
+    rec.dump_all(|| dbuffer_dumps(frame, &r, &s));
+    let settings = serde_json::json!({
+        "settings": s,
+        "light_view": {
+            "axis": r.view.axis.to_array(),
+            "distance_range": r.range,
+        },
+        "volumes": r.volumes,
+        "dbuffer": r.program,
+        "channel_writes": {
+            "R": r.program.r_writes,
+            "G": r.program.g_writes,
+            "B": r.program.b_writes,
+            "A": r.program.a_writes,
+        },
+        "screen": r.screen,
+        "gpu": frame.gpu,
+    });
+    Ok(rec.finish(r.visibility, settings))
 }
 
 /// The dumps of the D-buffer and of t (module doc).

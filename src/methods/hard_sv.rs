@@ -32,12 +32,11 @@ use crate::gpu::probe::Raw;
 use crate::gpu::raster::{bin, draw_probed};
 use crate::gpu::setup::CullMode;
 use crate::gpu::stencil::{StencilFace, StencilOp, StencilState};
-use crate::methods::output::{BufferPlan, MethodPlan};
+use crate::methods::output::BufferPlan;
+use crate::methods::recorder::PassRecorder;
 use crate::options::{option_names, option_table, OptionTable, OptionType};
-use crate::pass::PassStats;
 use crate::visibility::Visibility;
 use glam::Vec3;
-use std::time::Instant;
 
 option_names! {
     /// The `mode` option of the methods that count shadow-volume boundaries: z-pass, z-fail, or
@@ -318,19 +317,17 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
 
 /// Run `hard-sv` on a rendered frame.
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
-    let start = Instant::now();
+    let mut rec = PassRecorder::new(frame, "hard-sv");
     let center = frame.scene.light().center;
     let options = HardSvOptions::read(frame.scene)?;
     let settings = options.stencil_settings(frame, &[center]);
-    let pass_start = Instant::now();
-    let (tiles, counters) = stencil_shadow(frame, center, &settings);
-    let name = shadow_volume_pass(settings.test);
-    let pass = PassStats {
-        name: name.into(),
-        wall_seconds: pass_start.elapsed().as_secs_f64(),
-        runs: 1,
-        counters,
-    };
+    rec.uses(BufferPlan::stencil8());
+    rec.uses_hiz_depth();
+    let tiles = rec.pass(shadow_volume_pass(settings.test), |pass| {
+        let (tiles, counters) = stencil_shadow(frame, center, &settings);
+        pass.count(counters);
+        tiles
+    });
     let stencil = stencil_row_major(frame, &tiles);
     let prims = frame.prim_ids();
     let vis: Vec<f32> = stencil
@@ -354,17 +351,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
                 "lit where the stencil count is 0, else shadowed"
             })
     });
-    let plan = MethodPlan {
-        method: "hard-sv".into(),
-        passes: vec![frame.pass.name.clone(), name.into()],
-        buffers: [BufferPlan::depth(&frame.gpu), BufferPlan::stencil8()]
-            .into_iter()
-            .chain(frame.gpu.hiz.then(|| BufferPlan::hiz_zmin_zmax(&frame.gpu)))
-            .collect(),
-        settings: serde_json::json!({ "mode": options.mode.written(), "resolved": settings, "gpu": frame.gpu }),
-    };
-    let passes = vec![frame.pass.clone(), pass];
-    let dump = stencil_dump(
+    rec.output(stencil_dump(
         frame,
         "stencil",
         "the 8-bit stencil counts of the hard shadow volumes from the light center (Paper I §3; \
@@ -372,10 +359,9 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         &tiles,
         stencil,
         stencil_event_kind(settings.overflow),
-    );
-    Ok(MethodOutput {
-        visibility: Visibility::Gray(vis),
-        dumps: vec![dump],
-        stats: super::method_stats("hard-sv", frame, start, &plan, passes),
-    })
+    ));
+    Ok(rec.finish(
+        Visibility::Gray(vis),
+        serde_json::json!({ "mode": options.mode.written(), "resolved": settings, "gpu": frame.gpu }),
+    ))
 }

@@ -13,19 +13,18 @@
 use super::output::MethodOutput;
 use crate::error::InputError;
 use crate::frame::Frame;
-use crate::methods::output::MethodPlan;
+use crate::methods::recorder::PassRecorder;
 use crate::scene::Scene;
 use crate::visibility::Visibility;
-use std::time::Instant;
 
 /// Run `method` (through `run_one`, the single-light dispatch) once per light of `frame`'s
 /// scene and average the visibilities.
 pub fn run(
-    method: &str,
+    method: &'static str,
     frame: &Frame,
     run_one: impl Fn(&str, &Frame) -> Result<MethodOutput, InputError>,
 ) -> Result<MethodOutput, InputError> {
-    let start = Instant::now();
+    let mut rec = PassRecorder::new(frame, method);
     let lights = frame.scene.lights.len();
     let mut outputs = Vec::with_capacity(lights);
     for k in 0..lights {
@@ -47,56 +46,33 @@ pub fn run(
             .resolve(&visibility.channels(i), false)
             .note(format!("mean of the {lights} lights' visibilities"))
     });
-    let clamped_pixels = outputs.iter().map(|o| o.stats.clamped_pixels).sum();
-    let warnings = outputs
-        .iter()
-        .enumerate()
-        .flat_map(|(k, o)| {
-            o.stats
-                .warnings
-                .iter()
-                .map(move |w| format!("light {k}: {w}"))
-        })
-        .collect();
-    let mut passes = vec![frame.pass.clone()];
-    let mut dumps = Vec::new();
     let mut plans = Vec::new();
     for (k, out) in outputs.into_iter().enumerate() {
-        passes.extend(
-            out.stats
-                .passes
-                .into_iter()
-                .filter(|p| p.name != frame.pass.name)
-                .map(|mut p| {
-                    p.name = format!("light{k}/{}", p.name);
-                    p
-                }),
-        );
-        dumps.extend(out.dumps.into_iter().map(|mut d| {
+        rec.clamped(out.stats.clamped_pixels);
+        for w in &out.stats.warnings {
+            rec.warn(format!("light {k}: {w}"));
+        }
+        for mut p in out.stats.passes {
+            if p.name != frame.pass.name {
+                p.name = format!("light{k}/{}", p.name);
+                rec.record_pass(p);
+            }
+        }
+        for mut d in out.dumps {
             d.name = format!("{}-light{k}", d.name);
             d.about = format!("light {k} alone: {}", d.about);
-            d
-        }));
+            rec.output(d);
+        }
         plans.push(out.stats.plan);
     }
-    let plan = MethodPlan {
-        method: method.into(),
-        passes: passes.iter().map(|p| p.name.clone()).collect(),
-        buffers: vec![],
-        settings: serde_json::json!({
+    Ok(rec.finish(
+        visibility,
+        serde_json::json!({
             "lights": lights,
             "combine": "mean of per-light visibilities (f32 sum in light order, / n)",
             "per_light": plans,
         }),
-    };
-    let mut stats = super::method_stats(method, frame, start, &plan, passes);
-    stats.clamped_pixels = clamped_pixels;
-    stats.warnings = warnings;
-    Ok(MethodOutput {
-        visibility,
-        dumps,
-        stats,
-    })
+    ))
 }
 
 /// The mean of the visibilities, per pixel and channel: f32 sum in order, divided by n once.

@@ -25,6 +25,7 @@ pub mod penumbra_map;
 pub mod pw2002;
 pub mod pw_restructured;
 pub mod raycast;
+pub mod recorder;
 pub mod ssv;
 pub mod ssv_optimized;
 pub mod wedge_blending;
@@ -39,12 +40,9 @@ use crate::gpu::probe::{PassProbe, Tap};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::texture::Filter;
 use crate::gpu::tiling::Tiling;
-use crate::methods::output::{BufferPlan, MethodPlan};
 use crate::options::{option_names, KeyDoc, OptionTable};
-use crate::pass::PassStats;
 use crate::scene::{LightShape, Scene};
-use output::{MethodOutput, MethodStats};
-use std::time::Instant;
+use output::MethodOutput;
 
 /// One method as the rest of the crate knows it (`docs/architecture.md` "How to add a
 /// method"): each method's module declares one (`METHOD`) and [`ALL`] lists them, so that the
@@ -292,7 +290,7 @@ fn known(method: &str, frame: &Frame) -> Result<&'static Method, InputError> {
 pub fn run(method: &str, frame: &Frame) -> Result<MethodOutput, InputError> {
     let m = known(method, frame)?;
     let mut out = if frame.scene.is_multi_light() && m.lights == SeveralLights::PerLight {
-        light_average::run(method, frame, |_, f| (m.run)(f))?
+        light_average::run(m.name, frame, |_, f| (m.run)(f))?
     } else {
         (m.run)(frame)?
     };
@@ -458,58 +456,6 @@ where
         counters += c;
     }
     (out, stats, counters)
-}
-
-/// [`MethodStats`] of a method that started at `start` and ran `passes` after the frame's
-/// scene pass: the plan lists the scene pass and them, with `buffers` and `settings`.
-pub fn stats_after_scene_pass(
-    method: &str,
-    frame: &Frame,
-    start: Instant,
-    passes: &[PassStats],
-    buffers: Vec<BufferPlan>,
-    settings: serde_json::Value,
-) -> MethodStats {
-    let mut all = vec![frame.pass.clone()];
-    all.extend(passes.iter().cloned());
-    let plan = MethodPlan {
-        method: method.into(),
-        passes: all.iter().map(|p| p.name.clone()).collect(),
-        buffers,
-        settings,
-    };
-    method_stats(method, frame, start, &plan, all)
-}
-
-/// Assemble [`MethodStats`] for a method that started at `start` (totals summed over passes).
-pub fn method_stats(
-    method: &str,
-    frame: &Frame,
-    start: Instant,
-    plan: &MethodPlan,
-    passes: Vec<PassStats>,
-) -> MethodStats {
-    let mut totals = Counters::default();
-    for p in &passes {
-        totals += p.counters;
-    }
-    MethodStats {
-        method: method.into(),
-        width: frame.scene.width,
-        height: frame.scene.height,
-        wall_seconds: start.elapsed().as_secs_f64(),
-        plan: serde_json::to_value(plan).unwrap_or(serde_json::Value::Null),
-        passes,
-        totals,
-        warnings: Vec::new(),
-        clamped_pixels: 0,
-        meshes: frame
-            .scene
-            .meshes
-            .iter()
-            .map(crate::scene::repair::MeshReport::of)
-            .collect(),
-    }
 }
 
 /// Check `method`'s options against the rendered `frame` without running it

@@ -32,18 +32,16 @@ use super::output::MethodOutput;
 use crate::error::InputError;
 use crate::frame::{Frame, BACKGROUND};
 use crate::geometry::near_plane::representative_light_points;
-use crate::gpu::counters::Counters;
 use crate::gpu::probe::{Overflow, PrimitiveKind, Raw};
 use crate::light::sampling::{stratified, LightSample, Pattern};
 use crate::methods::hard_sv::CountMode;
-use crate::methods::output::{BufferPlan, MethodPlan};
+use crate::methods::output::BufferPlan;
+use crate::methods::recorder::PassRecorder;
 use crate::options::{option_table, OptionTable, OptionType};
-use crate::pass::PassStats;
 use crate::scene::{LightShape, Scene};
 use crate::visibility::Visibility;
 use glam::Vec3;
 use rayon::prelude::*;
-use std::time::Instant;
 
 /// Default sample count (Paper III §5.1).
 pub const DEFAULT_SAMPLES: u32 = 1024;
@@ -114,16 +112,26 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
 
 /// Run `nsample` on a rendered frame.
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
-    let start = Instant::now();
+    let mut rec = PassRecorder::new(frame, "nsample");
     let scene = frame.scene;
     let (samples, settings, mode) = options(frame)?;
     let colored = matches!(scene.light().shape, LightShape::TexturedRect { .. });
 
     let tiling = &frame.tiling;
-    let mut acc: Vec<Vec<[f64; 3]>> = (0..tiling.tile_count())
-        .map(|_| vec![[0.0; 3]; tiling.tile_len()])
-        .collect();
-    let mut counters = Counters::default();
+    rec.uses(BufferPlan::stencil8());
+    let mut acc: Vec<Vec<[f64; 3]>> = rec.allocate(
+        BufferPlan {
+            name: "accumulator".into(),
+            format: "f64x3".into(),
+            bytes_per_sample: 24,
+        },
+        || {
+            (0..tiling.tile_count())
+                .map(|_| vec![[0.0; 3]; tiling.tile_len()])
+                .collect()
+        },
+    );
+    rec.uses_hiz_depth();
     let mut overflows = vec![
         0u32;
         if frame.dump_buffers {
@@ -132,7 +140,10 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             0
         }
     ];
-    let pass_start = Instant::now();
+    let pass_name = match settings.test {
+        ShadowTest::ZPass => "sample-shadow-volume-zpass",
+        ShadowTest::ZFail => "sample-shadow-volume-zfail",
+    };
     let f64_bits = |px: &[f64; 3]| Raw::Channels(px.map(|v| Raw::F64(v.to_bits())).to_vec());
     frame.probe_record("accumulate", |tap, _| {
         tap.event().clear("accumulator", f64_bits(&[0.0; 3]))
@@ -152,78 +163,76 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             .as_ref()
             .map(|p| p.enter(move |sc| sc.sample = Some(k as u32)))
     };
-    for (b, chunk) in samples.chunks(batch).enumerate() {
-        let rendered: Vec<_> = chunk
-            .par_iter()
-            .enumerate()
-            .map(|(j, s)| {
-                let _scope = scoped(b * batch + j);
-                stencil_shadow(frame, s.position, &settings)
-            })
-            .collect();
-        for (j, (s, (stencil, c))) in chunk.iter().zip(rendered).enumerate() {
-            let k = b * batch + j;
-            let _scope = scoped(k);
-            counters += c;
-            if frame.dump_buffers {
-                let sample = row_major(tiling, &stencil, |t| &t.overflows);
-                overflows.iter_mut().zip(sample).for_each(|(a, b)| *a += b);
-            }
-            let w = s.weight.map(f64::from);
-            let add = |px: &mut [f64; 3], v: u8| {
-                if v == 0 {
-                    for ch in 0..3 {
-                        px[ch] += w[ch];
-                    }
-                }
-            };
-            let probe = frame.probe_pass("accumulate");
-            acc.par_iter_mut()
-                .zip(&stencil)
+    rec.pass(pass_name, |pass| {
+        pass.set_runs(samples.len() as u64);
+        for (b, chunk) in samples.chunks(batch).enumerate() {
+            let rendered: Vec<_> = chunk
+                .par_iter()
                 .enumerate()
-                .for_each(
-                    |(t, (a, st))| match probe.as_ref().filter(|p| p.watches_tile(t)) {
-                        None => a.iter_mut().zip(&st.values).for_each(|(px, v)| add(px, *v)),
-                        Some(p) => {
-                            for (i, (px, v)) in a.iter_mut().zip(&st.values).enumerate() {
-                                let before = *px;
-                                add(px, *v);
-                                if let Some(tap) = p.tap(t, i) {
-                                    let e = tap
-                                        .event()
-                                        .primitive(PrimitiveKind::LightSample, k as u32, "", None)
-                                        .value("lit", (*v == 0) as u8 as f64)
-                                        .value("weight", w[0]);
-                                    tap.push(e.read("stencil", Raw::U8(*v)));
-                                    let e = tap.event().write(
-                                        "accumulator",
-                                        f64_bits(&before),
-                                        f64_bits(px),
-                                        Overflow::NonFinite,
-                                        0,
-                                    );
-                                    tap.push(e.note(if *v == 0 {
-                                        "stencil 0: the sample lights the pixel"
-                                    } else {
-                                        "stencil ≠ 0: in the sample's shadow"
-                                    }));
+                .map(|(j, s)| {
+                    let _scope = scoped(b * batch + j);
+                    stencil_shadow(frame, s.position, &settings)
+                })
+                .collect();
+            for (j, (s, (stencil, c))) in chunk.iter().zip(rendered).enumerate() {
+                let k = b * batch + j;
+                let _scope = scoped(k);
+                pass.count(c);
+                if frame.dump_buffers {
+                    let sample = row_major(tiling, &stencil, |t| &t.overflows);
+                    overflows.iter_mut().zip(sample).for_each(|(a, b)| *a += b);
+                }
+                let w = s.weight.map(f64::from);
+                let add = |px: &mut [f64; 3], v: u8| {
+                    if v == 0 {
+                        for ch in 0..3 {
+                            px[ch] += w[ch];
+                        }
+                    }
+                };
+                let probe = frame.probe_pass("accumulate");
+                acc.par_iter_mut()
+                    .zip(&stencil)
+                    .enumerate()
+                    .for_each(
+                        |(t, (a, st))| match probe.as_ref().filter(|p| p.watches_tile(t)) {
+                            None => a.iter_mut().zip(&st.values).for_each(|(px, v)| add(px, *v)),
+                            Some(p) => {
+                                for (i, (px, v)) in a.iter_mut().zip(&st.values).enumerate() {
+                                    let before = *px;
+                                    add(px, *v);
+                                    if let Some(tap) = p.tap(t, i) {
+                                        let e = tap
+                                            .event()
+                                            .primitive(
+                                                PrimitiveKind::LightSample,
+                                                k as u32,
+                                                "",
+                                                None,
+                                            )
+                                            .value("lit", (*v == 0) as u8 as f64)
+                                            .value("weight", w[0]);
+                                        tap.push(e.read("stencil", Raw::U8(*v)));
+                                        let e = tap.event().write(
+                                            "accumulator",
+                                            f64_bits(&before),
+                                            f64_bits(px),
+                                            Overflow::NonFinite,
+                                            0,
+                                        );
+                                        tap.push(e.note(if *v == 0 {
+                                            "stencil 0: the sample lights the pixel"
+                                        } else {
+                                            "stencil ≠ 0: in the sample's shadow"
+                                        }));
+                                    }
                                 }
                             }
-                        }
-                    },
-                );
+                        },
+                    );
+            }
         }
-    }
-    let pass_name = match settings.test {
-        ShadowTest::ZPass => "sample-shadow-volume-zpass",
-        ShadowTest::ZFail => "sample-shadow-volume-zfail",
-    };
-    let pass = PassStats {
-        name: pass_name.into(),
-        wall_seconds: pass_start.elapsed().as_secs_f64(),
-        runs: samples.len() as u64,
-        counters,
-    };
+    });
     let flat: Vec<[f64; 3]> = acc.into_iter().flatten().collect();
     let rows = tiling.to_row_major(&flat);
     let prims = frame.prim_ids();
@@ -259,31 +268,10 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
                 "the lit samples' weights, clamped to [0, 1], as f32"
             })
     });
-    let plan = MethodPlan {
-        method: "nsample".into(),
-        passes: vec![
-            frame.pass.name.clone(),
-            format!("{pass_name} ×{}", samples.len()),
-        ],
-        buffers: [
-            BufferPlan::depth(&frame.gpu),
-            BufferPlan::stencil8(),
-            BufferPlan {
-                name: "accumulator".into(),
-                format: "f64x3".into(),
-                bytes_per_sample: 24,
-            },
-        ]
-        .into_iter()
-        .chain(frame.gpu.hiz.then(|| BufferPlan::hiz_zmin_zmax(&frame.gpu)))
-        .collect(),
-        settings: serde_json::json!({ "n": samples.len(), "pattern": "centered", "mode": mode.written(), "resolved": settings, "colored": colored, "gpu": frame.gpu }),
-    };
-    let passes = vec![frame.pass.clone(), pass];
-    let dumps = if frame.dump_buffers {
+    rec.dump(|| {
         let channels = if colored { 3 } else { 1 };
         let sums = rows.iter().flat_map(|p| p[..channels].to_vec()).collect();
-        vec![BufferDump::new(
+        BufferDump::new(
             "accumulator",
             "per pixel the f64 sum, in sample order, of the weights of the light samples whose \
              stencil count was 0 (Paper III §5.1); visibility = f32(clamp(sum, 0, 1)), \
@@ -296,13 +284,10 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             stencil_event_kind(settings.overflow),
             overflows,
             Vec::new(),
-        ))]
-    } else {
-        vec![]
-    };
-    Ok(MethodOutput {
+        ))
+    });
+    Ok(rec.finish(
         visibility,
-        dumps,
-        stats: super::method_stats("nsample", frame, start, &plan, passes),
-    })
+        serde_json::json!({ "n": samples.len(), "pattern": "centered", "mode": mode.written(), "resolved": settings, "colored": colored, "gpu": frame.gpu }),
+    ))
 }

@@ -131,6 +131,7 @@ use crate::gpu::setup::{setup_all_barycentric, CullMode};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::texture::Filter;
 use crate::methods::output::BufferPlan;
+use crate::methods::recorder::PassRecorder;
 use crate::options::{option_names, option_table, OptionTable};
 use crate::pass::PassStats;
 use crate::scene::{LightShape, Scene};
@@ -750,59 +751,53 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
 
 /// Run `penumbra-map` on a rendered frame (one light: [`super::run`] averages several).
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
-    let start = Instant::now();
+    let mut rec = PassRecorder::new(frame, "penumbra-map");
     let s = read_settings(frame)?;
-    let r = render(frame, &s)?;
     let n = s.map_size;
-    let mut buffers = vec![
-        BufferPlan::depth(&frame.gpu),
-        BufferPlan::depth_target(format!("shadow-map {n}x{n}"), s.depth),
-        BufferPlan::color_target(format!("penumbra-map colour {n}x{n}"), s.storage, 1),
-        BufferPlan::depth_target(format!("penumbra-map depth {n}x{n}"), s.depth),
-    ];
+    rec.uses(BufferPlan::depth_target(
+        format!("shadow-map {n}x{n}"),
+        s.depth,
+    ));
+    rec.uses(BufferPlan::color_target(
+        format!("penumbra-map colour {n}x{n}"),
+        s.storage,
+        1,
+    ));
+    rec.uses(BufferPlan::depth_target(
+        format!("penumbra-map depth {n}x{n}"),
+        s.depth,
+    ));
     if let Some(hiz_tile) = frame.gpu.hiz_tile() {
-        buffers.push(BufferPlan::hiz_zmin_zmax_of(
+        rec.uses(BufferPlan::hiz_zmin_zmax_of(
             "shadow map",
             s.depth,
             hiz_tile,
         ));
     }
-    let stats = super::stats_after_scene_pass(
-        "penumbra-map",
-        frame,
-        start,
-        &r.passes,
-        buffers,
-        serde_json::json!({
-            "settings": s,
-            "light_view": {
-                "axis": r.view.axis.to_array(),
-                "near": r.view.proj.near,
-                "far": r.view.proj.far,
-            },
-            "silhouette_edges": r.silhouette.0,
-            "silhouette_loops": r.silhouette.1,
-            "max_silhouette_vertex_degree": r.silhouette.2,
-            "cones": r.geometry.cones,
-            "sheets": r.geometry.sheets,
-            "skipped_sheets": r.geometry.skipped_sheets,
-            "max_sheet_twist_deg": r.geometry.max_sheet_twist_deg,
-            "penumbra_triangles": r.geometry.triangles.len(),
-            "program": r.program,
-            "screen": r.screen,
-            "gpu": frame.gpu,
-        }),
-    );
-    let dumps = if frame.dump_buffers {
-        map_dumps(&r, &s)
-    } else {
-        vec![]
-    };
-    Ok(MethodOutput {
-        visibility: r.visibility,
-        dumps,
-        stats,
-    })
+    // The passes time and count themselves ([`render`]), as the tests read them.
+    let r = render(frame, &s)?;
+    r.passes.iter().cloned().for_each(|p| rec.record_pass(p));
+    rec.dump_all(|| map_dumps(&r, &s));
+    let settings = serde_json::json!({
+        "settings": s,
+        "light_view": {
+            "axis": r.view.axis.to_array(),
+            "near": r.view.proj.near,
+            "far": r.view.proj.far,
+        },
+        "silhouette_edges": r.silhouette.0,
+        "silhouette_loops": r.silhouette.1,
+        "max_silhouette_vertex_degree": r.silhouette.2,
+        "cones": r.geometry.cones,
+        "sheets": r.geometry.sheets,
+        "skipped_sheets": r.geometry.skipped_sheets,
+        "max_sheet_twist_deg": r.geometry.max_sheet_twist_deg,
+        "penumbra_triangles": r.geometry.triangles.len(),
+        "program": r.program,
+        "screen": r.screen,
+        "gpu": frame.gpu,
+    });
+    Ok(rec.finish(r.visibility, settings))
 }
 
 /// The dumps of the shadow map and the penumbra map (module doc).

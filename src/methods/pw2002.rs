@@ -64,12 +64,11 @@ use crate::gpu::raster::{bin, draw_probed, TileDraw};
 use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::shader_vec::SVec3;
-use crate::methods::output::{BufferPlan, MethodPlan};
+use crate::methods::output::BufferPlan;
+use crate::methods::recorder::PassRecorder;
 use crate::options::{option_names, option_table, OptionTable, Switch};
-use crate::pass::PassStats;
 use crate::scene::{LightShape, Scene};
 use crate::visibility::Visibility;
-use std::time::Instant;
 
 /// How `pw2002` values the points where an eye ray enters or leaves a wedge.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -488,29 +487,36 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
 
 /// Run `pw2002` on a rendered frame.
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
-    let start = Instant::now();
     let s = options(frame)?;
     if s.multi_light == MultiLight::PerLight && frame.scene.is_multi_light() {
         return super::light_average::run("pw2002", frame, |_, f| run(f));
     }
-    let pass_start = Instant::now();
-    let set = frame_wedges(frame, &s)?;
-    let (tiles, counters) = render_li(frame, &set, &s);
-    let pass = PassStats {
-        name: "wedges".into(),
-        wall_seconds: pass_start.elapsed().as_secs_f64(),
-        runs: 1,
-        counters,
-    };
+    let mut rec = PassRecorder::new(frame, "pw2002");
+    rec.uses(li_buffer_plan(s.li));
+    if s.hiz_culling {
+        rec.uses_hiz_depth();
+    }
+    let (set, tiles) = rec.pass("wedges", |pass| {
+        let set = frame_wedges(frame, &s)?;
+        let (tiles, counters) = render_li(frame, &set, &s);
+        pass.count(counters);
+        Ok::<_, InputError>((set, tiles))
+    })?;
     let li = li_row_major(frame, &tiles);
-    let plan = MethodPlan {
-        method: "pw2002".into(),
-        passes: vec![frame.pass.name.clone(), "wedges".into()],
-        buffers: [BufferPlan::depth(&frame.gpu), li_buffer_plan(s.li)]
-            .into_iter()
-            .chain(s.hiz_culling.then(|| BufferPlan::hiz_zmin_zmax(&frame.gpu)))
-            .collect(),
-        settings: serde_json::json!({
+    let (visibility, clamped) = resolve(frame, &li);
+    rec.clamped(clamped.iter().filter(|&&c| c).count() as u64);
+    let lights = representative_light_points(frame.scene);
+    if eye_in_shadow(frame.scene, frame.proj.near, &lights) {
+        rec.warn(
+            "the eye is in shadow: Paper I counts wedges z-pass only, so this result is wrong \
+             where the eye's shadow volumes are (pw-restructured has Paper II's z-fail)"
+                .into(),
+        );
+    }
+    rec.dump(|| li_dump(frame, &s, &tiles, &li, clamped, "Paper I §4"));
+    Ok(rec.finish(
+        visibility,
+        serde_json::json!({
             "settings": s,
             "wedges": set.wedges.len(),
             "extra_corner_wedges": set.extra_wedges,
@@ -518,34 +524,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             "open_wedges": set.open_wedges,
             "gpu": frame.gpu,
         }),
-    };
-    let (visibility, clamped) = resolve(frame, &li);
-    let mut stats = super::method_stats(
-        "pw2002",
-        frame,
-        start,
-        &plan,
-        vec![frame.pass.clone(), pass],
-    );
-    stats.clamped_pixels = clamped.iter().filter(|&&c| c).count() as u64;
-    let lights = representative_light_points(frame.scene);
-    if eye_in_shadow(frame.scene, frame.proj.near, &lights) {
-        stats.warnings.push(
-            "the eye is in shadow: Paper I counts wedges z-pass only, so this result is wrong \
-             where the eye's shadow volumes are (pw-restructured has Paper II's z-fail)"
-                .into(),
-        );
-    }
-    let dumps = if frame.dump_buffers {
-        vec![li_dump(frame, &s, &tiles, &li, clamped, "Paper I §4")]
-    } else {
-        vec![]
-    };
-    Ok(MethodOutput {
-        visibility,
-        dumps,
-        stats,
-    })
+    ))
 }
 
 /// The plan entry of the LI buffer in format `li`.

@@ -100,7 +100,8 @@ use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::shader_vec::SVec3;
 use crate::gpu::stencil::{StencilFace, StencilOp, StencilState};
 use crate::methods::hard_sv::CountMode;
-use crate::methods::output::{BufferPlan, MethodPlan};
+use crate::methods::output::BufferPlan;
+use crate::methods::recorder::PassRecorder;
 use crate::options::{option_names, option_table, OptionTable, OptionType};
 use crate::pass::PassStats;
 use crate::scene::LightShape;
@@ -687,60 +688,39 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
 
 /// Run `pw-restructured` on a rendered frame.
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
-    let start = Instant::now();
     let (s, mode) = read_settings(frame)?;
     if s.wedge.multi_light == MultiLight::PerLight && frame.scene.is_multi_light() {
         return super::light_average::run("pw-restructured", frame, |_, f| run(f));
     }
-    let set = frame_wedges(frame, &s.wedge)?;
-    let (tiles, passes) = render_li(frame, &set, &s);
-    let li = li_row_major(frame, &tiles);
-    let mut names = vec![frame.pass.name.clone()];
-    names.extend(passes.iter().map(|p| p.name.clone()));
-    let mut buffers = vec![BufferPlan::depth(&frame.gpu), li_buffer_plan(s.wedge.li)];
+    let mut rec = PassRecorder::new(frame, "pw-restructured");
+    rec.uses(li_buffer_plan(s.wedge.li));
     if s.culling != Culling::Off {
         // The depth tiles' zmin and zmax (Paper II §4).
-        buffers.push(BufferPlan::hiz_zmin_zmax(&frame.gpu));
+        rec.uses_hiz_depth();
     }
     if s.passes == Passes::Three {
-        buffers.push(BufferPlan {
+        rec.uses(BufferPlan {
             name: "stencil".into(),
             format: "S8 (offset 128)".into(),
             bytes_per_sample: 1,
         });
     }
-    let plan = MethodPlan {
-        method: "pw-restructured".into(),
-        passes: names,
-        buffers,
-        settings: serde_json::json!({
+    let set = frame_wedges(frame, &s.wedge)?;
+    // The passes time and count themselves ([`render_li`]), as the tests read them.
+    let (tiles, passes) = render_li(frame, &set, &s);
+    passes.into_iter().for_each(|p| rec.record_pass(p));
+    let li = li_row_major(frame, &tiles);
+    let (visibility, clamped) = resolve(frame, &li);
+    rec.clamped(clamped.iter().filter(|&&c| c).count() as u64);
+    rec.dump(|| li_dump(frame, &s.wedge, &tiles, &li, clamped, "Paper II §3, §6"));
+    Ok(rec.finish(
+        visibility,
+        serde_json::json!({
             "mode": mode.written(),
             "resolved": s,
             "wedges": set.wedges.len(),
             "open_wedges": set.open_wedges,
             "gpu": frame.gpu,
         }),
-    };
-    let mut all = vec![frame.pass.clone()];
-    all.extend(passes);
-    let (visibility, clamped) = resolve(frame, &li);
-    let mut stats = super::method_stats("pw-restructured", frame, start, &plan, all);
-    stats.clamped_pixels = clamped.iter().filter(|&&c| c).count() as u64;
-    let dumps = if frame.dump_buffers {
-        vec![li_dump(
-            frame,
-            &s.wedge,
-            &tiles,
-            &li,
-            clamped,
-            "Paper II §3, §6",
-        )]
-    } else {
-        vec![]
-    };
-    Ok(MethodOutput {
-        visibility,
-        dumps,
-        stats,
-    })
+    ))
 }

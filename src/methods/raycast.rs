@@ -98,14 +98,13 @@
 //! jitter (a pure function of `seed` and the stratum), hence the error of the estimate is
 //! correlated between neighbouring pixels rather than noisy.
 
-use super::output::{BufferPlan, MethodOutput, MethodPlan};
+use super::output::MethodOutput;
+use super::recorder::PassRecorder;
 use crate::error::InputError;
 use crate::frame::Frame;
-use crate::gpu::counters::Counters;
 use crate::gpu::probe::{PassProbe, PrimitiveKind};
 use crate::light::sampling::{self, LightSample, Pattern};
 use crate::options::{option_names, option_table, OptionTable, OptionType};
-use crate::pass::PassStats;
 use crate::scene::{Light, LightShape, Scene};
 use crate::visibility::Visibility;
 use bvh::aabb::{Aabb, Bounded};
@@ -113,7 +112,6 @@ use bvh::bounding_hierarchy::BHShape;
 use bvh::bvh::{Bvh, BvhNode};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-use std::time::Instant;
 
 /// Ray-origin offset along the receiver normal, relative to the scene diagonal (module doc,
 /// "Shadow rays").
@@ -1020,31 +1018,31 @@ pub const METHOD: super::Method = super::Method {
 /// rasterized methods see; `"primary-ray"` the exact hit of the ray through the pixel center
 /// with the visible triangle's plane.
 fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
-    let start = Instant::now();
+    // The frame's scene pass writes the depth buffer whatever the receivers are read from.
+    let mut rec = PassRecorder::new(frame, "raycast");
     let scene = frame.scene;
     let (settings, receiver) = raycast_options(scene)?;
-    let pass_start = Instant::now();
-    let primary;
-    let receivers = if receiver == ReceiverPoint::PrimaryRay {
-        primary = frame.primary_ray_receivers();
-        &primary[..]
-    } else {
-        frame.receivers()
-    };
-    let probe = frame.probe_pass("raycast");
-    let visibility = raycast_visibility_probed(scene, receivers, &settings, probe.as_ref());
-    let pass = PassStats {
-        name: "raycast".into(),
-        wall_seconds: pass_start.elapsed().as_secs_f64(),
-        runs: 1,
-        counters: Counters::default(),
-    };
-    let plan = MethodPlan {
-        method: "raycast".into(),
-        passes: vec![frame.pass.name.clone(), "raycast".into()],
-        // The frame's scene pass writes the depth buffer whatever the receivers are read from.
-        buffers: vec![BufferPlan::depth(&frame.gpu)],
-        settings: serde_json::json!({
+    let visibility = rec.pass("raycast", |pass| {
+        let primary;
+        let receivers = if receiver == ReceiverPoint::PrimaryRay {
+            primary = frame.primary_ray_receivers();
+            &primary[..]
+        } else {
+            frame.receivers()
+        };
+        raycast_visibility_probed(scene, receivers, &settings, pass.probe().as_ref())
+    });
+    let snapped = frame.snapped_receivers();
+    if snapped > 0 && receiver == ReceiverPoint::DepthBuffer {
+        rec.warn(format!(
+            "{snapped} pixels: the depth buffer cannot hold the surface there (a near plane too \
+             close for the depth format?); their receivers, for every method, are the exact \
+             hits of the pixel rays with the visible triangles"
+        ));
+    }
+    Ok(rec.finish(
+        visibility,
+        serde_json::json!({
             "samples": settings.samples,
             "seed": settings.seed,
             "pattern": "jittered",
@@ -1054,22 +1052,7 @@ fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
                 SphereDisk::Facing(p) => format!("one disk facing ({}, {}, {})", p.x, p.y, p.z),
             },
         }),
-    };
-    let passes = vec![frame.pass.clone(), pass];
-    let mut stats = super::method_stats("raycast", frame, start, &plan, passes);
-    let snapped = frame.snapped_receivers();
-    if snapped > 0 && receiver == ReceiverPoint::DepthBuffer {
-        stats.warnings.push(format!(
-            "{snapped} pixels: the depth buffer cannot hold the surface there (a near plane too \
-             close for the depth format?); their receivers, for every method, are the exact \
-             hits of the pixel rays with the visible triangles"
-        ));
-    }
-    Ok(MethodOutput {
-        visibility,
-        dumps: vec![],
-        stats,
-    })
+    ))
 }
 
 /// The reference's own sampling noise (issue 15: the "% > 1/255" column is dominated by it for

@@ -95,15 +95,14 @@ use crate::light::coverage_texture::{
     coverage_texture, CoverageFilter, CoverageTexture, CoverageTextureKey, DEFAULT_N, MAX_N, MIN_N,
 };
 use crate::methods::hard_sv::CountMode;
-use crate::methods::output::{BufferPlan, MethodPlan};
+use crate::methods::output::BufferPlan;
+use crate::methods::recorder::PassRecorder;
 use crate::options::{option_names, option_table, OptionTable, OptionType};
-use crate::pass::PassStats;
 use crate::scene::LightShape;
 use crate::visibility::Visibility;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::sync::Arc;
-use std::time::Instant;
 
 /// How the coverage of an edge is computed (module doc, "Coverage").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -292,273 +291,290 @@ const WEDGE_CULLED: &str = "culled for the tile by the hierarchical Z: the wedge
 /// The name of pass 1.
 const HARD_QUADS: &str = "ssv-hard-quads";
 
-/// The result of the two passes.
+/// What the two passes hand back besides what they recorded.
 pub struct SsvRender {
     /// Visibility per pixel, row-major, clamped to [0, 1]; background 1.
     pub visibility: Visibility,
-    /// Receiver pixels whose resolved V-buffer value (some channel) was outside [0, 1].
-    pub clamped_pixels: u64,
-    /// Pass 1 counters.
-    pub pass1: Counters,
-    /// Pass 2 counters.
-    pub pass2: Counters,
     /// Number of wedges, and how many of them were drawn full-screen.
     pub wedges: (usize, usize),
-    /// Wall time of pass 1 and of pass 2 (with the resolve), informational.
-    pub seconds: [f64; 2],
-    /// The buffers before the resolve, when the frame asks for dumps (module doc).
-    pub dumps: Vec<BufferDump>,
 }
 
-/// Render `ssv` with `settings` on `frame` (the light must be a rectangle or a sphere, with
-/// exact coverage for a sphere: [`read_settings`] checks both).
-pub fn render(frame: &Frame, settings: &SsvSettings) -> SsvRender {
-    crate::with_shader_float!(frame.gpu.shader, T => match settings.vbuffer {
-        VBufferFormat::F32 => render_with::<VBufferF32Tile, T>(frame, settings),
-        VBufferFormat::F16 => render_with::<VBufferF16Tile, T>(frame, settings),
-        VBufferFormat::RgbF32 => render_with::<VBufferRgbTile, T>(frame, settings),
-        VBufferFormat::Split8 => render_with::<VBuffer8Tile, T>(frame, settings),
+/// Render `ssv` with `settings` on the recorder's frame (the light must be a rectangle or a
+/// sphere, with exact coverage for a sphere: [`read_settings`] checks both). The passes, the
+/// buffers, the pixels the resolve clamps and the dumps (module doc) go to `rec`.
+pub fn render(rec: &mut PassRecorder, settings: &SsvSettings) -> SsvRender {
+    crate::with_shader_float!(rec.frame().gpu.shader, T => match settings.vbuffer {
+        VBufferFormat::F32 => render_with::<VBufferF32Tile, T>(rec, settings),
+        VBufferFormat::F16 => render_with::<VBufferF16Tile, T>(rec, settings),
+        VBufferFormat::RgbF32 => render_with::<VBufferRgbTile, T>(rec, settings),
+        VBufferFormat::Split8 => render_with::<VBuffer8Tile, T>(rec, settings),
     })
 }
 
-fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSettings) -> SsvRender {
+fn render_with<V: VBufferDump, T: ShaderFloat>(
+    rec: &mut PassRecorder,
+    settings: &SsvSettings,
+) -> SsvRender {
+    let frame = rec.frame();
     let scene = frame.scene;
     let tiling = &frame.tiling;
     let light = WedgeLight::from_light(scene.light()).expect("ssv supports rects and spheres");
     let center = scene.light().center;
-    let mut vbuf: Vec<V> = (0..tiling.tile_count())
-        .map(|_| V::cleared(tiling.tile_len()))
-        .collect();
-    if frame.dump_buffers {
+    if V::FORMAT == VBufferFormat::Split8 {
+        rec.uses(BufferPlan::stencil8());
+    }
+    let vbuffer_plan = BufferPlan {
+        name: "vbuffer".into(),
+        format: format!("{:?}", settings.vbuffer),
+        bytes_per_sample: settings.vbuffer.bytes(),
+    };
+    let mut vbuf: Vec<V> = rec.allocate(vbuffer_plan, || {
+        (0..tiling.tile_count())
+            .map(|_| V::cleared(tiling.tile_len()))
+            .collect()
+    });
+    if frame.gpu.hiz {
+        // Pass 1 (hard quads or the 8-bit version's stencil) and the wedges.
+        rec.uses_hiz_depth();
+        rec.uses(BufferPlan::hiz_receiver_bounds(&frame.gpu));
+    }
+    if rec.dumping() {
         vbuf.iter_mut().for_each(V::record_overflows);
     }
-    let mut dumps = Vec::new();
     frame.probe_record("clear", |tap, _| {
         tap.event().clear("vbuffer", vbuf[0].raw(0))
     });
 
     // Pass 1: hard shadow quads, ±1 (float V-buffers) or the stencil (8-bit version).
-    let t1 = Instant::now();
-    let mut stencil = None;
-    let pass1 = if V::FORMAT == VBufferFormat::Split8 {
+    let stencil = if V::FORMAT == VBufferFormat::Split8 {
         let s = StencilShadowSettings {
             test: settings.test,
             overflow: StencilOverflow::Wrap,
             submission: Submission::TwoSided,
         };
-        let (tiles, c) = stencil_shadow(frame, center, &s);
-        let values = stencil_row_major(frame, &tiles);
-        if frame.dump_buffers {
-            dumps.push(stencil_dump(
-                frame,
-                "stencil",
-                "pass 1 of the 8-bit V-buffer (Paper III §4.2): the stencil counts of the hard \
-                 shadow quads from the light center (wrap); the resolve adds 1 − count",
-                &tiles,
-                values.clone(),
-                EventKind::Wrap,
-            ));
-        }
-        stencil = Some(values);
-        c
+        Some(rec.pass(HARD_QUADS, |pass| {
+            let (tiles, c) = stencil_shadow(frame, center, &s);
+            pass.count(c);
+            let values = stencil_row_major(frame, &tiles);
+            pass.dump(|| {
+                stencil_dump(
+                    frame,
+                    "stencil",
+                    "pass 1 of the 8-bit V-buffer (Paper III §4.2): the stencil counts of the \
+                     hard shadow quads from the light center (wrap); the resolve adds 1 − count",
+                    &tiles,
+                    values.clone(),
+                    EventKind::Wrap,
+                )
+            });
+            values
+        }))
     } else {
-        hard_quads_pass(frame, settings.test, &mut vbuf)
+        rec.pass(HARD_QUADS, |pass| {
+            pass.count(hard_quads_pass(frame, settings.test, &mut vbuf))
+        });
+        None
     };
 
     // Pass 2: wedges.
-    let t2 = Instant::now();
-    let pass1_seconds = t2.duration_since(t1).as_secs_f64();
-    let edges = edge_wedges(frame, &light);
-    let eye_radius = frame.near_plane_radius();
-    let eye = scene.camera.eye;
-    let mut prims: Vec<[ClipVertex; 3]> = Vec::new();
-    let mut owner: Vec<u32> = Vec::new();
-    let mut full_screen = 0;
-    let mut tris: Vec<RasterTriangle> = Vec::new();
-    let mut pass2 = Counters::default();
-    for (k, ew) in edges.iter().enumerate() {
-        let (faces, cull): (Vec<[ClipVertex; 3]>, CullMode) = match &ew.wedge {
-            Some(w) if !w.contains_within(eye, eye_radius) => (
-                w.triangles
-                    .iter()
-                    .map(|t| t.map(|v| v.clip(&frame.proj)))
-                    .collect(),
-                CullMode::Back,
-            ),
-            _ => {
-                full_screen += 1;
-                (FULL_SCREEN.to_vec(), CullMode::None)
-            }
-        };
-        for f in faces {
-            setup_triangle(
-                &f,
-                prims.len() as u32,
-                cull,
-                tiling.width,
-                tiling.height,
-                &mut tris,
-                &mut pass2,
-            );
-            prims.push(f);
-            owner.push(k as u32);
-        }
-    }
-    let receivers = frame.receivers();
-    let texture = match settings.coverage {
-        CoverageMode::Exact => None,
-        CoverageMode::Texture { n, .. } => Some(coverage_texture(&match &scene.light().shape {
-            LightShape::TexturedRect { texture, .. } => CoverageTextureKey::textured(n, texture),
-            _ => CoverageTextureKey::uniform(n),
-        })),
-    };
-    let programs = match (light, settings.coverage) {
-        (WedgeLight::Rect(rect), CoverageMode::Exact) => edges
-            .iter()
-            .map(|w| EdgeCoverageProgram::<T>::new(&rect, w.e0, w.e1))
-            .collect(),
-        _ => Vec::new(),
-    };
-    let source = CoverageSource {
-        light,
-        programs,
-        mode: settings.coverage,
-        texture,
-        receivers,
-        width: scene.width,
-    };
-    let probe = frame.probe_pass("ssv-wedges");
-    // The watched fragment's event, built only there.
-    let event = |tap: Tap, tri: &RasterTriangle| {
-        let k = owner[tri.prim as usize];
-        let (kind, how) = match edges[k as usize].wedge {
-            Some(_) => (PrimitiveKind::Wedge, "face"),
-            None => (PrimitiveKind::FullScreen, "full-screen"),
-        };
-        let detail = format!("of silhouette edge {k}, {how} triangle {}", tri.prim);
-        tap.event()
-            .primitive(kind, k, detail, Some(tri.front_facing))
-    };
-    // The hierarchical-Z unit's decision per wedge: the tiles where it may shade.
-    let kept = frame.gpu.hiz.then(|| {
-        let rounding = InsideTestRounding::new(T::PRECISION.format());
-        let (kept, c) = wedge_kept_tiles(frame, &edges, &owner, &tris, &rounding);
-        pass2 += c;
-        kept
-    });
-    let is_kept = |kept: &[Vec<u32>], t: usize, tri: &RasterTriangle| {
-        kept[owner[tri.prim as usize] as usize]
-            .binary_search(&(t as u32))
-            .is_ok()
-    };
-    // Each face is binned only to its wedge's kept tiles that it touches (each pair decided
-    // in the binning's bands: deciding once per face and collecting the lists measured
-    // slower), and the tiles it touches that were not binned are counted as culled: the
-    // touched pairs less the binned ones, where counting each face's kept tiles again was a
-    // serial loop of 6 ms of a 105 ms pass on two threads (`cube-of-spheres` 512²). With a
-    // probe, every face is binned to the tiles it touches and rejected tile by tile, in
-    // submission order, so that the watched samples record the rejection where it happens
-    // (the same pairs, the same counts).
-    let bins = match (&kept, &probe) {
-        (Some(kept), None) => {
-            let bins = bin_to(tiling, tris.len(), |i, rows| {
-                let tri = &tris[i];
-                let list = &kept[owner[tri.prim as usize] as usize];
-                let (first, end) = (rows.start * tiling.tiles_x, rows.end * tiling.tiles_x);
-                let from = list.partition_point(|&t| t < first);
-                let to = list.partition_point(|&t| t < end);
-                list[from..to]
-                    .iter()
-                    .map(|&t| t as usize)
-                    .filter(move |&t| touches_tile(tiling, tri, t))
-            });
-            count!(
-                pass2.tiles_culled_hiz += (tris
-                    .par_iter()
-                    .map(|tri| touched_tile_count(tiling, tri))
-                    .sum::<usize>()
-                    - bins.pair_count()) as u64
-            );
-            bins
-        }
-        _ => bin(tiling, &tris),
-    };
-    let binned_kept = probe.is_none();
-    pass2 += draw_probed(
-        tiling,
-        &mut vbuf,
-        &tris,
-        &bins,
-        probe.as_ref(),
-        |t, _, tri, c| {
-            let Some(kept) = &kept else {
-                return false;
-            };
-            if binned_kept {
-                return false;
-            }
-            let culled = !is_kept(kept, t, tri);
-            count!(c.tiles_culled_hiz += culled as u64);
-            if let (true, Some(probe)) = (culled, &probe) {
-                probe.record_culled(t, tri, None, WEDGE_CULLED, |tap| event(tap, tri));
-            }
-            culled
-        },
-        |t, vb, tri, f, c, tap| {
-            frame.tiles[t].depth.read(f.local, c);
-            let k = owner[tri.prim as usize];
-            let ew = &edges[k as usize];
-            let event = |tap: Tap| event(tap, tri);
-            let stop = |why: &str| {
-                if let Some(tap) = tap {
-                    tap.push(event(tap).note(why));
+    rec.pass("ssv-wedges", |pass| {
+        let edges = edge_wedges(frame, &light);
+        let eye_radius = frame.near_plane_radius();
+        let eye = scene.camera.eye;
+        let mut prims: Vec<[ClipVertex; 3]> = Vec::new();
+        let mut owner: Vec<u32> = Vec::new();
+        let mut full_screen = 0;
+        let mut tris: Vec<RasterTriangle> = Vec::new();
+        let mut pass2 = Counters::default();
+        for (k, ew) in edges.iter().enumerate() {
+            let (faces, cull): (Vec<[ClipVertex; 3]>, CullMode) = match &ew.wedge {
+                Some(w) if !w.contains_within(eye, eye_radius) => (
+                    w.triangles
+                        .iter()
+                        .map(|t| t.map(|v| v.clip(&frame.proj)))
+                        .collect(),
+                    CullMode::Back,
+                ),
+                _ => {
+                    full_screen += 1;
+                    (FULL_SCREEN.to_vec(), CullMode::None)
                 }
             };
-            let Some(rcv) = source.receivers[(f.y * source.width + f.x) as usize] else {
-                return stop("background: no receiver");
-            };
-            let p = rcv.point.as_dvec3();
-            if ew
-                .wedge
-                .as_ref()
-                .is_some_and(|w| !w.shader_contains::<T>(p))
-            {
-                return stop("receiver outside the wedge: discarded");
+            for f in faces {
+                setup_triangle(
+                    &f,
+                    prims.len() as u32,
+                    cull,
+                    tiling.width,
+                    tiling.height,
+                    &mut tris,
+                    &mut pass2,
+                );
+                prims.push(f);
+                owner.push(k as u32);
             }
-            count!(c.fragments_shaded += 1);
-            let coverage = source.coverage(k as usize, ew, p);
-            add_probed(vb, f.local, coverage, c, tap, |tap| {
-                event(tap).value("coverage", coverage[0] as f64)
-            });
-        },
-    );
-
-    // Resolve: pixels in parallel, each on its own (the same bits for any thread count).
-    let (rgb, clamped): (Vec<[f32; 3]>, Vec<bool>) = (0..receivers.len())
-        .into_par_iter()
-        .map(|i| {
-            if receivers[i].is_none() {
-                return ([1.0; 3], false);
+        }
+        let receivers = frame.receivers();
+        let texture = match settings.coverage {
+            CoverageMode::Exact => None,
+            CoverageMode::Texture { n, .. } => {
+                Some(coverage_texture(&match &scene.light().shape {
+                    LightShape::TexturedRect { texture, .. } => {
+                        CoverageTextureKey::textured(n, texture)
+                    }
+                    _ => CoverageTextureKey::uniform(n),
+                }))
             }
-            let [x, y] = [i as u32 % tiling.width, i as u32 / tiling.width];
-            let v = vbuf[tiling.tile_of(x, y)].resolve(tiling.local(x, y));
-            let umbra = stencil.as_ref().map_or(0.0, |s| 1.0 - s[i] as f32);
-            let unclamped = v.map(|x| x + umbra);
-            let clamped = unclamped.iter().any(|x| !(0.0..=1.0).contains(x));
-            (unclamped.map(|x| x.clamp(0.0, 1.0)), clamped)
-        })
-        .unzip();
-    let clamped_pixels = clamped.iter().filter(|&&c| c).count() as u64;
-    if frame.dump_buffers {
-        let overflows = || row_major(tiling, &vbuf, |t| t.overflows());
-        let events = match V::FORMAT {
-            VBufferFormat::F16 => EventMap::new(EventKind::NonFinite, overflows(), clamped.clone()),
-            VBufferFormat::Split8 => {
-                EventMap::new(EventKind::Saturate, overflows(), clamped.clone())
-            }
-            _ => EventMap::clamps(clamped.clone()),
         };
-        dumps.push(
+        let programs = match (light, settings.coverage) {
+            (WedgeLight::Rect(rect), CoverageMode::Exact) => edges
+                .iter()
+                .map(|w| EdgeCoverageProgram::<T>::new(&rect, w.e0, w.e1))
+                .collect(),
+            _ => Vec::new(),
+        };
+        let source = CoverageSource {
+            light,
+            programs,
+            mode: settings.coverage,
+            texture,
+            receivers,
+            width: scene.width,
+        };
+        let probe = pass.probe();
+        // The watched fragment's event, built only there.
+        let event = |tap: Tap, tri: &RasterTriangle| {
+            let k = owner[tri.prim as usize];
+            let (kind, how) = match edges[k as usize].wedge {
+                Some(_) => (PrimitiveKind::Wedge, "face"),
+                None => (PrimitiveKind::FullScreen, "full-screen"),
+            };
+            let detail = format!("of silhouette edge {k}, {how} triangle {}", tri.prim);
+            tap.event()
+                .primitive(kind, k, detail, Some(tri.front_facing))
+        };
+        // The hierarchical-Z unit's decision per wedge: the tiles where it may shade.
+        let kept = frame.gpu.hiz.then(|| {
+            let rounding = InsideTestRounding::new(T::PRECISION.format());
+            let (kept, c) = wedge_kept_tiles(frame, &edges, &owner, &tris, &rounding);
+            pass2 += c;
+            kept
+        });
+        let is_kept = |kept: &[Vec<u32>], t: usize, tri: &RasterTriangle| {
+            kept[owner[tri.prim as usize] as usize]
+                .binary_search(&(t as u32))
+                .is_ok()
+        };
+        // Each face is binned only to its wedge's kept tiles that it touches (each pair decided
+        // in the binning's bands: deciding once per face and collecting the lists measured
+        // slower), and the tiles it touches that were not binned are counted as culled: the
+        // touched pairs less the binned ones, where counting each face's kept tiles again was a
+        // serial loop of 6 ms of a 105 ms pass on two threads (`cube-of-spheres` 512²). With a
+        // probe, every face is binned to the tiles it touches and rejected tile by tile, in
+        // submission order, so that the watched samples record the rejection where it happens
+        // (the same pairs, the same counts).
+        let bins = match (&kept, &probe) {
+            (Some(kept), None) => {
+                let bins = bin_to(tiling, tris.len(), |i, rows| {
+                    let tri = &tris[i];
+                    let list = &kept[owner[tri.prim as usize] as usize];
+                    let (first, end) = (rows.start * tiling.tiles_x, rows.end * tiling.tiles_x);
+                    let from = list.partition_point(|&t| t < first);
+                    let to = list.partition_point(|&t| t < end);
+                    list[from..to]
+                        .iter()
+                        .map(|&t| t as usize)
+                        .filter(move |&t| touches_tile(tiling, tri, t))
+                });
+                count!(
+                    pass2.tiles_culled_hiz += (tris
+                        .par_iter()
+                        .map(|tri| touched_tile_count(tiling, tri))
+                        .sum::<usize>()
+                        - bins.pair_count()) as u64
+                );
+                bins
+            }
+            _ => bin(tiling, &tris),
+        };
+        let binned_kept = probe.is_none();
+        pass2 += draw_probed(
+            tiling,
+            &mut vbuf,
+            &tris,
+            &bins,
+            probe.as_ref(),
+            |t, _, tri, c| {
+                let Some(kept) = &kept else {
+                    return false;
+                };
+                if binned_kept {
+                    return false;
+                }
+                let culled = !is_kept(kept, t, tri);
+                count!(c.tiles_culled_hiz += culled as u64);
+                if let (true, Some(probe)) = (culled, &probe) {
+                    probe.record_culled(t, tri, None, WEDGE_CULLED, |tap| event(tap, tri));
+                }
+                culled
+            },
+            |t, vb, tri, f, c, tap| {
+                frame.tiles[t].depth.read(f.local, c);
+                let k = owner[tri.prim as usize];
+                let ew = &edges[k as usize];
+                let event = |tap: Tap| event(tap, tri);
+                let stop = |why: &str| {
+                    if let Some(tap) = tap {
+                        tap.push(event(tap).note(why));
+                    }
+                };
+                let Some(rcv) = source.receivers[(f.y * source.width + f.x) as usize] else {
+                    return stop("background: no receiver");
+                };
+                let p = rcv.point.as_dvec3();
+                if ew
+                    .wedge
+                    .as_ref()
+                    .is_some_and(|w| !w.shader_contains::<T>(p))
+                {
+                    return stop("receiver outside the wedge: discarded");
+                }
+                count!(c.fragments_shaded += 1);
+                let coverage = source.coverage(k as usize, ew, p);
+                add_probed(vb, f.local, coverage, c, tap, |tap| {
+                    event(tap).value("coverage", coverage[0] as f64)
+                });
+            },
+        );
+
+        // Resolve: pixels in parallel, each on its own (the same bits for any thread count).
+        let (rgb, clamped): (Vec<[f32; 3]>, Vec<bool>) = (0..receivers.len())
+            .into_par_iter()
+            .map(|i| {
+                if receivers[i].is_none() {
+                    return ([1.0; 3], false);
+                }
+                let [x, y] = [i as u32 % tiling.width, i as u32 / tiling.width];
+                let v = vbuf[tiling.tile_of(x, y)].resolve(tiling.local(x, y));
+                let umbra = stencil.as_ref().map_or(0.0, |s| 1.0 - s[i] as f32);
+                let unclamped = v.map(|x| x + umbra);
+                let clamped = unclamped.iter().any(|x| !(0.0..=1.0).contains(x));
+                (unclamped.map(|x| x.clamp(0.0, 1.0)), clamped)
+            })
+            .unzip();
+        pass.clamped(clamped.iter().filter(|&&c| c).count() as u64);
+        pass.count(pass2);
+        pass.dump(|| {
+            let overflows = || row_major(tiling, &vbuf, |t| t.overflows());
+            let events = match V::FORMAT {
+                VBufferFormat::F16 => {
+                    EventMap::new(EventKind::NonFinite, overflows(), clamped.clone())
+                }
+                VBufferFormat::Split8 => {
+                    EventMap::new(EventKind::Saturate, overflows(), clamped.clone())
+                }
+                _ => EventMap::clamps(clamped.clone()),
+            };
             BufferDump::new(
                 "vbuffer",
                 "the V-buffer before the resolve (Paper III §3.2, §4): cleared to 1, the hard \
@@ -569,41 +585,36 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(frame: &Frame, settings: &SsvSett
                 ElementFormat::VBuffer(V::FORMAT),
                 V::dump_values(tiling, &vbuf),
             )
-            .with_events(events),
-        );
-    }
-    let visibility = if V::FORMAT == VBufferFormat::RgbF32 {
-        Visibility::Rgb(rgb)
-    } else {
-        Visibility::Gray(rgb.iter().map(|v| v[0]).collect())
-    };
-    frame.probe_record("resolve", |tap, i| {
-        let [x, y] = [i as u32 % tiling.width, i as u32 / tiling.width];
-        let e = tap.event().read(
-            "vbuffer",
-            vbuf[tiling.tile_of(x, y)].raw(tiling.local(x, y)),
-        );
-        let e = match &stencil {
-            Some(s) => e.value("stencil", s[i] as f64),
-            None => e,
+            .with_events(events)
+        });
+        let visibility = if V::FORMAT == VBufferFormat::RgbF32 {
+            Visibility::Rgb(rgb)
+        } else {
+            Visibility::Gray(rgb.iter().map(|v| v[0]).collect())
         };
-        e.resolve(&visibility.channels(i), clamped[i]).note(
-            match (receivers[i].is_none(), &stencil) {
-                (true, _) => "background: lit",
-                (false, Some(_)) => "1 − stencil + (R − G)/63, clamped to [0, 1]",
-                (false, None) => "the V-buffer clamped to [0, 1]",
-            },
-        )
-    });
-    SsvRender {
-        visibility,
-        clamped_pixels,
-        pass1,
-        pass2,
-        wedges: (edges.len(), full_screen),
-        seconds: [pass1_seconds, t2.elapsed().as_secs_f64()],
-        dumps,
-    }
+        frame.probe_record("resolve", |tap, i| {
+            let [x, y] = [i as u32 % tiling.width, i as u32 / tiling.width];
+            let e = tap.event().read(
+                "vbuffer",
+                vbuf[tiling.tile_of(x, y)].raw(tiling.local(x, y)),
+            );
+            let e = match &stencil {
+                Some(s) => e.value("stencil", s[i] as f64),
+                None => e,
+            };
+            e.resolve(&visibility.channels(i), clamped[i]).note(
+                match (receivers[i].is_none(), &stencil) {
+                    (true, _) => "background: lit",
+                    (false, Some(_)) => "1 − stencil + (R − G)/63, clamped to [0, 1]",
+                    (false, None) => "the V-buffer clamped to [0, 1]",
+                },
+            )
+        });
+        SsvRender {
+            visibility,
+            wedges: (edges.len(), full_screen),
+        }
+    })
 }
 
 /// The hierarchical-Z unit's decision for every wedge (`crate::gpu::hiz`, "Receiver
@@ -761,55 +772,17 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
 
 /// Run `ssv` on a rendered frame.
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
-    let start = Instant::now();
+    let mut rec = PassRecorder::new(frame, "ssv");
     let (settings, mode) = read_settings(frame)?;
-    let r = render(frame, &settings);
-    let passes = vec![
-        frame.pass.clone(),
-        PassStats {
-            name: HARD_QUADS.into(),
-            wall_seconds: r.seconds[0],
-            runs: 1,
-            counters: r.pass1,
-        },
-        PassStats {
-            name: "ssv-wedges".into(),
-            wall_seconds: r.seconds[1],
-            runs: 1,
-            counters: r.pass2,
-        },
-    ];
-    let mut buffers = vec![BufferPlan::depth(&frame.gpu)];
-    if settings.vbuffer == VBufferFormat::Split8 {
-        buffers.push(BufferPlan::stencil8());
-    }
-    buffers.push(BufferPlan {
-        name: "vbuffer".into(),
-        format: format!("{:?}", settings.vbuffer),
-        bytes_per_sample: settings.vbuffer.bytes(),
-    });
-    if frame.gpu.hiz {
-        // Pass 1 (hard quads or the 8-bit version's stencil) and the wedges.
-        buffers.push(BufferPlan::hiz_zmin_zmax(&frame.gpu));
-        buffers.push(BufferPlan::hiz_receiver_bounds(&frame.gpu));
-    }
-    let plan = MethodPlan {
-        method: "ssv".into(),
-        passes: passes.iter().map(|p| p.name.clone()).collect(),
-        buffers,
-        settings: serde_json::json!({
+    let r = render(&mut rec, &settings);
+    Ok(rec.finish(
+        r.visibility,
+        serde_json::json!({
             "mode": mode.written(),
             "resolved": settings,
             "wedges": r.wedges.0,
             "wedges_full_screen": r.wedges.1,
             "gpu": frame.gpu,
         }),
-    };
-    let mut stats = super::method_stats("ssv", frame, start, &plan, passes);
-    stats.clamped_pixels = r.clamped_pixels;
-    Ok(MethodOutput {
-        visibility: r.visibility,
-        dumps: r.dumps,
-        stats,
-    })
+    ))
 }

@@ -124,13 +124,12 @@ use crate::gpu::transform::ClipVertex;
 use crate::light::coverage::{self, RectLight};
 use crate::light::lookup_tables::{AreaShape, AreaTable, Atan2CubeMap, SplitTable, TableFilter};
 use crate::methods::hard_sv::CountMode;
-use crate::methods::output::{BufferPlan, MethodPlan};
+use crate::methods::output::BufferPlan;
+use crate::methods::recorder::PassRecorder;
 use crate::options::{option_names, option_table, OptionTable};
-use crate::pass::PassStats;
 use crate::scene::LightShape;
 use crate::visibility::Visibility;
 use glam::{DVec2, DVec3, Vec3};
-use std::time::Instant;
 
 /// How the shaders compute coverage.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -1076,120 +1075,103 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
 
 /// Run `ssv-optimized` on a rendered frame.
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
-    let start = Instant::now();
+    let mut rec = PassRecorder::new(frame, "ssv-optimized");
     let s = options(frame)?;
     let model = LightModel::from_shape(frame.scene.light().center, &frame.scene.light().shape)
         .expect("options checked the shape");
     let pieces = model
         .pieces(s.light_split)
         .expect("options checked the split");
-    let pass_start = Instant::now();
-    let receivers = receiver_tiles(frame, s.position);
-    let mut sum = vec![0.0f32; frame.pixel_count()];
-    let mut clamped = vec![false; frame.pixel_count()];
-    let mut counters = Counters::default();
-    let mut dumps = Vec::new();
-    for (k, piece) in pieces.iter().enumerate() {
-        let scope = frame
-            .probe
-            .as_ref()
-            .filter(|_| pieces.len() > 1)
-            .map(|p| p.enter(|sc| sc.piece = Some(k as u32)));
-        // The shader precision is chosen once per piece's pass.
-        let (v, c, cl, piece_dumps) = crate::with_shader_float!(frame.gpu.shader, T => {
-            piece_visibility::<T>(frame, piece, &s, &receivers)
-        })?;
-        drop(scope);
-        frame.probe_record("pieces", |tap, i| {
-            tap.event()
-                .value("piece", k as f64)
-                .value("visibility", v[i] as f64)
-        });
-        dumps.extend(piece_dumps.into_iter().map(|mut d| {
-            if pieces.len() > 1 {
-                d.name = format!("{}-piece{k}", d.name);
-                d.about = format!("light piece {k} alone (§5.2): {}", d.about);
-            }
-            d
-        }));
-        counters += c;
-        for (acc, v) in sum.iter_mut().zip(&v) {
-            *acc += v;
-        }
-        for (a, b) in clamped.iter_mut().zip(cl) {
-            *a |= b;
-        }
-    }
-    let n = pieces.len() as f32;
-    let prims = frame.prim_ids();
-    let vis: Vec<f32> = sum
-        .iter()
-        .zip(prims)
-        .map(|(v, p)| {
-            if *p == BACKGROUND {
-                1.0
-            } else {
-                (v / n).clamp(0.0, 1.0)
-            }
-        })
-        .collect();
-    frame.probe_record("resolve", |tap, i| {
-        tap.event()
-            .resolve(&[vis[i]], clamped[i] && prims[i] != BACKGROUND)
-            .note(if prims[i] == BACKGROUND {
-                "background: lit".to_string()
-            } else {
-                format!("mean of {} light piece(s), clamped to [0, 1]", pieces.len())
-            })
+    rec.uses(BufferPlan::stencil8());
+    rec.uses(BufferPlan {
+        name: "v-buffer".into(),
+        format: format!(
+            "2×RGBA8 split {}-bit ({} carry bits per channel)",
+            s.format.value_bits(),
+            s.format.reserved_bits
+        ),
+        bytes_per_sample: 8,
     });
-    let pass = PassStats {
-        name: "soft-shadow-volumes".into(),
-        wall_seconds: pass_start.elapsed().as_secs_f64(),
-        runs: pieces.len() as u64,
-        counters,
-    };
-    let plan = MethodPlan {
-        method: "ssv-optimized".into(),
-        passes: vec![frame.pass.name.clone(), "soft-shadow-volumes".into()],
-        buffers: vec![
-            BufferPlan::depth(&frame.gpu),
-            BufferPlan::stencil8(),
-            BufferPlan {
-                name: "v-buffer".into(),
-                format: format!(
-                    "2×RGBA8 split {}-bit ({} carry bits per channel)",
-                    s.format.value_bits(),
-                    s.format.reserved_bits
-                ),
-                bytes_per_sample: 8,
-            },
-        ]
-        .into_iter()
-        .chain((s.position == PositionBuffer::F16).then(|| BufferPlan {
+    if s.position == PositionBuffer::F16 {
+        rec.uses(BufferPlan {
             name: "position".into(),
             format: "RGB16F (world positions, Paper IV §4.2)".into(),
             bytes_per_sample: 6,
-        }))
-        .chain(frame.gpu.hiz.then(|| BufferPlan::hiz_zmin_zmax(&frame.gpu)))
-        .chain(
-            frame
-                .gpu
-                .hiz
-                .then(|| BufferPlan::hiz_stencil_summary(&frame.gpu)),
-        )
-        .collect(),
-        settings: serde_json::json!({ "resolved": s, "gpu": frame.gpu }),
-    };
-    let passes = vec![frame.pass.clone(), pass];
-    let mut stats = super::method_stats("ssv-optimized", frame, start, &plan, passes);
-    stats.clamped_pixels = clamped
-        .iter()
-        .zip(prims)
-        .filter(|(c, p)| **c && **p != BACKGROUND)
-        .count() as u64;
-    Ok(MethodOutput {
-        visibility: Visibility::Gray(vis),
-        dumps,
-        stats,
-    })
+        });
+    }
+    rec.uses_hiz_depth();
+    if frame.gpu.hiz {
+        rec.uses(BufferPlan::hiz_stencil_summary(&frame.gpu));
+    }
+    let prims = frame.prim_ids();
+    let vis = rec.pass("soft-shadow-volumes", |pass| {
+        pass.set_runs(pieces.len() as u64);
+        let receivers = receiver_tiles(frame, s.position);
+        let mut sum = vec![0.0f32; frame.pixel_count()];
+        let mut clamped = vec![false; frame.pixel_count()];
+        for (k, piece) in pieces.iter().enumerate() {
+            let scope = frame
+                .probe
+                .as_ref()
+                .filter(|_| pieces.len() > 1)
+                .map(|p| p.enter(|sc| sc.piece = Some(k as u32)));
+            // The shader precision is chosen once per piece's pass.
+            let (v, c, cl, piece_dumps) = crate::with_shader_float!(frame.gpu.shader, T => {
+                piece_visibility::<T>(frame, piece, &s, &receivers)
+            })?;
+            drop(scope);
+            pass.record("pieces", |tap, i| {
+                tap.event()
+                    .value("piece", k as f64)
+                    .value("visibility", v[i] as f64)
+            });
+            for mut d in piece_dumps {
+                if pieces.len() > 1 {
+                    d.name = format!("{}-piece{k}", d.name);
+                    d.about = format!("light piece {k} alone (§5.2): {}", d.about);
+                }
+                pass.dump(|| d);
+            }
+            pass.count(c);
+            for (acc, v) in sum.iter_mut().zip(&v) {
+                *acc += v;
+            }
+            for (a, b) in clamped.iter_mut().zip(cl) {
+                *a |= b;
+            }
+        }
+        let n = pieces.len() as f32;
+        let vis: Vec<f32> = sum
+            .iter()
+            .zip(prims)
+            .map(|(v, p)| {
+                if *p == BACKGROUND {
+                    1.0
+                } else {
+                    (v / n).clamp(0.0, 1.0)
+                }
+            })
+            .collect();
+        pass.record("resolve", |tap, i| {
+            tap.event()
+                .resolve(&[vis[i]], clamped[i] && prims[i] != BACKGROUND)
+                .note(if prims[i] == BACKGROUND {
+                    "background: lit".to_string()
+                } else {
+                    format!("mean of {} light piece(s), clamped to [0, 1]", pieces.len())
+                })
+        });
+        pass.clamped(
+            clamped
+                .iter()
+                .zip(prims)
+                .filter(|(c, p)| **c && **p != BACKGROUND)
+                .count() as u64,
+        );
+        Ok::<_, InputError>(vis)
+    })?;
+    Ok(rec.finish(
+        Visibility::Gray(vis),
+        serde_json::json!({ "resolved": s, "gpu": frame.gpu }),
+    ))
 }

@@ -72,16 +72,32 @@ pub enum LightShape {
     /// A point light at the light center (hard shadows only).
     Point,
     /// A sphere of `radius` (Papers I, II, IV §4.2.1).
-    Sphere { radius: f32 },
+    Sphere {
+        /// The radius.
+        radius: f32,
+    },
     /// A one-sided circular disk of `radius` facing along `normal` (CGI 2004).
-    Disk { radius: f32, normal: Vec3 },
+    Disk {
+        /// The radius.
+        radius: f32,
+        /// The unit normal the disk emits along.
+        normal: Vec3,
+    },
     /// A rectangle spanned by the half-extent vectors `u` and `v` (Papers III, IV; Forest 2006).
-    Rect { u: Vec3, v: Vec3 },
+    Rect {
+        /// Half-extent along the first side.
+        u: Vec3,
+        /// Half-extent along the second side.
+        v: Vec3,
+    },
     /// A rectangle like [`LightShape::Rect`] whose emission is an RGB texture (Paper III §3.3);
     /// texel (0,0) is at `center − u + v` (top-left), texel columns run along `u`.
     TexturedRect {
+        /// Half-extent along the first side (texel columns).
         u: Vec3,
+        /// Half-extent along the second side (texel rows, downward from `center + v`).
         v: Vec3,
+        /// The emission.
         texture: RgbTexture,
     },
 }

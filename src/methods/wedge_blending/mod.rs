@@ -152,7 +152,8 @@ use crate::gpu::transform::{ClipVertex, WindowPlane};
 use crate::light::coverage::{quad_side, RectLight};
 use crate::light::radial_parts::{edge_in_parts, read, stored, PART_COUNT};
 use crate::methods::hard_sv::CountMode;
-use crate::methods::output::{BufferPlan, MethodPlan};
+use crate::methods::output::BufferPlan;
+use crate::methods::recorder::PassRecorder;
 use crate::options::{option_names, option_table, OptionTable, OptionType, Switch};
 use crate::pass::PassStats;
 use crate::scene::LightShape;
@@ -1260,19 +1261,8 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
 
 /// Run `wedge-blending` on a rendered frame.
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
-    let start = Instant::now();
+    let mut rec = PassRecorder::new(frame, "wedge-blending");
     let (s, mode) = options(frame)?;
-    let r = render(frame, &s)?;
-    let runs = r.counters.silhouettes;
-    let mut passes = vec![frame.pass.clone()];
-    for (name, (counters, seconds)) in PASS_NAMES.iter().zip(r.passes) {
-        passes.push(PassStats {
-            name: name.to_string(),
-            wall_seconds: seconds,
-            runs: if *name == "wb-resolve" { 1 } else { runs },
-            counters,
-        });
-    }
     let (sil_bytes, fin_bytes, format) = match s.packing {
         Packing::Bit8 => {
             let st = Packed8 {
@@ -1288,42 +1278,32 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             (st.silhouette_bytes(), st.final_bytes(), st.describe())
         }
     };
-    let mut buffers = vec![
-        BufferPlan::depth(&frame.gpu),
-        BufferPlan::stencil8(),
-        BufferPlan {
-            name: "silhouette-vbuffer".into(),
-            format: format.clone(),
-            bytes_per_sample: sil_bytes as u32,
-        },
-        BufferPlan {
-            name: "final-vbuffer".into(),
-            format,
-            bytes_per_sample: fin_bytes as u32,
-        },
-    ];
-    if frame.gpu.hiz {
-        buffers.push(BufferPlan::hiz_zmin_zmax(&frame.gpu));
+    rec.uses(BufferPlan::stencil8());
+    rec.uses(BufferPlan {
+        name: "silhouette-vbuffer".into(),
+        format: format.clone(),
+        bytes_per_sample: sil_bytes as u32,
+    });
+    rec.uses(BufferPlan {
+        name: "final-vbuffer".into(),
+        format,
+        bytes_per_sample: fin_bytes as u32,
+    });
+    rec.uses_hiz_depth();
+    let footprint = rec.buffer_bytes();
+    // The passes time and count themselves, summed over silhouettes ([`render`]).
+    let r = render(frame, &s)?;
+    let runs = r.counters.silhouettes;
+    for (name, (counters, seconds)) in PASS_NAMES.iter().zip(r.passes) {
+        rec.record_pass(PassStats {
+            name: name.to_string(),
+            wall_seconds: seconds,
+            runs: if *name == "wb-resolve" { 1 } else { runs },
+            counters,
+        });
     }
-    let footprint: u64 = buffers
-        .iter()
-        .map(|b| b.bytes_per_sample as u64 * frame.pixel_count() as u64)
-        .sum();
-    let plan = MethodPlan {
-        method: "wedge-blending".into(),
-        passes: passes.iter().map(|p| p.name.clone()).collect(),
-        buffers,
-        settings: serde_json::json!({
-            "mode": mode.written(),
-            "resolved": s,
-            "gpu": frame.gpu,
-            "buffer_bytes": footprint,
-            "counters": r.counters,
-        }),
-    };
-    let mut stats = super::method_stats("wedge-blending", frame, start, &plan, passes);
-    stats.clamped_pixels = r.counters.clamped_pixels;
-    let mut dumps = vec![BufferDump::new(
+    rec.clamped(r.counters.clamped_pixels);
+    rec.output(BufferDump::new(
         "penumbrae",
         "per pixel, the number of silhouettes whose occlusion (mean over the radial parts) \
          lies strictly between 0.5/255 and 1 − 0.5/255 there: where two or more overlap, the \
@@ -1331,11 +1311,16 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         (frame.scene.width, frame.scene.height),
         ElementFormat::Count8,
         DumpValues::U8(r.penumbrae),
-    )];
-    dumps.extend(r.dumps);
-    Ok(MethodOutput {
-        visibility: Visibility::Gray(r.visibility),
-        dumps,
-        stats,
-    })
+    ));
+    r.dumps.into_iter().for_each(|d| rec.output(d));
+    Ok(rec.finish(
+        Visibility::Gray(r.visibility),
+        serde_json::json!({
+            "mode": mode.written(),
+            "resolved": s,
+            "gpu": frame.gpu,
+            "buffer_bytes": footprint,
+            "counters": r.counters,
+        }),
+    ))
 }
