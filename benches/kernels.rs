@@ -210,8 +210,9 @@ fn setup_and_traversal(c: &mut Criterion, frame: &Frame) {
                 &mut counts,
                 &tris,
                 &bins,
+                None,
                 no_tile_culling,
-                |_, n, _, f, _| {
+                |_, n, _, f, _, _| {
                     black_box(f);
                     *n += 1;
                 },

@@ -230,13 +230,14 @@ impl<'s> Frame<'s> {
             &mut tiles,
             &tris,
             &bins,
+            None,
             |t, tile, tri, c| {
                 if !gpu.hiz {
                     return TileDraw::Whole;
                 }
                 tile.depth.early_z(&tiling, t, tri.bbox, tri.z_range[0], c)
             },
-            |_, tile, tri, f, c| {
+            |_, tile, tri, f, c, _| {
                 if tile.depth.test_and_write(&state, &f, c) {
                     tile.prim[f.local] = tri.prim;
                 }

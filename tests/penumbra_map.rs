@@ -11,6 +11,7 @@
 //! gone at r = 1.5; the true penumbra reaches out to half-width 0.75 + r/2.
 
 use penumbra::frame::{Frame, GpuSettings, Receiver};
+use penumbra::limits::DEFAULT_HIZ_TILE_SIZE;
 use penumbra::methods::penumbra_map::{self, PenumbraMapRender, PenumbraMapSettings};
 use penumbra::scene::{LightShape, OptionValue, Scene};
 
@@ -212,7 +213,7 @@ fn aliasing_falls_as_the_map_grows() {
     for n in [256u32, 512, 1024, 2048] {
         let tiling = Tiling::new(n, n, 8).unwrap();
         let view = LightView::fit(&scene, light, tiling, DepthFormat::D24).unwrap();
-        let (shadow_map, _) = view.render_depth(&scene, offset);
+        let (shadow_map, _) = view.render_depth(&scene, offset, Some(DEFAULT_HIZ_TILE_SIZE), None);
         let mut count = 0;
         for rcv in receivers.iter().flatten() {
             if rcv.point.y.abs() > 1e-4 {
@@ -261,7 +262,8 @@ fn overlapping_penumbrae_keep_the_darkest() {
             .map(|(_, (m, sl))| (m, sl.clone()))
             .unzip();
         let g = cones_and_sheets(&m, &sl, &light, s.cone_segments);
-        penumbra_map::render_penumbra_map::<f64>(&full.view, &full.shadow_map, &g, &s, false).0
+        penumbra_map::render_penumbra_map::<f64>(&full.view, &full.shadow_map, &g, &s, false, None)
+            .0
     };
     let (first, rest) = (map_of(0), map_of(1));
     let mut both = 0;
@@ -520,7 +522,12 @@ fn bias_stages_trade_specks_for_leaks() {
                 .filter(|&i| r.reference[i] <= 0.01 && vis[i] > 0.5)
                 .count(),
         );
-        let (exact, _) = r.pm.view.render_depth(&scene, PolygonOffset::NONE);
+        let (exact, _) = r.pm.view.render_depth(
+            &scene,
+            PolygonOffset::NONE,
+            Some(DEFAULT_HIZ_TILE_SIZE),
+            None,
+        );
         assert_eq!(r.pm.shadow_map == exact, stage == BiasStage::Lookup);
     }
     eprintln!("dark pixels lit: render {}, lookup {}", leaks[0], leaks[1]);

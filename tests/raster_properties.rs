@@ -37,8 +37,9 @@ fn hits(tris: &[[ClipVertex; 3]], tile: u32) -> Vec<u32> {
         &mut tiles,
         &setup,
         &bins,
+        None,
         no_tile_culling,
-        |_, t, _, f, _| t[f.local] += 1,
+        |_, t, _, f, _, _| t[f.local] += 1,
     );
     let flat: Vec<u32> = tiles.into_iter().flatten().collect();
     tiling.to_row_major(&flat)

@@ -355,8 +355,9 @@ fn draw_checked(setup: &[RasterTriangle], tile: u32) {
         &mut tiles,
         setup,
         &bins,
+        None,
         no_tile_culling,
-        |t, storage: &mut Vec<u32>, _tri, f, _c| {
+        |t, storage: &mut Vec<u32>, _tri, f, _c, _tap| {
             assert!(f.x < SIZE && f.y < SIZE, "fragment ({}, {})", f.x, f.y);
             assert_eq!(tiling.tile_of(f.x, f.y), t);
             assert_eq!(tiling.local(f.x, f.y), f.local);

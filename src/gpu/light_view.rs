@@ -53,12 +53,11 @@ use super::buffers::{alloc_tiles, DepthTile};
 use super::counters::Counters;
 use super::depth::{DepthFormat, DepthState, PolygonOffset};
 use super::probe::{Overflow, PassProbe, PrimitiveKind, Raw};
-use super::raster::{bin, draw_probed, Fragment, TileDraw};
+use super::raster::{bin, draw, Fragment, TileDraw};
 use super::setup::{setup_all, CullMode};
 use super::texture::{nearest, sample_2d, Filter, Wrap};
 use super::tiling::Tiling;
 use super::transform::{viewport, ClipVertex, Projection};
-use crate::limits::DEFAULT_HIZ_TILE_SIZE;
 use crate::scene::Scene;
 use glam::{DVec3, Vec3};
 
@@ -349,20 +348,16 @@ impl LightView {
     }
 
     /// Render the depth of every mesh of `scene` that casts shadows (receiver-only meshes
-    /// cast none) from the light with polygon `offset` (module doc, "The shadow map"), with
-    /// early Z: the tile-major depth target and the pass counters.
-    pub fn render_depth(&self, scene: &Scene, offset: PolygonOffset) -> (Vec<DepthTile>, Counters) {
-        self.render_depth_probed(scene, offset, Some(DEFAULT_HIZ_TILE_SIZE), None)
-    }
-
-    /// [`LightView::render_depth`] with the hierarchical-Z unit on, with HiZ tiles of edge
-    /// `hiz` (`Some`), or off (`None`) (early Z as in the scene pass: [`crate::gpu::hiz`]),
-    /// recording the clear and every fragment at the
-    /// texels `probe` watches ([`super::probe`]). A triangle whose offset depth is at or
+    /// cast none) from the light with polygon `offset` (module doc, "The shadow map"): the
+    /// tile-major depth target and the pass counters. The hierarchical-Z unit is on with HiZ
+    /// tiles of edge `hiz` (`Some`, e.g.
+    /// [`DEFAULT_HIZ_TILE_SIZE`](crate::limits::DEFAULT_HIZ_TILE_SIZE)), or off (`None`) (early Z
+    /// as in the scene pass: [`crate::gpu::hiz`]): a triangle whose offset depth is at or
     /// behind a tile's zmax at its nearest vertex fails LESS at every texel there and is not
-    /// drawn in it ([`super::setup::RasterTriangle::nearest_offset_depth`]). The same bits on
-    /// and off (unit test).
-    pub fn render_depth_probed(
+    /// drawn in it ([`super::setup::RasterTriangle::nearest_offset_depth`]); the same bits on
+    /// and off (unit test). With a probe, the clear and every fragment at the texels `probe`
+    /// watches are recorded ([`super::probe`]).
+    pub fn render_depth(
         &self,
         scene: &Scene,
         offset: PolygonOffset,
@@ -384,7 +379,7 @@ impl LightView {
         }
         let state = DepthState::LESS_WRITE;
         let format = self.depth;
-        counters += draw_probed(
+        counters += draw(
             &self.tiling,
             &mut tiles,
             &tris,
@@ -427,6 +422,7 @@ impl LightView {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::limits::DEFAULT_HIZ_TILE_SIZE;
     use crate::scene::builtin;
 
     fn tiling(size: u32) -> Tiling {
@@ -535,8 +531,8 @@ mod tests {
                 let view =
                     LightView::fit(&scene, scene.light().center, tiling(128), format).unwrap();
                 for offset in offsets {
-                    let (on, c_on) = view.render_depth_probed(&scene, offset, Some(8), None);
-                    let (off, c_off) = view.render_depth_probed(&scene, offset, None, None);
+                    let (on, c_on) = view.render_depth(&scene, offset, Some(8), None);
+                    let (off, c_off) = view.render_depth(&scene, offset, None, None);
                     let values = |tiles: &[DepthTile]| -> Vec<u32> {
                         tiles.iter().flat_map(|t| t.values.clone()).collect()
                     };
@@ -555,7 +551,12 @@ mod tests {
         let scene = builtin::load("single-quad").unwrap();
         let view =
             LightView::fit(&scene, scene.light().center, tiling(64), DepthFormat::D24).unwrap();
-        let (plain, c) = view.render_depth(&scene, PolygonOffset::NONE);
+        let (plain, c) = view.render_depth(
+            &scene,
+            PolygonOffset::NONE,
+            Some(DEFAULT_HIZ_TILE_SIZE),
+            None,
+        );
         assert!(c.depth_write_bytes > 0);
         // The texel under the light center sees the quad's top at y = 1 (view depth 2).
         let [x, y, _] = view.window(Vec3::new(0.0, 1.0, 0.0)).unwrap();
@@ -569,7 +570,7 @@ mod tests {
             factor: 0.0,
             units: 8.0,
         };
-        let (biased, _) = view.render_depth(&scene, units);
+        let (biased, _) = view.render_depth(&scene, units, Some(DEFAULT_HIZ_TILE_SIZE), None);
         let moved = view.sample(x, y, Filter::Nearest, |t, l| biased[t].values[l] as f64);
         assert_eq!(moved, stored + 8.0);
     }

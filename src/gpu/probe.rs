@@ -13,7 +13,7 @@
 //! A [`PassProbe`] names a pass and the samples of its render target it watches, as
 //! (tile, index in the tile) of that target's tiling: the probed pixel for camera passes and
 //! screen passes, the texels the screen pass will read for passes into maps seen from the
-//! light. [`super::raster::draw_probed`] compares the tile index once per tile and only in
+//! light. [`super::raster::draw`] compares the tile index once per tile and only in
 //! the watched tile compares each fragment's sample; it hands the fragment program a [`Tap`]
 //! for the watched fragment and `None` for every other one. With no probe attached nothing is
 //! recorded and the output bits are the same (tested for every method).

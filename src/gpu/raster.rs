@@ -330,36 +330,11 @@ pub fn rasterize_in_tile(
 /// in the counters it is given). It gets the
 /// tile's storage mutably, so that a pass writing depth can bring the tile's bounds up to date
 /// before it decides (early Z in a pass that writes depth).
+/// `fragment` gets a [`Tap`] for the fragments of the samples `probe` watches
+/// ([`super::probe`]) and `None` for every other one: the tile index is compared with the
+/// watched tiles once per tile; only in a watched tile is each fragment's sample compared.
 /// Returns the counters summed over tiles.
 pub fn draw<T, S, D, F>(
-    tiling: &Tiling,
-    tiles: &mut [T],
-    tris: &[RasterTriangle],
-    bins: &Bins,
-    skip_tile: S,
-    fragment: F,
-) -> Counters
-where
-    T: Send,
-    S: Fn(usize, &mut T, &RasterTriangle, &mut Counters) -> D + Sync,
-    D: Into<TileDraw>,
-    F: Fn(usize, &mut T, &RasterTriangle, Fragment, &mut Counters) + Sync,
-{
-    draw_probed(
-        tiling,
-        tiles,
-        tris,
-        bins,
-        None,
-        skip_tile,
-        |t, storage, tri, f, c, _| fragment(t, storage, tri, f, c),
-    )
-}
-
-/// [`draw`] with a probe ([`super::probe`]): `fragment` gets a [`Tap`] for the fragments of
-/// the samples `probe` watches and `None` for every other one. The tile index is compared with
-/// the watched tiles once per tile; only in a watched tile is each fragment's sample compared.
-pub fn draw_probed<T, S, D, F>(
     tiling: &Tiling,
     tiles: &mut [T],
     tris: &[RasterTriangle],

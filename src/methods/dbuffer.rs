@@ -147,7 +147,7 @@ use crate::gpu::depth::DepthFunc;
 use crate::gpu::depth::{DepthFormat, DepthState, PolygonOffset};
 use crate::gpu::light_view::LightView;
 use crate::gpu::probe::{Overflow, PassProbe, PrimitiveKind, ProbeEvent, Raw, Tap};
-use crate::gpu::raster::{bin, draw_probed, Fragment, TileDraw};
+use crate::gpu::raster::{bin, draw, Fragment, TileDraw};
 use crate::gpu::setup::{setup_all_barycentric, CullMode};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::shader_vec::SVec3;
@@ -556,7 +556,7 @@ fn draw_dbuffer(
     let (tris, mut counters) = setup_all_barycentric(&input.prims, cull, &view.tiling);
     let bins = bin(&view.tiling, &tris);
     let format = view.depth;
-    counters += draw_probed(
+    counters += draw(
         &view.tiling,
         tiles,
         &tris,
@@ -900,7 +900,7 @@ fn screen_pass<T: ShaderFloat>(
     let width = frame.scene.width as usize;
     let texel_bytes = 4 * s.storage.bytes();
     let probe = frame.probe_pass("screen");
-    let (pixels, stats, counters) = super::shade_receivers_probed(
+    let (pixels, stats, counters) = super::shade_receivers(
         &receivers,
         width,
         probe.as_ref(),

@@ -29,7 +29,7 @@ use crate::gpu::buffers::{alloc_tiles, StencilTile};
 use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::probe::Raw;
-use crate::gpu::raster::{bin, draw_probed};
+use crate::gpu::raster::{bin, draw};
 use crate::gpu::setup::CullMode;
 use crate::gpu::stencil::{StencilFace, StencilOp, StencilState};
 use crate::methods::output::BufferPlan;
@@ -233,7 +233,7 @@ pub fn stencil_shadow(
         counters += c;
         let bins = bin(tiling, &tris);
         let probe = frame.probe_pass(&format!("{name}{suffix}"));
-        counters += draw_probed(
+        counters += draw(
             tiling,
             &mut stencil,
             &tris,

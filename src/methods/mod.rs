@@ -397,27 +397,13 @@ pub fn fit_light_view(
     })
 }
 
-/// A screen pass: the fragment program `program(pixel, receiver, stats, counters)` run on the
-/// receiver of every pixel (`None` for background), rows in parallel, each row's tallies summed
-/// in row order (integer sums: independent of the thread count). Returns the program's outputs
-/// in row-major order, the summed stats and the summed counters.
+/// A screen pass: the fragment program `program(pixel, receiver, stats, counters, tap)` run
+/// on the receiver of every pixel (`None` for background), rows in parallel, each row's
+/// tallies summed in row order (integer sums: independent of the thread count). `program` gets
+/// a [`Tap`] for the pixel `probe` watches ([`crate::gpu::probe`]) and `None` for every other
+/// one (the row is compared once per row). Returns the program's outputs in row-major order,
+/// the summed stats and the summed counters.
 pub fn shade_receivers<T, S>(
-    receivers: &[Option<crate::frame::Receiver>],
-    width: usize,
-    program: impl Fn(usize, Option<&crate::frame::Receiver>, &mut S, &mut Counters) -> T + Sync,
-) -> (Vec<T>, S, Counters)
-where
-    T: Send,
-    S: Default + std::ops::AddAssign + Send,
-{
-    shade_receivers_probed(receivers, width, None, |i, r, st, c, _| {
-        program(i, r, st, c)
-    })
-}
-
-/// [`shade_receivers`] with a probe ([`crate::gpu::probe`]): `program` gets a [`Tap`] for the
-/// pixel `probe` watches and `None` for every other one (the row is compared once per row).
-pub fn shade_receivers_probed<T, S>(
     receivers: &[Option<crate::frame::Receiver>],
     width: usize,
     probe: Option<&PassProbe>,

@@ -70,7 +70,7 @@ impl BufferPlan {
     }
 
     /// [`BufferPlan::hiz_zmin_zmax`] of a depth target seen from the light (`target`, e.g.
-    /// "shadow map": its early Z, [`crate::gpu::light_view::LightView::render_depth_probed`]),
+    /// "shadow map": its early Z, [`crate::gpu::light_view::LightView::render_depth`]),
     /// in its `depth` format with HiZ tiles of edge `hiz_tile`.
     pub fn hiz_zmin_zmax_of(
         target: &str,

@@ -126,7 +126,7 @@ use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::{DepthFormat, DepthState, PolygonOffset};
 use crate::gpu::light_view::LightView;
 use crate::gpu::probe::{Overflow, PassProbe, PrimitiveKind, ProbeEvent, Raw, Tap};
-use crate::gpu::raster::{bin, draw_probed, no_tile_culling, Fragment};
+use crate::gpu::raster::{bin, draw, no_tile_culling, Fragment};
 use crate::gpu::setup::{setup_all_barycentric, CullMode};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::texture::Filter;
@@ -375,7 +375,7 @@ pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRende
     };
     let probe = map_probe("shadow-map");
     let hiz_tile = frame.gpu.hiz_tile();
-    let (shadow_map, c1) = view.render_depth_probed(scene, render_offset, hiz_tile, probe.as_ref());
+    let (shadow_map, c1) = view.render_depth(scene, render_offset, hiz_tile, probe.as_ref());
     let pass1 = PassStats::since("shadow-map", t, c1);
 
     // The silhouette from the light center (CPU; the paper's 30 %).
@@ -396,7 +396,7 @@ pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRende
     );
     let probe = map_probe("penumbra-map");
     let (color, program, c2) = crate::with_shader_float!(frame.gpu.shader, T => {
-        render_penumbra_map_probed::<T>(
+        render_penumbra_map::<T>(
             &view,
             &shadow_map,
             &geometry,
@@ -485,19 +485,9 @@ pub fn cone_light(view: &LightView, radius: f32) -> ConeLight {
 /// `view`) into a penumbra map; returns its colour tiles (recording their overflow events per
 /// sample when `record`, for a buffer dump), the program's stats and the pass counters. The
 /// fragment program computes in the shader precision `T` (module doc, "Shader precision").
+/// With a probe, the clears and every fragment at the texels `probe` watches are recorded
+/// ([`crate::gpu::probe`]).
 pub fn render_penumbra_map<T: ShaderFloat>(
-    view: &LightView,
-    shadow_map: &[DepthTile],
-    geometry: &PenumbraGeometry,
-    s: &PenumbraMapSettings,
-    record: bool,
-) -> (Vec<ColorTile>, ProgramStats, Counters) {
-    render_penumbra_map_probed::<T>(view, shadow_map, geometry, s, record, None)
-}
-
-/// [`render_penumbra_map`] recording the clears and every fragment at the texels `probe`
-/// watches ([`crate::gpu::probe`]).
-pub fn render_penumbra_map_probed<T: ShaderFloat>(
     view: &LightView,
     shadow_map: &[DepthTile],
     geometry: &PenumbraGeometry,
@@ -527,7 +517,7 @@ pub fn render_penumbra_map_probed<T: ShaderFloat>(
                 .clear("depth", Raw::Depth(cleared.depth.values[0]))
         });
     }
-    counters += draw_probed(
+    counters += draw(
         &view.tiling,
         &mut tiles,
         &tris,
@@ -657,7 +647,7 @@ fn screen_pass<T: ShaderFloat>(
         Filter::Bilinear => 4,
     };
     let probe = frame.probe_pass("screen");
-    let (values, stats, counters) = super::shade_receivers_probed(
+    let (values, stats, counters) = super::shade_receivers(
         &receivers,
         width,
         probe.as_ref(),

@@ -60,7 +60,7 @@ use crate::gpu::counters::count;
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::li_buffer::{li_clamped, li_visibility, LiFormat, LiOverflow, LiTile, LI_CLEAR};
 use crate::gpu::probe::{PrimitiveKind, ProbeEvent, Raw, Tap};
-use crate::gpu::raster::{bin, draw_probed, TileDraw};
+use crate::gpu::raster::{bin, draw, TileDraw};
 use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::shader_vec::SVec3;
@@ -338,7 +338,7 @@ fn render_li_with<T: ShaderFloat>(
     let eye_uniform = SVec3::<T>::from_f64(eye);
     let full = li_amount(1.0, s.lights);
     let far = frame.gpu.depth.far();
-    counters += draw_probed(
+    counters += draw(
         tiling,
         &mut li,
         &rt,

@@ -94,7 +94,7 @@ use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::DepthFunc;
 use crate::gpu::li_buffer::{LiTile, LI_CLEAR};
 use crate::gpu::probe::{PassProbe, PrimitiveKind, ProbeEvent, Raw};
-use crate::gpu::raster::{bin, draw_probed, Fragment};
+use crate::gpu::raster::{bin, draw, Fragment};
 use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::shader_vec::SVec3;
@@ -408,7 +408,7 @@ fn li_pass<T: ShaderFloat>(
         let p = !(penumbra && roles.penumbra) || ctx.penumbra_culled(t, tri);
         (u, p)
     };
-    draw_probed(
+    draw(
         tiling,
         tiles,
         rt,
@@ -640,7 +640,7 @@ fn stencil_pass(
     };
     let tiling = &ctx.frame.tiling;
     let bins = bin(tiling, rt);
-    draw_probed(
+    draw(
         tiling,
         stencil,
         rt,

@@ -889,17 +889,9 @@ fn light_samples(light: &Light, toward: Vec3, settings: &RaycastSettings) -> Vec
 /// # Panics
 ///
 /// If `settings.samples` is not a perfect square (see [`RaycastSettings::validate`]).
+/// With a probe, every shadow ray's verdict and the resolve are recorded at the pixel `probe`
+/// watches (the pass's tiling is the image's; [`crate::gpu::probe`]).
 pub fn raycast_visibility(
-    scene: &Scene,
-    receivers: &[Option<Receiver>],
-    settings: &RaycastSettings,
-) -> Visibility {
-    raycast_visibility_probed(scene, receivers, settings, None)
-}
-
-/// [`raycast_visibility`] recording, at the pixel `probe` watches (the pass's tiling is the
-/// image's), every shadow ray's verdict and the resolve ([`crate::gpu::probe`]).
-pub fn raycast_visibility_probed(
     scene: &Scene,
     receivers: &[Option<Receiver>],
     settings: &RaycastSettings,
@@ -1030,7 +1022,7 @@ fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         } else {
             frame.receivers()
         };
-        raycast_visibility_probed(scene, receivers, &settings, pass.probe().as_ref())
+        raycast_visibility(scene, receivers, &settings, pass.probe().as_ref())
     });
     let snapped = frame.snapped_receivers();
     if snapped > 0 && receiver == ReceiverPoint::DepthBuffer {
@@ -1153,7 +1145,7 @@ pub fn raycast_where(
             .zip(mask)
             .map(|(r, &a)| r.filter(|_| a))
             .collect();
-        Ok(raycast_visibility(f.scene, &some, &settings))
+        Ok(raycast_visibility(f.scene, &some, &settings, None))
     };
     if frame.scene.is_multi_light() {
         let mut per_light = Vec::new();
@@ -1430,7 +1422,12 @@ mod tests {
             ShadowRayCaster::new(&s).visibility(s.light(), &ON_FLOOR, &RaycastSettings::default());
         // Red is hidden, blue fully visible, green emits nothing (reported as 0).
         assert_eq!(v, [0.0, 0.0, 1.0]);
-        let out = raycast_visibility(&s, &[Some(ON_FLOOR), None], &RaycastSettings::default());
+        let out = raycast_visibility(
+            &s,
+            &[Some(ON_FLOOR), None],
+            &RaycastSettings::default(),
+            None,
+        );
         assert_eq!(out, Visibility::Rgb(vec![[0.0, 0.0, 1.0], [1.0; 3]]));
     }
 
@@ -1467,7 +1464,7 @@ mod tests {
                     .num_threads(threads)
                     .build()
                     .unwrap()
-                    .install(|| raycast_visibility(&s, &receivers, &settings))
+                    .install(|| raycast_visibility(&s, &receivers, &settings, None))
             };
             let one = run(1);
             assert_eq!(one, run(3));
@@ -1746,7 +1743,7 @@ mod tests {
         let t = std::time::Instant::now();
         let caster = ShadowRayCaster::new(&s);
         let build = t.elapsed();
-        let v = raycast_visibility(&s, &receivers, &RaycastSettings::default());
+        let v = raycast_visibility(&s, &receivers, &RaycastSettings::default(), None);
         let total = t.elapsed();
         let mean: f64 = (0..v.len()).map(|i| f64::from(v.gray(i))).sum::<f64>() / v.len() as f64;
         println!(

@@ -79,7 +79,7 @@ use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::hiz::InsideTestRounding;
 use crate::gpu::probe::{PrimitiveKind, Tap};
-use crate::gpu::raster::{bin, bin_to, draw_probed, touched_tile_count, touches_tile};
+use crate::gpu::raster::{bin, bin_to, draw, touched_tile_count, touches_tile};
 use crate::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::transform::ClipVertex;
@@ -498,7 +498,7 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(
             _ => bin(tiling, &tris),
         };
         let binned_kept = probe.is_none();
-        pass2 += draw_probed(
+        pass2 += draw(
             tiling,
             &mut vbuf,
             &tris,
@@ -710,7 +710,7 @@ fn hard_quads_pass<V: VBufferTile>(frame: &Frame, test: ShadowTest, vbuf: &mut [
         write: false,
     };
     let probe = frame.probe_pass(HARD_QUADS);
-    counters += draw_probed(
+    counters += draw(
         &frame.tiling,
         vbuf,
         &tris,

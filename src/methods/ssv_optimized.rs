@@ -113,7 +113,7 @@ use crate::gpu::buffers::{alloc_tiles, StencilTile};
 use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw};
-use crate::gpu::raster::{bin, draw_probed, TileDraw};
+use crate::gpu::raster::{bin, draw, TileDraw};
 use crate::gpu::setup::setup_all_culled;
 use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::shader_float::{ShaderFloat, FP16};
@@ -714,7 +714,7 @@ fn render_group<T: ShaderFloat>(
                 e.primitive(PrimitiveKind::HalfWedge, h, detail, Some(tri.front_facing))
             }
         };
-        counters += draw_probed(
+        counters += draw(
             tiling,
             &mut tiles,
             &tris,

@@ -144,7 +144,7 @@ use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::pack4ub::{FloatTarget, StoreEvents};
 use crate::gpu::probe::{Overflow, PrimitiveKind, ProbeEvent, Raw, Tap};
-use crate::gpu::raster::{bin, draw_probed, TileDraw};
+use crate::gpu::raster::{bin, draw, TileDraw};
 use crate::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::tiling::Tiling;
@@ -765,7 +765,7 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
         let t0 = Instant::now();
         let (tris, mut c1) = setup_all(&sil.volume, CullMode::None, tiling);
         let bins = bin(tiling, &tris);
-        c1 += draw_probed(
+        c1 += draw(
             tiling,
             &mut tiles,
             &tris,
@@ -930,7 +930,7 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
             );
         }
         let bins = bin(tiling, &tris);
-        c2 += draw_probed(
+        c2 += draw(
             tiling,
             &mut tiles,
             &tris,
