@@ -10,6 +10,10 @@
 //! tests build their own pools and `install` them), no panic hook, and no fixed output path
 //! (temporary directories are named by module, process id and a per-module counter). A test
 //! that needs a process of its own goes in its own `tests/NAME.rs`, with the reason in its doc.
+//!
+//! proptest keeps the seeds of past failures in `tests/proptest-regressions/MODULE.txt`: its
+//! default (`FileFailurePersistence::SourceParallel`) walks up from a module's file to the
+//! directory holding `main.rs` and uses `proptest-regressions/` beside that directory.
 
 // Helpers shared by several modules.
 mod common;
