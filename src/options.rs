@@ -509,7 +509,7 @@ pub fn markdown(tables: &[(&str, Vec<KeyDoc>)]) -> String {
         "# Options\n\n",
         "<!-- Generated from the option tables' declarations by ",
         "`cargo run --release -- list --options --markdown > docs/options.md`. ",
-        "Do not edit: tests/options.rs fails when this file differs from the code. -->\n\n",
+        "Do not edit: tests/suite/options.rs fails when this file differs from the code. -->\n\n",
         "Every key of every option table, as `penumbra list --options` prints it. A method's ",
         "keys are set with `[options.METHOD]` in a scene file or `--opt METHOD.KEY=VALUE` on ",
         "the command line, those of every pass with `[options.gpu]`; how values are written ",

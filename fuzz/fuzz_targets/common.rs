@@ -1,6 +1,6 @@
 //! The code paths the fuzz targets exercise, written once and shared: each `fuzz_targets/*.rs`
 //! includes this file with `#[path = "common.rs"] mod common;`, and
-//! `tests/fuzz_corpus_replay.rs` includes it the same way to replay every corpus and
+//! `tests/suite/fuzz_corpus_replay.rs` includes it the same way to replay every corpus and
 //! regression input under `cargo test`. It depends only on `penumbra` and `std` (no
 //! `arbitrary`), so the replay test needs no extra dependency.
 //!

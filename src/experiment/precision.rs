@@ -610,7 +610,7 @@ pub fn claims(s: &Study) -> Vec<String> {
         out.push(format!(
             "Paper IV §4.3: \"more than 16 overlapping\" volumes need the 5 carry bits — on the \
              stack: {}. (The buffer arithmetic alone: 36 full contributions fit with 5 carry \
-             bits, `tests/optimized_ssv.rs`.)",
+             bits, `tests/suite/optimized_ssv.rs`.)",
             per_bits.join("; ")
         ));
     }
@@ -1010,7 +1010,7 @@ mod tests {
     /// overflow behaviour shows here): Paper III's 8-bit V-buffer has its first overflow
     /// event between N = 6 and 8 and a corrupted pixel at 8; Paper IV's split V-buffer with 5
     /// carry bits has none up to N = 18 and a corrupted pixel at 24 (its buffer arithmetic
-    /// alone holds 36 full contributions: `tests/optimized_ssv.rs`; wedges that overlap on
+    /// alone holds 36 full contributions: `tests/suite/optimized_ssv.rs`; wedges that overlap on
     /// the stack's rim add more than one full contribution per quad).
     #[test]
     fn pin_overflow_of_the_v_buffers_on_the_stack() {

@@ -10,7 +10,7 @@
 //! front planes and that of their two back planes. Each side plane carries a **ray direction**:
 //! the average of the two quad normals projected into the side plane and normalized (§4.1).
 //!
-//! Choices where the paper is silent (tested in `tests/penumbra_wedges.rs`):
+//! Choices where the paper is silent (tested in `tests/suite/penumbra_wedges.rs`):
 //! * **Finite wedges.** Each wedge is closed by a **bottom** plane (Paper II §5: "if the wedge
 //!   planes are of finite length, a capping bottom plane of the wedge must be added") through
 //!   the far points `P_v = v + far·d_v` of its two front lines `d_v` (the front–front

@@ -112,7 +112,7 @@
 //! neighbours in their loop are not trimmed: §4 handles them with the depth test ("it is much
 //! easier to use depth test to ensure storing of proper distances"), and that is the paper's
 //! no-umbra artifact — also where a short edge separates two long ones, as the vertical edges
-//! of a thin slab whose sides are silhouette faces (measured in `tests/dbuffer.rs`).
+//! of a thin slab whose sides are silhouette faces (measured in `tests/suite/dbuffer.rs`).
 //!
 //! # Silhouette faces (§3.3)
 //!

@@ -131,7 +131,7 @@
 //! by the registry. Several disk lights: one D-buffer each, averaged
 //! ([`super::light_average`]). The paper's failure cases — concave and overlapping occluders,
 //! no umbra (§4 case 2: V too low, √t better), acute silhouette corners — are measured and
-//! pinned in `tests/dbuffer.rs`; the findings are in `docs/dbuffer.md`.
+//! pinned in `tests/suite/dbuffer.rs`; the findings are in `docs/dbuffer.md`.
 
 use super::dump::{color_values, row_major, BufferDump, DumpValues, ElementFormat};
 use super::dump::{EventKind, EventMap};

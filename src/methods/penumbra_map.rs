@@ -101,7 +101,7 @@
 //! per light and averaged ([`super::light_average`]).
 //!
 //! The paper's limits follow from the construction and are measured in
-//! `tests/penumbra_map.rs`: the penumbra is outer only (inside the hard shadow nothing is lit),
+//! `tests/suite/penumbra_map.rs`: the penumbra is outer only (inside the hard shadow nothing is lit),
 //! the umbra does not shrink as the light grows (§4.1), shadows harden where occluder and
 //! receiver touch, and the shadow map's resolution shows as aliasing. Against `raycast` the
 //! method is less accurate than the plain hard shadow (`hard-sv`) on every sphere-light

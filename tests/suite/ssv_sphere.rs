@@ -20,10 +20,10 @@
 //! 0) its diameter is < 1 (≤ 0.7, at the floor's corners, where the disk of radius 0.5 three
 //! above is tilted by 55°), while opposite sides of the 1×1 occluder are 1 apart: at most two
 //! (adjacent) edges cross, so max |e| ≤ 2·0.0868 = 0.174. Jitter errors are unbiased, so the
-//! mean is far smaller; as for the rectangle (`tests/soft_shadow_volumes.rs`) we require
+//! mean is far smaller; as for the rectangle (`tests/suite/soft_shadow_volumes.rs`) we require
 //! mean ≤ 1/(2k). Measured: 64² max 0.0081, mean 0.00027; 256² max 0.0106, mean 0.00025.
 
-mod common;
+use crate::common;
 use common::{gray, K};
 use glam::{DVec2, DVec3, Vec3};
 use penumbra::frame::{Frame, GpuSettings};

@@ -151,7 +151,7 @@ fn pw2002_and_restructured_agree_on_the_shared_li_buffer_of_two_lights() {
             .collect();
         // One pixel whose eye ray grazes a line where two wedge faces meet may differ by one
         // umbra step of one light, li_amount(1, 2) = 128 (see GRAZING_PIXELS_ALLOWED in
-        // tests/penumbra_wedges.rs); everywhere else the integers are the same.
+        // tests/suite/penumbra_wedges.rs); everywhere else the integers are the same.
         assert!(
             diff.len() <= 1 && diff.iter().all(|d| (d.2 - d.3).abs() == 128),
             "{passes:?}: {diff:?}"

@@ -1,5 +1,5 @@
 //! Shader precision (issue 11, `[options.gpu] shader`) of `penumbra-map`, `dbuffer` and
-//! `wedge-blending` (the wedge methods: `tests/shader_precision.rs`): every converted method's fragment
+//! `wedge-blending` (the wedge methods: `tests/suite/shader_precision.rs`): every converted method's fragment
 //! programs compute in the chosen format, so a narrower format changes the visibility of a
 //! small render of the method's usual scene, and the default (f64) is what the method
 //! computes with no `[options.gpu]` at all. The bounds of the single operations are derived

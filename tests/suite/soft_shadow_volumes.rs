@@ -1,6 +1,6 @@
 //! `ssv` (Paper III) against the ray-cast reference, its invariants, its V-buffer overflow.
 //!
-//! Tolerance of the planar-occluder test (derivation, as in `tests/reference_agreement.rs`).
+//! Tolerance of the planar-occluder test (derivation, as in `tests/suite/reference_agreement.rs`).
 //! `ssv` with exact clipping is exact for a single planar occluder (Paper III §5.3: neither the
 //! single-silhouette nor the overlap artifact applies), up to f32 accumulation of a handful of
 //! terms (< 1e-5). Both evaluate the same depth-buffer receiver point, so the difference is
@@ -12,7 +12,7 @@
 //! |ssv − raycast| ≤ 2/k at every pixel. Jitter errors are unbiased, so the mean is far
 //! smaller; we require mean ≤ 1/(2k).
 
-mod common;
+use crate::common;
 use common::{gray, K};
 use glam::{DVec2, DVec3, Vec3};
 use penumbra::frame::{Frame, GpuSettings};

@@ -15,7 +15,7 @@ use penumbra::limits::DEFAULT_HIZ_TILE_SIZE;
 use penumbra::methods::penumbra_map::{self, PenumbraMapRender, PenumbraMapSettings};
 use penumbra::scene::{LightShape, OptionValue, Scene};
 
-mod sphere_hard_cases;
+use crate::sphere_hard_cases;
 use sphere_hard_cases::{gray, small, with_sphere};
 
 fn set(scene: &mut Scene, method: &str, key: &str, v: OptionValue) {

@@ -19,7 +19,7 @@ use penumbra::scene::adjacency;
 use penumbra::scene::{builtin, LightShape, Mesh, OptionValue, Scene};
 use penumbra::visibility::Visibility;
 
-mod sphere_hard_cases;
+use crate::sphere_hard_cases;
 use sphere_hard_cases::{gray, small};
 
 /// Visibility 0 and 1 up to f32 rounding.

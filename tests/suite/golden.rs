@@ -1,8 +1,8 @@
 //! Golden outputs: every case of the catalog (`penumbra::golden::cases`: every method on the
 //! foundation scenes and the knobs), rendered small and compared bit for bit with `golden/`,
 //! counters included (see `penumbra::golden`). Re-bless with
-//! `cargo run --release -- golden --bless` (or `PENUMBRA_BLESS=1 cargo test --test golden`)
-//! only when a change of output is intended.
+//! `cargo run --release -- golden --bless` (or, this module only,
+//! `PENUMBRA_BLESS=1 cargo test --test suite golden::`) only when a change of output is intended.
 
 use std::path::Path;
 

@@ -6,7 +6,7 @@
 //!
 //! Each input runs under `catch_unwind`; a test fails listing every input that panicked.
 
-#[path = "../fuzz/fuzz_targets/common.rs"]
+#[path = "../../fuzz/fuzz_targets/common.rs"]
 #[allow(dead_code)] // `fuzz_scene_dir` serves the cargo-fuzz binaries; replay uses its own dirs
 mod common;
 

@@ -288,7 +288,7 @@ fn every_relative_link_of_the_pages_points_to_a_file_and_heading() {
     for arriving in ARRIVING {
         assert!(
             !root().join(arriving).exists(),
-            "{arriving} exists now: remove it from ARRIVING in tests/options.rs"
+            "{arriving} exists now: remove it from ARRIVING in tests/suite/options.rs"
         );
     }
 }

@@ -11,7 +11,7 @@ use penumbra::scene::Scene;
 use std::cmp::Ordering;
 use std::collections::BTreeMap;
 
-mod sphere_hard_cases;
+use crate::sphere_hard_cases;
 use sphere_hard_cases::{gray, small, with_sphere};
 
 fn wedge_settings(frame: &Frame) -> WedgeSettings {
