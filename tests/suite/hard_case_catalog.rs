@@ -72,7 +72,7 @@ const EXACT: Bound = Correct {
 };
 
 /// `nsample` takes N hard shadows; with N ≥ 64 its error is ≤ 1/(2√N)·(edges crossing the
-/// light) ≤ 0.0625 per edge at N = 64 and 0.016 at N = 1024 (tests/reference_agreement.rs).
+/// light) ≤ 0.0625 per edge at N = 64 and 0.016 at N = 1024 (tests/suite/reference_agreement.rs).
 const NSAMPLE: Bound = Correct {
     max_frac: 0.002,
     why: "N-sample average: sampling error below the threshold at N = 1024",
@@ -128,8 +128,8 @@ const TABLE: &[(&str, &str, Bound)] = &[
     ("far-origin-rect", "ssv-optimized", Pin { max_frac: 0.013, why: "f32 vertices at 1e5 rounded by ≤ 0.0039: every method differs from raycast along the shadow edge (nsample too)" }), // 52 px
     ("far-origin-rect", "ssv", Pin { max_frac: 0.0152, why: "f32 vertices at 1e5 rounded by ≤ 0.0039: every method differs from raycast along the shadow edge (nsample too)" }), // 61 px
     ("far-origin-rect", "wedge-blending", Pin { max_frac: 0.016, why: "f32 vertices at 1e5 rounded by ≤ 0.0039: every method differs from raycast along the shadow edge (nsample too)" }), // 64 px
-    ("far-point-light", "nsample", Pin { max_frac: 0.0033, why: "as hard-sv: 13 px on faces parallel to the light within 3e-7 (tests/reference_agreement.rs)" }), // 13 px
-    ("far-point-light", "hard-sv", Pin { max_frac: 0.0033, why: "13 px on faces parallel to the light within 3e-7: side quad fights in depth (tests/reference_agreement.rs)" }), // 13 px
+    ("far-point-light", "nsample", Pin { max_frac: 0.0033, why: "as hard-sv: 13 px on faces parallel to the light within 3e-7 (tests/suite/reference_agreement.rs)" }), // 13 px
+    ("far-point-light", "hard-sv", Pin { max_frac: 0.0033, why: "13 px on faces parallel to the light within 3e-7: side quad fights in depth (tests/suite/reference_agreement.rs)" }), // 13 px
     ("far-sun-sphere", "nsample", NSAMPLE),
     ("far-sun-sphere", "hard-sv", Pin { max_frac: 0.0003, why: "the hard shadow from the light center has no penumbra" }), // 1 px
     ("far-sun-sphere", "pw2002", Pin { max_frac: 0.0003, why: "penumbra wedges: Paper I/II's linear-in-angle falloff and summed wedges, approximate" }), // 1 px
@@ -483,7 +483,7 @@ fn every_hard_scene_renders_with_every_method_within_its_bound() {
             match entry {
                 None => failures.push(format!(
                     "{name} {m}: no entry in TABLE (measured fraction {frac:.5} over \
-                     {THRESHOLD}): add one to tests/hard_case_catalog.rs — Correct if the bound \
+                     {THRESHOLD}): add one to tests/suite/hard_case_catalog.rs — Correct if the bound \
                      follows from the math or a paper, else Pin with the reason"
                 )),
                 Some((_, _, b)) if frac > b.max_frac() => failures.push(format!(
