@@ -14,6 +14,11 @@
 //! - The scene: the `scene` field's scene, else scene 0; a file without scenes gives every
 //!   root node (a node that is no node's child); a file without nodes gives every mesh as it
 //!   is. Nodes outside the chosen scene are not drawn (as a viewer would not).
+//! - At most [`MAX_ELEMENTS`] vertices and as many triangles in all (an error past that). glTF
+//!   is the one format whose size does not bound its mesh: one accessor may be drawn by many
+//!   primitives, each mesh placed by many nodes, so a few kilobytes of JSON could ask for 10¹⁰
+//!   vertices. The bound is what a file of the input size limit could write out (12 bytes per
+//!   position), so every mesh such a file really holds is read.
 //! - Each node's transform (`matrix`, or `translation`·`rotation`·`scale`) composed down the
 //!   hierarchy in f64; each position is transformed once and rounded to f32. A node whose
 //!   world transform has a negative determinant flips its triangles' winding (glTF's rule). A
@@ -37,6 +42,7 @@ use super::super::input_file::read_input_file;
 use super::super::procedural::transform_point;
 use super::{MeshFormat, RawMesh};
 use crate::error::InputError;
+use crate::limits::MAX_INPUT_FILE_BYTES;
 use base64::Engine as _;
 use glam::{DMat4, DQuat, DVec3, DVec4, Vec3};
 use gltf::accessor::{DataType, Dimensions};
@@ -52,6 +58,10 @@ const GLB_MAGIC: &[u8; 4] = b"glTF";
 const CHUNK_JSON: u32 = 0x4E4F_534A;
 /// The GLB chunk type of the binary chunk ("BIN\0").
 const CHUNK_BIN: u32 = 0x004E_4942;
+
+/// Most vertices, and most triangles, one glTF file may place (see the module doc): as many
+/// VEC3 FLOAT positions as a file of [`MAX_INPUT_FILE_BYTES`] holds, about 44.7 million.
+pub const MAX_ELEMENTS: usize = (MAX_INPUT_FILE_BYTES / 12) as usize;
 
 /// Required extensions this reader refuses, and what they are.
 const REFUSED_EXTENSIONS: [(&str, &str); 3] = [
@@ -85,6 +95,9 @@ pub(super) fn parse(
     // The other required extensions do not change geometry (see the module doc); the crate's
     // validation would refuse any it does not know.
     root.extensions_required.clear();
+    if let Some(problem) = position_index_out_of_range(&root) {
+        return Err(err(format!("glTF validation error at {problem}")));
+    }
     let mut problems = Vec::new();
     {
         use gltf::json::validation::Validate;
@@ -123,6 +136,31 @@ pub(super) fn parse(
         triangles: reader.triangles,
         format: MeshFormat::Gltf,
         polygons_triangulated: 0,
+    })
+}
+
+/// The first primitive whose POSITION accessor index is past the accessors, named as the
+/// crate's validation names a bad index (`meshes[M].primitives[P].attributes["POSITION"]:
+/// Index out of bounds`). Checked before that validation: gltf-json 1.4's primitive check
+/// reads the POSITION accessor by its index before the index itself is checked, and panics on
+/// an index past the end (found by fuzzing, `fuzz/regressions/gltf/`).
+fn position_index_out_of_range(root: &gltf::json::Root) -> Option<String> {
+    use gltf::json::mesh::Semantic;
+    use gltf::json::validation::{Checked, Error};
+    root.meshes.iter().enumerate().find_map(|(m, mesh)| {
+        mesh.primitives.iter().enumerate().find_map(|(p, prim)| {
+            let index = prim.attributes.get(&Checked::Valid(Semantic::Positions))?;
+            (index.value() >= root.accessors.len()).then(|| {
+                let path = gltf::json::Path::new()
+                    .field("meshes")
+                    .index(m)
+                    .field("primitives")
+                    .index(p)
+                    .field("attributes")
+                    .key("POSITION");
+                format!("{path}: {}", Error::IndexOutOfBounds)
+            })
+        })
     })
 }
 
@@ -281,6 +319,16 @@ impl<'a> MeshReader<'a> {
                     .map_err(|m| format!("{}: indices {m}", at()))?,
                 None => (0..local.len() as u32).collect(),
             };
+            let triangles = match mode {
+                Mode::Triangles => corners.len() / 3,
+                _ => corners.len().saturating_sub(2),
+            };
+            within_limit(
+                (self.positions.len(), self.triangles.len()),
+                local.len(),
+                triangles,
+            )
+            .map_err(|m| format!("{}: {m}", at()))?;
             let base = self.positions.len() as u32;
             for p in &local {
                 let q = transform_point(world, *p);
@@ -303,8 +351,7 @@ impl<'a> MeshReader<'a> {
                 ));
             }
             let c = |i: usize| corners[i] + base;
-            let n = corners.len();
-            for i in 0..n.saturating_sub(2) {
+            for i in 0..corners.len().saturating_sub(2) {
                 let t = match mode {
                     Mode::Triangles if i % 3 == 0 => [c(i), c(i + 1), c(i + 2)],
                     Mode::Triangles => continue,
@@ -483,6 +530,19 @@ impl<'a> MeshReader<'a> {
         }
         Ok(out)
     }
+}
+
+/// Whether a primitive of `vertices` and `triangles` placed after the `placed` (vertices,
+/// triangles) so far keeps the file within [`MAX_ELEMENTS`] of each, else why not.
+fn within_limit(placed: (usize, usize), vertices: usize, triangles: usize) -> Result<(), String> {
+    if placed.0 + vertices > MAX_ELEMENTS || placed.1 + triangles > MAX_ELEMENTS {
+        return Err(format!(
+            "the file places more than {MAX_ELEMENTS} vertices or triangles (this primitive \
+             adds {vertices} and {triangles} to {} and {})",
+            placed.0, placed.1
+        ));
+    }
+    Ok(())
 }
 
 /// A node's local transform in f64: its `matrix` (which must be affine and finite), or
@@ -728,6 +788,19 @@ mod tests {
     }
 
     #[test]
+    fn placed_elements_are_limited() {
+        // Primitives placed by many nodes add up; the limit is on the sum.
+        assert_eq!(within_limit((0, 0), MAX_ELEMENTS, MAX_ELEMENTS), Ok(()));
+        assert_eq!(within_limit((MAX_ELEMENTS - 3, 7), 3, 1), Ok(()));
+        assert_eq!(
+            within_limit((MAX_ELEMENTS - 3, 7), 4, 1).unwrap_err(),
+            "the file places more than 44739242 vertices or triangles (this primitive adds 4 \
+             and 1 to 44739239 and 7)"
+        );
+        assert!(within_limit((0, MAX_ELEMENTS), 0, 1).is_err());
+    }
+
+    #[test]
     fn refused() {
         let nodes = r#""nodes": [{"mesh": 0}]"#;
         let sparse = document(Some(&data_uri()), nodes, "").replacen(
@@ -777,6 +850,16 @@ mod tests {
             e.message
                 .starts_with("glTF validation error at nodes[0].mesh: "),
             "{e}"
+        );
+        // Found by fuzzing (`fuzz/regressions/gltf/`): gltf-json's own validation panicked on
+        // a POSITION index one past the accessors.
+        let e = parse_str(
+            &document(Some(&data_uri()), nodes, "").replace(r#""POSITION": 2"#, r#""POSITION": 3"#),
+        )
+        .unwrap_err();
+        assert_eq!(
+            e.message,
+            r#"glTF validation error at meshes[1].primitives[0].attributes["POSITION"]: Index out of bounds"#
         );
         let e = parse_str("{\"asset\": ").unwrap_err();
         assert!(e.message.starts_with("glTF JSON error: "), "{e}");
