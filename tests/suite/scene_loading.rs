@@ -212,6 +212,19 @@ fn a_directory_is_not_a_scene_file() {
 /// A scene in a fresh temporary folder: a floor (the unit cube flattened) and one mesh from
 /// `obj` (an absolute path) with the extra mesh keys `keys`, lit by a rectangle from above.
 fn repair_scene(obj: &Path, keys: &str, size: u32, methods: &str) -> PathBuf {
+    repair_scene_lit(obj, keys, size, methods, RECT_LIGHT)
+}
+
+/// The light of [`repair_scene`]: a rectangle above the floor.
+const RECT_LIGHT: &str = "type = \"rect\"\ncenter = [0.5, 3.5, 0.3]\nu = [0.4, 0, 0]\nv = [0, 0, 0.4]";
+/// A sphere light where [`RECT_LIGHT`] is, for the methods of Papers I, II and Wyman & Hansen.
+const SPHERE_LIGHT: &str = "type = \"sphere\"\ncenter = [0.5, 3.5, 0.3]\nradius = 0.3";
+/// A disk light facing down where [`RECT_LIGHT`] is, for the D-buffer (CGI 2004).
+const DISK_LIGHT: &str =
+    "type = \"disk\"\ncenter = [0.5, 3.5, 0.3]\nradius = 0.3\nnormal = [0, -1, 0]";
+
+/// [`repair_scene`] under `light` (the TOML keys of the `[light]` table).
+fn repair_scene_lit(obj: &Path, keys: &str, size: u32, methods: &str, light: &str) -> PathBuf {
     static NEXT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let dir = std::env::temp_dir().join(format!("penumbra-repair-{}-{n}", std::process::id()));
@@ -227,10 +240,7 @@ target = [0.0, 0.4, 0.0]
 up = [0, 1, 0]
 vfov_deg = 45
 [light]
-type = "rect"
-center = [0.5, 3.5, 0.3]
-u = [0.4, 0, 0]
-v = [0, 0, 0.4]
+{light}
 [[meshes]]
 obj = {cube:?}
 transform = [6, 0, 0, 0,   0, 0.1, 0, 0,   0, 0, 6, 0,   0, -0.05, 0, 1]
@@ -313,45 +323,41 @@ fn errors_against_raycast(path: &Path) -> Vec<(String, f64)> {
     out
 }
 
-/// A box without its top face, rendered by every method of the rectangle light: capped
-/// (`open = "close"`) it is the closed box again, so each method's mean error against
-/// raycast matches its error on the closed box within 0.002 (what a different
+/// A box without its top face, rendered by every method, under a rectangle, a sphere and a
+/// disk light: capped (`open = "close"`) it is the closed box again, so each method's mean
+/// error against raycast matches its error on the closed box within 0.002 (what a different
 /// triangulation of the cap can move); as a two-sided shell (`open = "shell"`) the methods
 /// see a surface that folds at the rim, and each one's mean error stays within 0.05 of its
 /// error on the closed box (the V-buffer methods' overlap where the shell folds,
-/// docs/mesh-repair.md).
+/// docs/mesh-repair.md). Every method of the registry runs under one of the lights.
 #[test]
 fn a_mesh_with_a_hole_renders_with_every_method() {
     let open_box = scenes_dir().join("bad/models/open-box.obj");
     let closed_box = scenes_dir().join("models/cube.obj");
-    // Both span [−0.4, 0.4] × [0.4, 1.2] × [−0.4, 0.4] (cube.obj is centred, open-box.obj
-    // spans [0, 1]³).
-    let place = "scale = 0.8\ntranslate = [0, 0.8, 0]";
-    let closed = errors_against_raycast(&repair_scene(&closed_box, place, 48, ""));
-    let place = "scale = 0.8\ntranslate = [-0.4, 0.4, -0.4]";
-    // Every method of the rectangle light besides the reference.
-    let names: Vec<&str> = closed.iter().map(|(m, _)| m.as_str()).collect();
-    assert_eq!(
-        names,
-        [
-            "nsample",
-            "hard-sv",
-            "ssv-optimized",
-            "ssv",
-            "wedge-blending"
-        ]
-    );
-    for (open, bound) in [("close", 0.002), ("shell", 0.05)] {
-        let keys = format!("{place}\nopen = \"{open}\"");
-        let repaired = errors_against_raycast(&repair_scene(&open_box, &keys, 48, ""));
-        assert_eq!(repaired.len(), closed.len());
-        for ((m, e), (m0, e0)) in repaired.iter().zip(&closed) {
-            assert_eq!(m, m0);
-            assert!(
-                (e - e0).abs() <= bound,
-                "open = {open}: {m}: mean error {e} vs {e0} on the closed box"
-            );
+    let mut seen: Vec<String> = vec![penumbra::methods::REFERENCE.into()];
+    for light in [RECT_LIGHT, SPHERE_LIGHT, DISK_LIGHT] {
+        // Both span [−0.4, 0.4] × [0.4, 1.2] × [−0.4, 0.4] (cube.obj is centred,
+        // open-box.obj spans [0, 1]³).
+        let place = "scale = 0.8\ntranslate = [0, 0.8, 0]";
+        let closed = errors_against_raycast(&repair_scene_lit(&closed_box, place, 48, "", light));
+        let place = "scale = 0.8\ntranslate = [-0.4, 0.4, -0.4]";
+        seen.extend(closed.iter().map(|(m, _)| m.clone()));
+        for (open, bound) in [("close", 0.002), ("shell", 0.05)] {
+            let keys = format!("{place}\nopen = \"{open}\"");
+            let repaired =
+                errors_against_raycast(&repair_scene_lit(&open_box, &keys, 48, "", light));
+            assert_eq!(repaired.len(), closed.len());
+            for ((m, e), (m0, e0)) in repaired.iter().zip(&closed) {
+                assert_eq!(m, m0);
+                assert!(
+                    (e - e0).abs() <= bound,
+                    "{light}: open = {open}: {m}: mean error {e} vs {e0} on the closed box"
+                );
+            }
         }
+    }
+    for m in penumbra::methods::names() {
+        assert!(seen.iter().any(|s| s == m), "{m} ran under none of the lights");
     }
 }
 
