@@ -12,6 +12,11 @@
 //! accepted: they are hard cases the shadow methods must handle, not bad input. Vertex
 //! manifoldness (two fans touching at one vertex) is not checked; silhouette loops handle
 //! vertices of any even degree (Paper V).
+//!
+//! Design choice (issue 27, scale): edges are found through the crate's one edge table
+//! (`EdgeTable`: half-edges grouped by a counting sort on their lower vertex, no hashing, no
+//! sort of all half-edges), which mesh repair ([`super::repair`]) uses for every step that
+//! walks edges; a mesh of a million triangles is checked in one linear pass over it.
 
 use crate::scene::Mesh;
 use glam::Vec3;
@@ -146,7 +151,7 @@ impl std::error::Error for AdjacencyError {}
 /// two-manifold. Checks run triangle by triangle for index errors, then edge by edge in edge
 /// order, so the reported edge is deterministic: the first problematic edge in edge order.
 ///
-/// The edges come from an [`EdgeTable`] (half-edges grouped by a counting sort, no hashing),
+/// The edges come from an `EdgeTable` (half-edges grouped by a counting sort, no hashing),
 /// numbered by their first half-edge: a linear pass, no allocation per triangle or edge.
 pub fn build(mesh: &Mesh) -> Result<Adjacency, AdjacencyError> {
     let n = mesh.triangles.len();
@@ -250,11 +255,7 @@ impl<'a> EdgeTable<'a> {
     /// The edge table of `tris` (every index below `u32::MAX`, at most `u32::MAX / 3`
     /// triangles).
     pub(crate) fn new(tris: &'a [[u32; 3]]) -> Self {
-        let vertices = tris
-            .iter()
-            .flatten()
-            .max()
-            .map_or(0, |&m| m as usize + 1);
+        let vertices = tris.iter().flatten().max().map_or(0, |&m| m as usize + 1);
         let (start, entries) = bucket_sort(vertices, 3 * tris.len(), |h| {
             let (t, k) = (tris[h / 3], h % 3);
             let (a, b) = (t[k], t[(k + 1) % 3]);

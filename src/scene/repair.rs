@@ -11,7 +11,7 @@
 //!    the order of their first occurrence, so a mesh that needs nothing stays bit-identical.
 //!    This is the only weld of the load path: a file's corners reach it as the file holds
 //!    them. A welded vertex stores −0 as +0 (chosen: the two are one position, and the mesh
-//!    loader always stored it so, which every file scene's golden image depends on); with
+//!    loader always stored it so, which keeps every file scene bit-identical); with
 //!    `weld = false` positions stay as written.
 //! 2. **Clean**: triangles that repeat a vertex (after welding) and exact duplicates (the same
 //!    three vertices in the same rotation) are dropped. A face and its reverse are kept: the
@@ -443,25 +443,17 @@ pub fn repair(
     }
 
     // 6. Closed parts right side out (shells have volume 0 and are left as they are).
-    // Each closed part's triangles in triangle order (a counting sort by part).
+    // Each closed part's triangles in triangle order (shelled parts' in a last bucket, unused).
     let part_count = open_part.len();
-    let mut start = vec![0u32; part_count + 1];
-    for &p in &part_of {
-        if !shelled[p as usize] {
-            start[p as usize + 1] += 1;
-        }
-    }
-    for p in 0..part_count {
-        start[p + 1] += start[p];
-    }
-    let mut fill: Vec<u32> = start[..part_count].to_vec();
-    let mut members = vec![0u32; start[part_count] as usize];
-    for (t, &p) in part_of.iter().enumerate() {
-        if !shelled[p as usize] {
-            members[fill[p as usize] as usize] = t as u32;
-            fill[p as usize] += 1;
-        }
-    }
+    let (start, members) = bucket_sort(part_count + 1, part_of.len(), |t| {
+        let p = part_of[t];
+        let bucket = if shelled[p as usize] {
+            part_count as u32
+        } else {
+            p
+        };
+        (bucket, t as u32)
+    });
     let mut own: Vec<[u32; 3]> = Vec::new();
     for p in 0..part_count {
         let list = &members[start[p] as usize..start[p + 1] as usize];
@@ -1547,7 +1539,10 @@ mod tests {
         let counted = run(p.clone(), t.clone(), options);
         let uncounted = run(p, t, shared);
         assert_eq!((counted.0, counted.1), (uncounted.0, uncounted.1));
-        assert_eq!((counted.2.corners_welded, uncounted.2.corners_welded), (2, 0));
+        assert_eq!(
+            (counted.2.corners_welded, uncounted.2.corners_welded),
+            (2, 0)
+        );
         // Welds within the tolerance still count: the STL cube with one corner of 28 welded
         // corners moved one f32 step, 27 of them identical.
         let (cp, ct) = cube();

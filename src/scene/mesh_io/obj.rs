@@ -497,4 +497,43 @@ pub(super) mod tests {
         let e = parse_mesh(&[0xff, 0xfe, 0x00], MeshFormat::Obj, "x.obj", None).unwrap_err();
         assert_eq!(e.message, "the OBJ file has no triangles");
     }
+
+    /// A file of many chunks of the pre-pass (each vertex line ~20 bytes): tobj's errors still
+    /// name their line across chunks, and a pre-pass error after a line tobj rejects is the
+    /// one reported (as when the pre-pass ran to its end before tobj began).
+    #[test]
+    fn errors_far_into_a_file_of_many_chunks() {
+        let n = 20_000; // ~6 chunks of vertices
+        let mut text = String::new();
+        for i in 0..n {
+            text.push_str(&format!("v {i} 0.5 0.25\n"));
+        }
+        text.push_str("f 1 2 3\n");
+        let good = parse_str(&text).unwrap();
+        assert_eq!((good.positions.len(), good.triangles.len()), (3, 1));
+        let bad_face = format!("{text}f 1 2 x\n");
+        let e = parse_str(&bad_face).unwrap_err();
+        assert_eq!(
+            e.message,
+            format!(
+                "OBJ parse error at line {}: a face needs three or more vertex indices: f i j k \
+                 (line reads \"f 1 2 x\")",
+                n + 2
+            )
+        );
+        // Line 2 has only two numbers (for tobj to report), the last line is not finite.
+        let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+        lines[1] = "v 1 2".into();
+        lines.push("v 0 nan 0".into());
+        let e = parse_str(&(lines.join("\n") + "\n")).unwrap_err();
+        assert_eq!(
+            e.message,
+            format!(
+                "OBJ parse error at line {}: vertex {} is not finite: (0, NaN, 0) (line reads \
+                 \"v 0 nan 0\")",
+                n + 2,
+                n + 1
+            )
+        );
+    }
 }
