@@ -47,8 +47,11 @@
 //!
 //! A mesh file is read by [`read_mesh`] (format by extension, case-insensitive; what each
 //! format accepts is in `docs/mesh-formats.md`), moved by its transform
-//! ([`RawMesh::transformed`](super::mesh_io::RawMesh::transformed)) and its bit-identical
-//! vertices welded ([`weld_identical`]); validation then requires it closed.
+//! ([`RawMesh::transformed`](super::mesh_io::RawMesh::transformed)) and repaired
+//! ([`repair`], which welds its bit-identical corners); validation then requires it closed.
+//! A load that takes longer than a second (a model of a million triangles) shows a progress
+//! bar on a terminal's stderr, one step per mesh read, mesh repaired and the validation
+//! ([`Progress::delayed`]).
 //!
 //! Unknown keys anywhere are errors (`deny_unknown_fields`), as are light fields that do not
 //! belong to the chosen light type and missing ones that do (the error names `light.<field>`),
@@ -58,18 +61,20 @@
 //! naming the file, and for syntax and schema errors the line and column.
 
 use super::input_file::read_input_file;
-use super::mesh_io::{check_transform, read_mesh, weld_identical, MeshFormat};
+use super::mesh_io::{check_transform, read_mesh, MeshFormat};
 use super::repair::{repair, OpenTreatment, RepairOptions};
 use super::validate::validate;
 use super::{builtin, Camera, Light, LightShape, Mesh, OptionValue, RawOptions, RgbTexture, Scene};
 use crate::error::InputError;
 use crate::limits::MAX_LIGHTS;
+use crate::progress::Progress;
 use glam::{DMat4, DVec3, Mat4, Vec3};
 use serde::de::{self, IgnoredAny, MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 use std::collections::BTreeMap;
 use std::fmt;
 use std::path::Path;
+use std::time::Duration;
 
 /// The syntax a scene file is written in; both share one schema.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -262,8 +267,16 @@ pub fn parse_scene_str(
         Format::Toml => toml::from_str(text).map_err(|e| toml_error(source_name, text, &e))?,
         Format::Json => serde_json::from_str(text).map_err(|e| json_error(source_name, &e))?,
     };
-    let scene = build(def, source_name, base_dir)?;
+    // Two steps per mesh (read, repair) and validation; drawn once loading takes a second.
+    let progress = Progress::delayed(
+        2 * def.meshes.len() + 1,
+        &format!("loading {source_name}"),
+        LOAD_PROGRESS_DELAY,
+    );
+    let scene = build(def, source_name, base_dir, &progress)?;
+    progress.start("validating");
     validate(&scene)?;
+    progress.finish();
     Ok(scene)
 }
 
@@ -347,8 +360,18 @@ fn v3(a: Three) -> Vec3 {
     DVec3::from_array(a.0).as_vec3()
 }
 
-/// Turns the parsed definition into a scene: light fields per type, meshes, options.
-fn build(def: SceneDef, source: &str, base_dir: &Path) -> Result<Scene, InputError> {
+/// How long loading a scene runs before its progress bar appears (issue 27: "a progress bar
+/// when loading takes longer than a second").
+const LOAD_PROGRESS_DELAY: Duration = Duration::from_secs(1);
+
+/// Turns the parsed definition into a scene: light fields per type, meshes (each a step of
+/// `progress`), options.
+fn build(
+    def: SceneDef,
+    source: &str,
+    base_dir: &Path,
+    progress: &Progress,
+) -> Result<Scene, InputError> {
     let at = |object: &str, message: String| InputError::at(source, object, message);
     let camera = Camera {
         eye: DVec3::from_array(def.camera.eye.0),
@@ -361,7 +384,7 @@ fn build(def: SceneDef, source: &str, base_dir: &Path) -> Result<Scene, InputErr
 
     let mut meshes = Vec::with_capacity(def.meshes.len());
     for (i, m) in def.meshes.iter().enumerate() {
-        meshes.push(build_mesh(m, i, source, base_dir)?);
+        meshes.push(build_mesh(m, i, source, base_dir, progress)?);
     }
 
     let mut options = RawOptions::new();
@@ -530,7 +553,14 @@ fn transform_from_parts(m: &MeshDef) -> Mat4 {
     Mat4::from_cols_array(&mat.to_cols_array().map(|x| x as f32))
 }
 
-fn build_mesh(m: &MeshDef, i: usize, source: &str, base_dir: &Path) -> Result<Mesh, InputError> {
+/// Mesh `i` of the scene: its file read, moved and repaired (two steps of `progress`).
+fn build_mesh(
+    m: &MeshDef,
+    i: usize,
+    source: &str,
+    base_dir: &Path,
+    progress: &Progress,
+) -> Result<Mesh, InputError> {
     let at = |field: &str, message: String| {
         InputError::at(source, format!("meshes[{i}]{field}"), message)
     };
@@ -586,34 +616,23 @@ fn build_mesh(m: &MeshDef, i: usize, source: &str, base_dir: &Path) -> Result<Me
     };
     let path = base_dir.join(file);
     let display = path.display().to_string();
-    let options = repair_options(m).map_err(|(field, e)| at(field, e))?;
+    let mut options = repair_options(m).map_err(|(field, e)| at(field, e))?;
     let object = format!("meshes[{i}] ({display})");
     let in_mesh = |message: String| InputError::at(source, &object, message);
+    progress.start(&format!("reading meshes[{i}]"));
     let mut raw = read_mesh(&path, &display).map_err(|e| in_mesh(e.message))?;
     if let Some(t) = transform {
         raw = raw.transformed(t).map_err(in_mesh)?;
     }
-    // Bit-identical corners are welded first, numbered by first appearance (as the OBJ
-    // loader always did, so closed models keep their vertex order and every golden its
-    // bits); repair then welds within the tolerance, cleans, orients and closes. With
-    // `weld = false` the corners reach repair as the file holds them.
-    // The corners OBJ groups repeat are tobj's numbering (per group), not the file's: the
-    // file shares them, so their welding is no repair; STL's and glTF's are the file's own.
-    let format = raw.format;
-    let corners = raw.positions.len();
-    let (positions, triangles) = if options.weld {
-        let welded = weld_identical(raw, &display, color);
-        (welded.positions, welded.triangles)
-    } else {
-        (raw.positions, raw.triangles)
-    };
-    let file_corners_welded = match format {
-        MeshFormat::Obj => 0,
-        _ => (corners - positions.len()) as u64,
-    };
-    let (positions, triangles, mut repairs) =
-        repair(positions, triangles, &options).map_err(in_mesh)?;
-    repairs.corners_welded += file_corners_welded;
+    // Repair's weld is the only one: bit-identical corners numbered by first appearance (as
+    // the OBJ loader always did, so closed models keep their vertex order and every golden
+    // its bits), then within the tolerance. The positions an OBJ repeats (exporters write a
+    // group's shared `v` lines again) are one vertex in the file, so joining them is no
+    // repair; STL's, PLY's and glTF's repeated corners are reported.
+    options.count_identical_welds = raw.format != MeshFormat::Obj;
+    progress.start(&format!("repairing meshes[{i}]"));
+    let (positions, triangles, repairs) =
+        repair(raw.positions, raw.triangles, &options).map_err(in_mesh)?;
     let mesh = Mesh {
         name: display.clone(),
         positions,
@@ -649,6 +668,8 @@ fn repair_options(m: &MeshDef) -> Result<RepairOptions, (&'static str, String)> 
         weld_tolerance,
         open,
         receiver_only: m.receiver_only.unwrap_or(false),
+        // Set by the mesh's format (build_mesh).
+        count_identical_welds: true,
     })
 }
 

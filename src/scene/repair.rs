@@ -9,6 +9,10 @@
 //!    union-find, so the result depends on neither thread count nor hashing), become the
 //!    vertex of their first occurrence; vertices no triangle uses are dropped. Vertices keep
 //!    the order of their first occurrence, so a mesh that needs nothing stays bit-identical.
+//!    This is the only weld of the load path: a file's corners reach it as the file holds
+//!    them. A welded vertex stores −0 as +0 (chosen: the two are one position, and the mesh
+//!    loader always stored it so, which keeps every file scene bit-identical); with
+//!    `weld = false` positions stay as written.
 //! 2. **Clean**: triangles that repeat a vertex (after welding) and exact duplicates (the same
 //!    three vertices in the same rotation) are dropped. A face and its reverse are kept: the
 //!    pair is a two-sided flat part (closed on its own, volume 0). A zero-area triangle with
@@ -33,6 +37,7 @@
 //!
 //! A receiver-only mesh casts nothing and may stay open: it gets steps 1 and 2 only.
 
+use super::adjacency::{bucket_sort, EdgeTable};
 use super::validate::inside_out_volume;
 use super::{Mesh, Scene};
 use glam::{DVec2, DVec3, Vec3};
@@ -76,6 +81,12 @@ pub struct RepairOptions {
     pub open: Option<OpenTreatment>,
     /// A receiver-only mesh: weld and clean only, it may stay open and unoriented.
     pub receiver_only: bool,
+    /// Whether corners at bit-identical positions count in
+    /// [`MeshRepairs::corners_welded`] (default true). False for OBJ, whose exporters write
+    /// the positions a group shares with another group again (one `v` line per group), so
+    /// joining them is reading the file, not repairing it (and OBJ loading never reported
+    /// it); welds within the tolerance count either way.
+    pub count_identical_welds: bool,
 }
 
 impl Default for RepairOptions {
@@ -85,6 +96,7 @@ impl Default for RepairOptions {
             weld_tolerance: 0.0,
             open: None,
             receiver_only: false,
+            count_identical_welds: true,
         }
     }
 }
@@ -290,16 +302,19 @@ pub fn repair(
     }
 
     // 1. Weld, 2. clean, then drop unused vertices.
-    let canon = if options.weld {
+    let (canon, identical) = if options.weld {
         weld_map(&positions, options.weld_tolerance)
     } else {
-        (0..positions.len() as u32).collect()
+        ((0..positions.len() as u32).collect(), 0)
     };
     r.corners_welded = canon
         .iter()
         .enumerate()
         .filter(|&(i, &c)| c as usize != i)
         .count() as u64;
+    if !options.count_identical_welds {
+        r.corners_welded -= identical;
+    }
     let mut tris: Vec<[u32; 3]> = triangles
         .iter()
         .map(|t| t.map(|i| canon[i as usize]))
@@ -307,8 +322,8 @@ pub fn repair(
     let before = tris.len();
     tris.retain(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0]);
     r.degenerate_dropped = (before - tris.len()) as u64;
-    r.duplicates_dropped = drop_duplicates(&mut tris);
-    let (mut pos, dropped) = compact(&positions, &canon, &mut tris);
+    r.duplicates_dropped = drop_duplicates(&mut tris, positions.len());
+    let (mut pos, dropped) = compact(&positions, &canon, &mut tris, options.weld);
     r.unused_vertices_dropped = dropped;
     if tris.is_empty() {
         return Err("no triangle is left after dropping degenerate ones".into());
@@ -319,7 +334,10 @@ pub fn repair(
     }
 
     // 3. Orient each part by its majority.
-    let (flips, conflicts) = orient(&tris);
+    let edges = EdgeTable::new(&tris);
+    let (flips, conflicts) = orient(&edges);
+    let crowded = edges.groups().any(|g| g.len() > 2);
+    let buckets = edges.into_buckets();
     for (t, &f) in tris.iter_mut().zip(&flips) {
         if f {
             t.swap(1, 2);
@@ -328,12 +346,19 @@ pub fn repair(
     r.faces_flipped = flips.iter().filter(|&&f| f).count() as u64;
 
     // 4. Cut non-manifold and conflicting edges into sheets.
-    let (cut, split) = split_sheets(&mut pos, &mut tris, conflicts)?;
-    r.nonmanifold_edges_split = cut;
-    r.vertices_split = split;
+    let cuts = crowded || !conflicts.is_empty();
+    if cuts {
+        let (cut, split) = split_sheets(&mut pos, &mut tris, conflicts)?;
+        r.nonmanifold_edges_split = cut;
+        r.vertices_split = split;
+    }
 
-    // 5. Open parts.
-    let edges = EdgeTable::new(&tris);
+    // 5. Open parts (the edge table of step 3 serves unless sheets were cut).
+    let edges = if cuts {
+        EdgeTable::new(&tris)
+    } else {
+        EdgeTable::turned(&tris, buckets, &flips)
+    };
     if let Some(e) = edges
         .groups()
         .find(|g| g.len() > 2 || edges.same_direction(g))
@@ -418,14 +443,25 @@ pub fn repair(
     }
 
     // 6. Closed parts right side out (shells have volume 0 and are left as they are).
-    let mut members: Vec<Vec<u32>> = vec![Vec::new(); open_part.len()];
-    for (t, &p) in part_of.iter().enumerate() {
-        if !shelled[p as usize] {
-            members[p as usize].push(t as u32);
+    // Each closed part's triangles in triangle order (shelled parts' in a last bucket, unused).
+    let part_count = open_part.len();
+    let (start, members) = bucket_sort(part_count + 1, part_of.len(), |t| {
+        let p = part_of[t];
+        let bucket = if shelled[p as usize] {
+            part_count as u32
+        } else {
+            p
+        };
+        (bucket, t as u32)
+    });
+    let mut own: Vec<[u32; 3]> = Vec::new();
+    for p in 0..part_count {
+        let list = &members[start[p] as usize..start[p + 1] as usize];
+        if list.is_empty() {
+            continue;
         }
-    }
-    for list in members.iter().filter(|l| !l.is_empty()) {
-        let own: Vec<[u32; 3]> = list.iter().map(|&t| tris[t as usize]).collect();
+        own.clear();
+        own.extend(list.iter().map(|&t| tris[t as usize]));
         if inside_out_volume(&pos, &own).is_some() {
             r.parts_turned_inside_out += 1;
             for &t in list {
@@ -449,23 +485,34 @@ fn fmt_p(p: Vec3) -> String {
 
 /// Per vertex, the vertex it welds into: the first (lowest-index) vertex at the same
 /// position (bits of `p + 0`, so −0 = +0), or with `tolerance > 0` the lowest index of its
-/// class of points chained within `tolerance × diagonal` of each other.
-fn weld_map(positions: &[Vec3], tolerance: f64) -> Vec<u32> {
+/// class of points chained within `tolerance × diagonal` of each other; and how many
+/// vertices are welded for being at a bit-identical position.
+pub(crate) fn weld_map(positions: &[Vec3], tolerance: f64) -> (Vec<u32>, u64) {
     let n = positions.len();
     let mut canon: Vec<u32> = (0..n as u32).collect();
-    let mut order: Vec<([u32; 3], u32)> = positions
-        .iter()
-        .enumerate()
-        .map(|(i, p)| ((*p + Vec3::ZERO).to_array().map(f32::to_bits), i as u32))
-        .collect();
-    order.sort_unstable();
-    for w in 1..order.len() {
-        if order[w].0 == order[w - 1].0 {
-            canon[order[w].1 as usize] = canon[order[w - 1].1 as usize];
+    // Equal positions meet in one bucket of a fixed hash of their bits (a hash only places
+    // them: collisions cost time, not correctness), sorted there by bits and index.
+    let bits = |i: usize| (positions[i] + Vec3::ZERO).to_array().map(f32::to_bits);
+    let log_buckets = (n / 4).max(1).next_power_of_two().trailing_zeros();
+    let (start, order) = bucket_sort(1 << log_buckets, n, |i| {
+        let [x, y, z] = bits(i).map(u64::from);
+        let h = x.wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            ^ y.wrapping_mul(0xC2B2_AE3D_27D4_EB4F)
+            ^ z.wrapping_mul(0x1656_67B1_9E37_79F9);
+        ((h >> 32 >> (32 - log_buckets)) as u32, (bits(i), i as u32))
+    });
+    let mut identical = 0;
+    for w in start.windows(2) {
+        let bucket = &order[w[0] as usize..w[1] as usize];
+        for k in 1..bucket.len() {
+            if bucket[k].0 == bucket[k - 1].0 {
+                canon[bucket[k].1 as usize] = canon[bucket[k - 1].1 as usize];
+                identical += 1;
+            }
         }
     }
     if tolerance <= 0.0 || n == 0 {
-        return canon;
+        return (canon, identical);
     }
     let (lo, hi) = positions
         .iter()
@@ -474,7 +521,7 @@ fn weld_map(positions: &[Vec3], tolerance: f64) -> Vec<u32> {
         });
     let h = tolerance * (hi - lo).length();
     if h <= 0.0 {
-        return canon;
+        return (canon, identical);
     }
     // Cells of edge h: points within h of each other are in neighbouring cells.
     let cell = |p: Vec3| ((p.as_dvec3() - lo) / h).floor().as_i64vec3().to_array();
@@ -506,7 +553,8 @@ fn weld_map(positions: &[Vec3], tolerance: f64) -> Vec<u32> {
             }
         }
     }
-    (0..n as u32).map(|i| find(&mut parent, i)).collect()
+    let canon = (0..n as u32).map(|i| find(&mut parent, i)).collect();
+    (canon, identical)
 }
 
 /// Union-find root with path halving.
@@ -529,23 +577,26 @@ fn union_min(parent: &mut [u32], a: u32, b: u32) {
     }
 }
 
-/// Drops every later copy of a triangle (the same vertices in the same rotation); returns
-/// how many.
-fn drop_duplicates(tris: &mut Vec<[u32; 3]>) -> u64 {
+/// Drops every later copy of a triangle (the same vertices in the same rotation, every index
+/// below `vertices`); returns how many. The triangles, each turned to start at its lowest
+/// vertex, are bucketed by that vertex (a counting sort) and each bucket sorted by the other
+/// two and the triangle index, so copies meet in index order.
+fn drop_duplicates(tris: &mut Vec<[u32; 3]>, vertices: usize) -> u64 {
     let rotated = |t: &[u32; 3]| {
         let k = (0..3).min_by_key(|&k| t[k]).unwrap_or(0);
         [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
     };
-    let mut keys: Vec<([u32; 3], u32)> = tris
-        .iter()
-        .enumerate()
-        .map(|(i, t)| (rotated(t), i as u32))
-        .collect();
-    keys.sort_unstable();
+    let (start, keys) = bucket_sort(vertices, tris.len(), |i| {
+        let [a, b, c] = rotated(&tris[i]);
+        (a, ([b, c], i as u32))
+    });
     let mut keep = vec![true; tris.len()];
-    for w in 1..keys.len() {
-        if keys[w].0 == keys[w - 1].0 {
-            keep[keys[w].1 as usize] = false;
+    for w in start.windows(2) {
+        let bucket = &keys[w[0] as usize..w[1] as usize];
+        for k in 1..bucket.len() {
+            if bucket[k].0 == bucket[k - 1].0 {
+                keep[bucket[k].1 as usize] = false;
+            }
         }
     }
     let before = tris.len();
@@ -554,9 +605,15 @@ fn drop_duplicates(tris: &mut Vec<[u32; 3]>) -> u64 {
     (before - tris.len()) as u64
 }
 
-/// The used vertices renumbered in their original order (triangles rewritten); returns the
-/// new positions and how many unused vertices (other than welded-away ones) were dropped.
-fn compact(positions: &[Vec3], canon: &[u32], tris: &mut [[u32; 3]]) -> (Vec<Vec3>, u64) {
+/// The used vertices renumbered in their original order (triangles rewritten), each stored
+/// as `p + 0` (−0 as +0) when `welded`; returns the new positions and how many unused
+/// vertices (other than welded-away ones) were dropped.
+pub(crate) fn compact(
+    positions: &[Vec3],
+    canon: &[u32],
+    tris: &mut [[u32; 3]],
+    welded: bool,
+) -> (Vec<Vec3>, u64) {
     let mut new_index = vec![u32::MAX; positions.len()];
     for t in tris.iter() {
         for &i in t {
@@ -568,7 +625,11 @@ fn compact(positions: &[Vec3], canon: &[u32], tris: &mut [[u32; 3]]) -> (Vec<Vec
     for (i, slot) in new_index.iter_mut().enumerate() {
         if *slot == 0 {
             *slot = pos.len() as u32;
-            pos.push(positions[i]);
+            pos.push(if welded {
+                positions[i] + Vec3::ZERO
+            } else {
+                positions[i]
+            });
         } else if canon[i] as usize == i {
             unused += 1;
         }
@@ -579,80 +640,6 @@ fn compact(positions: &[Vec3], canon: &[u32], tris: &mut [[u32; 3]]) -> (Vec<Vec
     (pos, unused)
 }
 
-/// The undirected edges of a triangle list: every half-edge (triangle·3 + corner, the edge
-/// from corner k to corner k+1), sorted by its undirected key, so each edge's triangles are
-/// one run in triangle order (deterministic, no hashing).
-struct EdgeTable<'a> {
-    tris: &'a [[u32; 3]],
-    /// (undirected key: min << 32 | max, half-edge), sorted.
-    sorted: Vec<(u64, u32)>,
-}
-
-impl<'a> EdgeTable<'a> {
-    fn new(tris: &'a [[u32; 3]]) -> Self {
-        let mut sorted: Vec<(u64, u32)> = (0..tris.len() as u32 * 3)
-            .map(|h| {
-                let [a, b] = half_edge(tris, h);
-                (key(a, b), h)
-            })
-            .collect();
-        sorted.sort_unstable();
-        EdgeTable { tris, sorted }
-    }
-
-    /// The half-edges of each undirected edge, edges in key order.
-    fn groups(&self) -> impl Iterator<Item = Group<'_>> + '_ {
-        self.sorted.chunk_by(|x, y| x.0 == y.0).map(Group)
-    }
-
-    /// The half-edges of the undirected edge `a–b`.
-    fn of(&self, a: u32, b: u32) -> impl Iterator<Item = u32> + '_ {
-        let k = key(a, b);
-        let start = self.sorted.partition_point(|&(x, _)| x < k);
-        self.sorted[start..]
-            .iter()
-            .take_while(move |&&(x, _)| x == k)
-            .map(|&(_, h)| h)
-    }
-
-    /// The ends of half-edge `h`, in its triangle's direction.
-    fn ends(&self, h: u32) -> [u32; 2] {
-        half_edge(self.tris, h)
-    }
-
-    /// Whether the two half-edges of a two-triangle edge run the same way.
-    fn same_direction(&self, g: &Group) -> bool {
-        g.len() == 2 && self.ends(g.h(0)) == self.ends(g.h(1))
-    }
-}
-
-/// The half-edges of one undirected edge (a run of [`EdgeTable`]'s sorted half-edges).
-struct Group<'a>(&'a [(u64, u32)]);
-
-impl Group<'_> {
-    /// How many triangles use the edge.
-    fn len(&self) -> usize {
-        self.0.len()
-    }
-
-    /// The `i`-th half-edge, in triangle order.
-    fn h(&self, i: usize) -> u32 {
-        self.0[i].1
-    }
-
-    /// All its half-edges, in triangle order.
-    fn all(&self) -> Vec<u32> {
-        self.0.iter().map(|&(_, h)| h).collect()
-    }
-}
-
-/// The ends of half-edge `h` (triangle h/3, corner h%3 to the next corner).
-fn half_edge(tris: &[[u32; 3]], h: u32) -> [u32; 2] {
-    let t = tris[(h / 3) as usize];
-    let k = (h % 3) as usize;
-    [t[k], t[(k + 1) % 3]]
-}
-
 fn key(a: u32, b: u32) -> u64 {
     (u64::from(a.min(b)) << 32) | u64::from(a.max(b))
 }
@@ -660,9 +647,8 @@ fn key(a: u32, b: u32) -> u64 {
 /// Per triangle whether to flip it so that each part (joined by two-triangle edges) agrees
 /// with its majority, and the two-triangle edges that still disagree afterwards (a part
 /// that cannot be oriented), as the vertex pairs of their ends.
-fn orient(tris: &[[u32; 3]]) -> (Vec<bool>, Vec<[u32; 2]>) {
-    let edges = EdgeTable::new(tris);
-    let n = tris.len();
+fn orient(edges: &EdgeTable) -> (Vec<bool>, Vec<[u32; 2]>) {
+    let n = edges.tris().len();
     // Per triangle its neighbours across two-triangle edges: (neighbour, same direction).
     let mut neighbours: Vec<[(u32, bool); 3]> = vec![[(u32::MAX, false); 3]; n];
     let mut pairs = Vec::new();
@@ -676,13 +662,15 @@ fn orient(tris: &[[u32; 3]]) -> (Vec<bool>, Vec<[u32; 2]>) {
     }
     let mut state: Vec<Option<bool>> = vec![None; n];
     let mut queue = std::collections::VecDeque::new();
+    let mut members = Vec::new();
     for seed in 0..n {
         if state[seed].is_some() {
             continue;
         }
         state[seed] = Some(false);
         queue.push_back(seed as u32);
-        let mut members = vec![seed as u32];
+        members.clear();
+        members.push(seed as u32);
         while let Some(t) = queue.pop_front() {
             let s = state[t as usize].unwrap_or(false);
             for &(u, same) in &neighbours[t as usize] {
@@ -810,7 +798,7 @@ fn pair_by_angle(pos: &[Vec3], edges: &EdgeTable, g: &[u32]) -> Option<Vec<[u32;
     let (pa, pb) = (pos[a as usize].as_dvec3(), pos[b as usize].as_dvec3());
     let d = pb - pa;
     let perp = |h: u32| {
-        let t = edges.tris[(h / 3) as usize];
+        let t = edges.tris()[(h / 3) as usize];
         let third = t[((h % 3 + 2) % 3) as usize];
         let w = pos[third as usize].as_dvec3() - pa;
         w - d * (w.dot(d) / d.length_squared())
@@ -888,7 +876,7 @@ fn boundary_loops(edges: &EdgeTable, boundary: &[u32]) -> Vec<BoundaryLoop> {
             out = (twin / 3) * 3 + (twin % 3 + 1) % 3;
         }
     };
-    let mut used = vec![false; edges.tris.len() * 3];
+    let mut used = vec![false; edges.tris().len() * 3];
     let mut loops = Vec::new();
     for &start in boundary {
         if used[start as usize] {
@@ -1498,6 +1486,76 @@ mod tests {
             r.boundary_edges, 4,
             "the lone corner's triangle opens a crack"
         );
+    }
+
+    /// Two triangles of a square with copied corners, positions in this order: (1,1,0),
+    /// (−0,0,0), (1,0,0), (0,0,0), (1,1,0), (0,1,0); as a receiver-only mesh (weld and clean
+    /// only, so the open square stays as it is).
+    fn square_with_minus_zero() -> (Vec<Vec3>, Vec<[u32; 3]>, RepairOptions) {
+        let p = vec![
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(-0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        ];
+        let options = RepairOptions {
+            receiver_only: true,
+            ..Default::default()
+        };
+        (p, vec![[1, 2, 0], [3, 4, 5]], options)
+    }
+
+    #[test]
+    fn welded_vertices_keep_first_appearance_order_and_store_plus_zero() {
+        let (p, t, options) = square_with_minus_zero();
+        let (p2, t2, r) = run(p.clone(), t.clone(), options);
+        let bits = |v: &[Vec3]| -> Vec<[u32; 3]> {
+            v.iter().map(|x| x.to_array().map(f32::to_bits)).collect()
+        };
+        let expected = [p[0], Vec3::ZERO, p[2], p[5]];
+        assert_eq!(bits(&p2), bits(&expected), "−0 is stored as +0");
+        assert_eq!(t2, vec![[1, 2, 0], [1, 0, 3]]);
+        assert_eq!(r.corners_welded, 2);
+        // Without welding the positions stay as written, −0 included.
+        let off = RepairOptions {
+            weld: false,
+            ..options
+        };
+        let (p3, t3, r) = run(p.clone(), t.clone(), off);
+        assert_eq!(bits(&p3), bits(&p));
+        assert_eq!(p3[1].x.to_bits(), 0x8000_0000);
+        assert_eq!((t3, r.corners_welded), (t, 0));
+    }
+
+    #[test]
+    fn identical_welds_can_go_uncounted() {
+        let (p, t, options) = square_with_minus_zero();
+        let shared = RepairOptions {
+            count_identical_welds: false,
+            ..options
+        };
+        let counted = run(p.clone(), t.clone(), options);
+        let uncounted = run(p, t, shared);
+        assert_eq!((counted.0, counted.1), (uncounted.0, uncounted.1));
+        assert_eq!(
+            (counted.2.corners_welded, uncounted.2.corners_welded),
+            (2, 0)
+        );
+        // Welds within the tolerance still count: the STL cube with one corner of 28 welded
+        // corners moved one f32 step, 27 of them identical.
+        let (cp, ct) = cube();
+        let (mut sp, st) = stl(&cp, &ct);
+        let k = sp.iter().rposition(|v| *v == Vec3::ONE).unwrap();
+        sp[k].x = f32::from_bits(1.0f32.to_bits() + 1);
+        let near = RepairOptions {
+            weld_tolerance: 1e-6,
+            count_identical_welds: false,
+            ..Default::default()
+        };
+        let (p2, _, r) = run(sp, st, near);
+        assert_eq!((r.corners_welded, p2.len()), (1, 8));
     }
 
     #[test]

@@ -9,9 +9,10 @@
 //!
 //! The design choice: readers only *read*. They do not weld, drop degenerate triangles or
 //! reorient: a [`RawMesh`] may have duplicated corners (STL always has: three per facet),
-//! degenerate triangles and holes. Turning it into a scene [`Mesh`] is a separate step
-//! ([`weld_identical`] here: bit-identical positions become one vertex, which is what OBJ
-//! loading always did, so existing scenes render the same). Every reader does check what would
+//! degenerate triangles and holes. Turning it into a scene [`Mesh`] is a separate step: mesh
+//! repair ([`super::repair`]), whose weld is the only one of the load path (bit-identical
+//! positions become one vertex, numbered by first appearance, which is what OBJ loading always
+//! did, so existing scenes render the same). Every reader does check what would
 //! make later steps meaningless: every coordinate finite (the error names the vertex: its index,
 //! and its line in text formats), every index inside the positions, at least one triangle.
 //!
@@ -25,10 +26,10 @@ pub mod stl;
 
 use super::input_file::read_input_file;
 use super::procedural::transform_point;
+use super::repair::weld_map;
 use super::Mesh;
 use crate::error::InputError;
 use glam::{Mat4, Vec3, Vec4};
-use std::collections::HashMap;
 use std::path::Path;
 
 /// A mesh as its file holds it, in the file's world space (glTF node transforms applied),
@@ -170,29 +171,23 @@ impl RawMesh {
     }
 }
 
-/// The scene mesh of `raw`: vertices with bit-identical coordinates (−0 = +0) become one,
-/// numbered in order of first appearance, and the triangles are renumbered; nothing else
-/// changes (no triangle is dropped or turned). This restores the shared vertices of OBJ
-/// groups (tobj numbers vertices per group) and of STL facets, and closes meshes written with
-/// per-face vertex copies.
+/// The scene mesh of `raw` with only its bit-identical vertices joined: the weld of mesh
+/// repair ([`super::repair`], −0 = +0, stored as +0, numbered in order of first appearance)
+/// and nothing else (no vertex dropped, no triangle dropped or turned). Not on the load path,
+/// which repairs (and so welds) every mesh; for the fuzz targets, which want the file's own
+/// triangles in a mesh.
 pub fn weld_identical(raw: RawMesh, name: &str, color: [f32; 3]) -> Mesh {
+    let (canon, _) = weld_map(&raw.positions, 0.0);
+    let mut remap = vec![0u32; canon.len()];
     let mut positions: Vec<Vec3> = Vec::new();
-    let mut weld: HashMap<[u32; 3], u32> = HashMap::new();
-    let remap: Vec<u32> = raw
-        .positions
-        .iter()
-        .map(|p| {
-            // +0.0 turns −0.0 into +0.0, so both weld together.
-            let v = *p + Vec3::ZERO;
-            let next = positions.len() as u32;
-            *weld
-                .entry(v.to_array().map(f32::to_bits))
-                .or_insert_with(|| {
-                    positions.push(v);
-                    next
-                })
-        })
-        .collect();
+    for (i, &c) in canon.iter().enumerate() {
+        remap[i] = if c as usize == i {
+            positions.push(raw.positions[i] + Vec3::ZERO);
+            (positions.len() - 1) as u32
+        } else {
+            remap[c as usize]
+        };
+    }
     let triangles = raw
         .triangles
         .iter()

@@ -17,17 +17,27 @@
 //!   keywords — become empty lines: they may hold any bytes, UTF-8 or not (latin-1 material
 //!   names are common). A `#` inside a `v` or `f` line starts a comment.
 //!
+//! The pre-pass runs on a thread of its own and hands its output on in chunks of whole lines
+//! while `tobj` parses them (a million-triangle model parses in about half the time); the
+//! result is the same as running one after the other: the same text reaches `tobj`, and an
+//! error of the pre-pass is the one reported.
+//!
 //! `tobj` then parses the numbers and triangulates (`triangulate = true`: a polygon becomes a
 //! fan from its first corner; [`RawMesh::polygons_triangulated`] counts the faces with more than
 //! three corners); since groups and materials are blanked it sees one model. Positions come out
 //! compacted to the vertices faces use, in order of first use. Materials are never loaded
-//! (colour comes from the scene file). Positions are not welded here ([`super::weld_identical`]).
+//! (colour comes from the scene file). Positions are not welded here (mesh repair welds them,
+//! [`crate::scene::repair`]).
 
 use super::{non_finite_vertex, MeshFormat, RawMesh};
 use crate::error::InputError;
 use glam::Vec3;
 use std::borrow::Cow;
-use std::io::{BufRead, Cursor, Read};
+use std::io::{BufRead, Read};
+use std::sync::mpsc::{self, Receiver, Sender};
+
+/// The pre-pass hands `tobj` its output in chunks of whole lines of about this many bytes.
+const CHUNK: usize = 1 << 16;
 
 /// Reads OBJ bytes into a [`RawMesh`]; errors name `display_name` and the line.
 pub(super) fn parse(bytes: &[u8], display_name: &str) -> Result<RawMesh, InputError> {
@@ -41,27 +51,34 @@ pub(super) fn parse(bytes: &[u8], display_name: &str) -> Result<RawMesh, InputEr
             ),
         )
     };
-    let kept = keep_positions_and_faces(&text).map_err(|(line, cause)| err(line, cause))?;
-
     let options = tobj::LoadOptions {
         single_index: false,
         triangulate: true,
         ignore_points: true,
         ignore_lines: true,
     };
-    let mut reader = LineCountingReader {
-        inner: Cursor::new(&kept.text),
-        newlines: 0,
-        at_line_start: true,
-    };
-    let (models, _materials) = tobj::load_obj_buf(&mut reader, &options, |_| {
-        Err(tobj::LoadError::OpenFileFailed)
-    })
-    .map_err(|e| {
+    // The pre-pass runs on its own thread while tobj parses what it has handed on (the two
+    // take about the same time); its error, if any, is the one reported, as if it had run
+    // first: it stops there, and tobj's result is then not looked at.
+    let total_vertices = count_vertices(&text);
+    let (loaded, polygons, tobj_line) = std::thread::scope(|scope| {
+        let (send, chunks) = mpsc::channel();
+        let text = &text;
+        let prepass = scope.spawn(move || keep_positions_and_faces(text, total_vertices, send));
+        let mut reader = KeptReader::new(chunks);
+        let loaded = tobj::load_obj_buf(&mut reader, &options, |_| {
+            Err(tobj::LoadError::OpenFileFailed)
+        });
         // tobj stops at the line it cannot use: the last line the reader handed out.
         let line = reader.newlines + usize::from(!reader.at_line_start);
-        err(line, load_error_cause(&e))
-    })?;
+        drop(reader);
+        let polygons = prepass
+            .join()
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (loaded, polygons, line)
+    });
+    let polygons = polygons.map_err(|(line, cause)| err(line, cause))?;
+    let (models, _materials) = loaded.map_err(|e| err(tobj_line, load_error_cause(&e)))?;
 
     let mut positions: Vec<Vec3> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
@@ -84,7 +101,7 @@ pub(super) fn parse(bytes: &[u8], display_name: &str) -> Result<RawMesh, InputEr
         positions,
         triangles,
         format: MeshFormat::Obj,
-        polygons_triangulated: kept.polygons,
+        polygons_triangulated: polygons,
     })
 }
 
@@ -110,30 +127,34 @@ fn decode(bytes: &[u8]) -> Cow<'_, [u8]> {
     }
 }
 
-/// What the pre-pass hands `tobj`.
-struct Kept {
-    /// One line per input line: `v` and `f` lines reduced to positions, every other line empty.
-    text: Vec<u8>,
-    /// Faces with more than three corners.
-    polygons: usize,
-}
-
 /// The first whitespace-separated word of `line` and the words after it, up to a word starting
 /// with `#` (a comment).
-fn words(line: &[u8]) -> impl Iterator<Item = &[u8]> {
+fn words(line: &[u8]) -> impl Iterator<Item = &[u8]> + Clone {
     line.split(|b| b.is_ascii_whitespace())
         .filter(|w| !w.is_empty())
         .take_while(|w| w[0] != b'#')
 }
 
+/// The number of `v` lines of `text`.
+fn count_vertices(text: &[u8]) -> usize {
+    text.split(|b| *b == b'\n')
+        .filter(|line| words(line).next() == Some(b"v".as_slice()))
+        .count()
+}
+
 /// The pre-pass of the module doc: `v` and `f` lines reduced to what `tobj` needs, everything
-/// else blanked, positions checked finite and face indices checked in range. An error is the
-/// 1-based line and its cause. A line whose numbers do not parse is handed on unchanged, for
-/// `tobj` to report.
-fn keep_positions_and_faces(text: &[u8]) -> Result<Kept, (usize, String)> {
-    let is_vertex = |line: &&[u8]| words(line).next() == Some(b"v".as_slice());
-    let total_vertices = text.split(|b| *b == b'\n').filter(is_vertex).count();
-    let mut out = Vec::with_capacity(text.len());
+/// else blanked, positions checked finite and face indices checked in range (against the
+/// file's `total_vertices`), sent on in chunks of whole lines (one output line per input
+/// line) until the end or an error. Returns the faces with more than three corners, or the
+/// 1-based line of the error and its cause. A line whose numbers do not parse is handed on
+/// unchanged, for `tobj` to report. No allocation per line (a model of a million triangles
+/// has 1.5 million lines).
+fn keep_positions_and_faces(
+    text: &[u8],
+    total_vertices: usize,
+    send: Sender<Vec<u8>>,
+) -> Result<usize, (usize, String)> {
+    let mut out = Vec::with_capacity(2 * CHUNK);
     let mut vertices = 0usize;
     let mut polygons = 0usize;
     for (i, line) in text.split(|b| *b == b'\n').enumerate() {
@@ -142,8 +163,15 @@ fn keep_positions_and_faces(text: &[u8]) -> Result<Kept, (usize, String)> {
         match w.next() {
             Some(b"v") => {
                 vertices += 1;
-                let values: Vec<&[u8]> = w.collect();
-                match finite_position(&values) {
+                // Up to 7 values: more is not a position form (finite_position says None).
+                let mut buf: [&[u8]; 7] = [&[]; 7];
+                let mut count = 0;
+                for (slot, v) in buf.iter_mut().zip(w) {
+                    *slot = v;
+                    count += 1;
+                }
+                let values = &buf[..count];
+                match finite_position(values) {
                     Some(Ok(())) => {
                         out.push(b'v');
                         // x y z [w]: colours (six values) dropped.
@@ -158,29 +186,28 @@ fn keep_positions_and_faces(text: &[u8]) -> Result<Kept, (usize, String)> {
                 }
             }
             Some(b"f") => {
-                let corners: Vec<&[u8]> = w
-                    .map(|c| c.split(|b| *b == b'/').next().unwrap_or_default())
-                    .collect();
-                if corners.len() >= 3 {
-                    for c in &corners {
-                        check_index(c, vertices, total_vertices).map_err(|e| (number, e))?;
-                    }
+                let corners = w.map(|c| c.split(|b| *b == b'/').next().unwrap_or_default());
+                let count = corners.clone().count();
+                if count >= 3 {
                     out.push(b'f');
-                    for c in &corners {
+                    for c in corners {
+                        check_index(c, vertices, total_vertices).map_err(|e| (number, e))?;
                         out.push(b' ');
                         out.extend_from_slice(c);
                     }
-                    polygons += usize::from(corners.len() > 3);
+                    polygons += usize::from(count > 3);
                 }
             }
             _ => {}
         }
         out.push(b'\n');
+        if out.len() >= CHUNK {
+            // A closed channel (tobj stopped reading) leaves only the checks to finish.
+            let _ = send.send(std::mem::replace(&mut out, Vec::with_capacity(2 * CHUNK)));
+        }
     }
-    Ok(Kept {
-        text: out,
-        polygons,
-    })
+    let _ = send.send(out);
+    Ok(polygons)
 }
 
 /// For a `v` line's values: `None` if they are not `x y z`, `x y z w` or `x y z r g b` with
@@ -233,44 +260,62 @@ fn check_index(corner: &[u8], seen: usize, total: usize) -> Result<(), String> {
     }
 }
 
-/// A `BufRead` over the OBJ bytes that counts the lines handed out, so that a `tobj` error,
+/// A `BufRead` over the pre-pass's output as its thread sends it (chunks of whole lines; the
+/// end when the pre-pass is done), counting the lines handed out, so that a `tobj` error,
 /// which carries no position, can name its line.
-struct LineCountingReader<'a> {
-    inner: Cursor<&'a [u8]>,
+struct KeptReader {
+    chunks: Receiver<Vec<u8>>,
+    /// The chunk being read, and how far.
+    chunk: Vec<u8>,
+    at: usize,
     /// Newlines consumed so far.
     newlines: usize,
     /// Whether the last byte consumed was a newline (or nothing was consumed).
     at_line_start: bool,
 }
 
-impl Read for LineCountingReader<'_> {
+impl KeptReader {
+    fn new(chunks: Receiver<Vec<u8>>) -> Self {
+        KeptReader {
+            chunks,
+            chunk: Vec::new(),
+            at: 0,
+            newlines: 0,
+            at_line_start: true,
+        }
+    }
+}
+
+impl Read for KeptReader {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        let n = self.inner.read(buf)?;
-        self.count(&buf[..n]);
+        let available = self.fill_buf()?;
+        let n = available.len().min(buf.len());
+        buf[..n].copy_from_slice(&available[..n]);
+        self.consume(n);
         Ok(n)
     }
 }
 
-impl BufRead for LineCountingReader<'_> {
+impl BufRead for KeptReader {
     fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
-        self.inner.fill_buf()
+        while self.at == self.chunk.len() {
+            match self.chunks.recv() {
+                Ok(next) => (self.chunk, self.at) = (next, 0),
+                // The pre-pass is done: the end of the text.
+                Err(_) => break,
+            }
+        }
+        Ok(&self.chunk[self.at..])
     }
 
     fn consume(&mut self, amt: usize) {
-        let start = self.inner.position() as usize;
-        let data = *self.inner.get_ref();
-        let end = (start + amt).min(data.len());
-        self.count(&data[start..end]);
-        self.inner.consume(amt);
-    }
-}
-
-impl LineCountingReader<'_> {
-    fn count(&mut self, consumed: &[u8]) {
-        if let Some(last) = consumed.last() {
+        let end = (self.at + amt).min(self.chunk.len());
+        let consumed = &self.chunk[self.at..end];
+        if let Some(&last) = consumed.last() {
             self.newlines += consumed.iter().filter(|b| **b == b'\n').count();
-            self.at_line_start = *last == b'\n';
+            self.at_line_start = last == b'\n';
         }
+        self.at = end;
     }
 }
 
@@ -451,5 +496,44 @@ pub(super) mod tests {
         // A UTF-16 byte-order mark and half a character: one line, no face.
         let e = parse_mesh(&[0xff, 0xfe, 0x00], MeshFormat::Obj, "x.obj", None).unwrap_err();
         assert_eq!(e.message, "the OBJ file has no triangles");
+    }
+
+    /// A file of many chunks of the pre-pass (each vertex line ~20 bytes): tobj's errors still
+    /// name their line across chunks, and a pre-pass error after a line tobj rejects is the
+    /// one reported (as when the pre-pass ran to its end before tobj began).
+    #[test]
+    fn errors_far_into_a_file_of_many_chunks() {
+        let n = 20_000; // ~6 chunks of vertices
+        let mut text = String::new();
+        for i in 0..n {
+            text.push_str(&format!("v {i} 0.5 0.25\n"));
+        }
+        text.push_str("f 1 2 3\n");
+        let good = parse_str(&text).unwrap();
+        assert_eq!((good.positions.len(), good.triangles.len()), (3, 1));
+        let bad_face = format!("{text}f 1 2 x\n");
+        let e = parse_str(&bad_face).unwrap_err();
+        assert_eq!(
+            e.message,
+            format!(
+                "OBJ parse error at line {}: a face needs three or more vertex indices: f i j k \
+                 (line reads \"f 1 2 x\")",
+                n + 2
+            )
+        );
+        // Line 2 has only two numbers (for tobj to report), the last line is not finite.
+        let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+        lines[1] = "v 1 2".into();
+        lines.push("v 0 nan 0".into());
+        let e = parse_str(&(lines.join("\n") + "\n")).unwrap_err();
+        assert_eq!(
+            e.message,
+            format!(
+                "OBJ parse error at line {}: vertex {} is not finite: (0, NaN, 0) (line reads \
+                 \"v 0 nan 0\")",
+                n + 2,
+                n + 1
+            )
+        );
     }
 }

@@ -318,9 +318,10 @@ impl Face {
         if name != "vertex_indices" && name != "vertex_index" {
             return PropertyAccessResult::Ignored;
         }
+        // Into the list's own allocation where `T` is 4 bytes (int, uint: the common case).
         self.corners = list
-            .iter()
-            .map(|&i| {
+            .into_iter()
+            .map(|i| {
                 i.try_into()
                     .map_err(|_| format!("vertex index {i} is not a vertex"))
             })

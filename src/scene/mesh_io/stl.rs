@@ -19,8 +19,8 @@
 //!   bytes. The normal is not read (the winding gives the orientation). A loop of more than
 //!   three vertices is fan-triangulated and counted. Errors name the line.
 //!
-//! Every facet's corners are its own: 3·n positions, unwelded ([`super::weld_identical`] or the
-//! repair welds them). A non-finite corner is an error naming the vertex (its index among the
+//! Every facet's corners are its own: 3·n positions, unwelded (mesh repair welds them,
+//! [`crate::scene::repair`]). A non-finite corner is an error naming the vertex (its index among the
 //! positions) and its line or byte offset.
 
 use super::{non_finite_vertex, push_fan, MeshFormat, RawMesh};
