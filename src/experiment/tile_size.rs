@@ -17,6 +17,7 @@ use crate::methods::pw2002::frame_wedges;
 use crate::methods::pw_restructured::{
     render_li, Culling, Passes, PwRestructuredOptions, RestructuredSettings, WedgeTest,
 };
+use crate::methods::recorder::PassRecorder;
 use crate::options::OptionTable;
 use crate::scene::Scene;
 use plotters::coord::Shift;
@@ -109,13 +110,19 @@ pub fn sweep(scene: &Scene) -> Result<Vec<Row>, InputError> {
         for round in 0..TIMING_RUNS {
             for (v, s) in settings.iter().enumerate() {
                 let start = Instant::now();
-                let (_, stats) = render_li(&frame, &set, s);
+                let mut rec = PassRecorder::new(&frame, "pw-restructured");
+                render_li(&mut rec, &set, s);
                 times[v].push(start.elapsed().as_secs_f64());
                 if round > 0 {
                     continue;
                 }
+                // The passes after the scene pass.
+                let out = rec.finish(
+                    crate::visibility::Visibility::Gray(Vec::new()),
+                    Default::default(),
+                );
                 let mut c = crate::gpu::counters::Counters::default();
-                for p in &stats {
+                for p in &out.stats.passes[1..] {
                     c += p.counters;
                 }
                 rows.push(Row {

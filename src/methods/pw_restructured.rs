@@ -103,9 +103,7 @@ use crate::methods::hard_sv::CountMode;
 use crate::methods::output::BufferPlan;
 use crate::methods::recorder::PassRecorder;
 use crate::options::{option_names, option_table, OptionTable, OptionType};
-use crate::pass::PassStats;
 use crate::scene::LightShape;
-use std::time::Instant;
 
 /// Counting direction.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -493,24 +491,21 @@ fn raster_triangles(
     (rt, c)
 }
 
-/// Render the LI buffer of `pw-restructured` (tile-major); returns it with per-pass stats (the
-/// zmin/zmax reads of the culling tests in `hiz_read_bytes`). The penumbra fragment program
-/// runs in the frame's shader precision.
-pub fn render_li(
-    frame: &Frame,
-    set: &WedgeSet,
-    s: &RestructuredSettings,
-) -> (Vec<LiTile>, Vec<PassStats>) {
-    crate::with_shader_float!(frame.gpu.shader, T => render_li_with::<T>(frame, set, s))
+/// Render the LI buffer of `pw-restructured` (tile-major) on the recorder's frame; its passes
+/// and buffers go to `rec` (the zmin/zmax reads of the culling tests in `hiz_read_bytes`). The
+/// penumbra fragment program runs in the frame's shader precision.
+pub fn render_li(rec: &mut PassRecorder, set: &WedgeSet, s: &RestructuredSettings) -> Vec<LiTile> {
+    crate::with_shader_float!(rec.frame().gpu.shader, T => render_li_with::<T>(rec, set, s))
 }
 
 /// [`render_li`] with the penumbra fragment program in the precision `T` (module doc, "Shader
 /// precision").
 fn render_li_with<T: ShaderFloat>(
-    frame: &Frame,
+    rec: &mut PassRecorder,
     set: &WedgeSet,
     s: &RestructuredSettings,
-) -> (Vec<LiTile>, Vec<PassStats>) {
+) -> Vec<LiTile> {
+    let frame = rec.frame();
     let mut tris = Vec::new();
     if s.test == WedgeTest::ZFail {
         tris.extend(cap_triangles(set, &frame.proj));
@@ -543,49 +538,57 @@ fn render_li_with<T: ShaderFloat>(
         s: *s,
     };
     let tiling = &frame.tiling;
-    let mut tiles = alloc_tiles(tiling, |_, len| RTile {
-        li: LiTile::cleared(s.wedge.li, s.wedge.overflow, len).recording(frame.dump_buffers),
-        memo: (0, false, false),
+    let mut tiles = rec.allocate(li_buffer_plan(s.wedge.li), || {
+        alloc_tiles(tiling, |_, len| RTile {
+            li: LiTile::cleared(s.wedge.li, s.wedge.overflow, len).recording(frame.dump_buffers),
+            memo: (0, false, false),
+        })
     });
+    if s.culling != Culling::Off {
+        // The depth tiles' zmin and zmax (Paper II §4).
+        rec.uses_hiz_depth();
+    }
     frame.probe_record("clear", |tap, _| {
         tap.event().clear("li", Raw::Int(LI_CLEAR))
     });
-    let mut stats = Vec::new();
-    let mut timed = |name: &str, f: &mut dyn FnMut() -> Counters| {
-        let start = Instant::now();
-        let counters = f();
-        stats.push(PassStats {
-            name: name.into(),
-            wall_seconds: start.elapsed().as_secs_f64(),
-            runs: 1,
-            counters,
-        });
-    };
     match s.passes {
-        Passes::Single => timed("wedges-single-pass", &mut || {
-            let (rt, mut c) = raster_triangles(&ctx, |r, _| r.umbra || r.penumbra);
-            let probe = frame.probe_pass("wedges-single-pass");
-            c += li_pass::<T>(&ctx, &mut tiles, &rt, true, true, probe.as_ref());
-            c
+        Passes::Single => rec.pass("wedges-single-pass", |pass| {
+            let (rt, c) = raster_triangles(&ctx, |r, _| r.umbra || r.penumbra);
+            pass.count(c);
+            let probe = pass.probe();
+            pass.count(li_pass::<T>(
+                &ctx,
+                &mut tiles,
+                &rt,
+                true,
+                true,
+                probe.as_ref(),
+            ));
         }),
         Passes::Three => {
-            let mut stencil = alloc_tiles(tiling, |_, len| StencilTile::cleared(128, len));
+            let stencil_plan = BufferPlan {
+                name: "stencil".into(),
+                format: "S8 (offset 128)".into(),
+                bytes_per_sample: 1,
+            };
+            let mut stencil = rec.allocate(stencil_plan, || {
+                alloc_tiles(tiling, |_, len| StencilTile::cleared(128, len))
+            });
             frame.probe_record("clear", |tap, _| tap.event().clear("stencil", Raw::U8(128)));
             for (name, front) in [("umbra-stencil-front", true), ("umbra-stencil-back", false)] {
-                timed(name, &mut || {
-                    let (rt, mut c) =
-                        raster_triangles(&ctx, |r, t| r.umbra && t.front_facing == front);
-                    let probe = frame.probe_pass(name);
-                    c += stencil_pass(&ctx, &mut stencil, &rt, probe.as_ref());
-                    c
+                rec.pass(name, |pass| {
+                    let (rt, c) = raster_triangles(&ctx, |r, t| r.umbra && t.front_facing == front);
+                    pass.count(c);
+                    let probe = pass.probe();
+                    pass.count(stencil_pass(&ctx, &mut stencil, &rt, probe.as_ref()));
                 });
             }
-            timed("umbra-to-li", &mut || {
+            rec.pass("umbra-to-li", |pass| {
                 let mult = match s.test {
                     WedgeTest::ZPass => li_amount(1.0, s.wedge.lights),
                     WedgeTest::ZFail => -li_amount(1.0, s.wedge.lights),
                 };
-                let probe = frame.probe_pass("umbra-to-li");
+                let probe = pass.probe();
                 let mut c = Counters::default();
                 for (t, (tile, st)) in tiles.iter_mut().zip(&stencil).enumerate() {
                     let watched = probe.as_ref().filter(|p| p.watches_tile(t));
@@ -606,17 +609,24 @@ fn render_li_with<T: ShaderFloat>(
                         }
                     }
                 }
-                c
+                pass.count(c);
             });
-            timed("penumbra", &mut || {
-                let (rt, mut c) = raster_triangles(&ctx, |r, _| r.penumbra);
-                let probe = frame.probe_pass("penumbra");
-                c += li_pass::<T>(&ctx, &mut tiles, &rt, false, true, probe.as_ref());
-                c
+            rec.pass("penumbra", |pass| {
+                let (rt, c) = raster_triangles(&ctx, |r, _| r.penumbra);
+                pass.count(c);
+                let probe = pass.probe();
+                pass.count(li_pass::<T>(
+                    &ctx,
+                    &mut tiles,
+                    &rt,
+                    false,
+                    true,
+                    probe.as_ref(),
+                ));
             });
         }
     }
-    (tiles.into_iter().map(|t| t.li).collect(), stats)
+    tiles.into_iter().map(|t| t.li).collect()
 }
 
 /// One stencil pass of the three-pass umbra: DECR for front-facing, INCR for back-facing
@@ -693,22 +703,8 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         return super::light_average::run("pw-restructured", frame, |_, f| run(f));
     }
     let mut rec = PassRecorder::new(frame, "pw-restructured");
-    rec.uses(li_buffer_plan(s.wedge.li));
-    if s.culling != Culling::Off {
-        // The depth tiles' zmin and zmax (Paper II §4).
-        rec.uses_hiz_depth();
-    }
-    if s.passes == Passes::Three {
-        rec.uses(BufferPlan {
-            name: "stencil".into(),
-            format: "S8 (offset 128)".into(),
-            bytes_per_sample: 1,
-        });
-    }
     let set = frame_wedges(frame, &s.wedge)?;
-    // The passes time and count themselves ([`render_li`]), as the tests read them.
-    let (tiles, passes) = render_li(frame, &set, &s);
-    passes.into_iter().for_each(|p| rec.record_pass(p));
+    let tiles = render_li(&mut rec, &set, &s);
     let li = li_row_major(frame, &tiles);
     let (visibility, clamped) = resolve(frame, &li);
     rec.clamped(clamped.iter().filter(|&&c| c).count() as u64);

@@ -13,6 +13,7 @@
 
 use penumbra::frame::Frame;
 use penumbra::gpu::counters::Counters;
+use penumbra::methods::recorder::PassRecorder;
 use penumbra::methods::{self, output::MethodOutput, pw2002, pw_restructured};
 use penumbra::scene::procedural::box_mesh;
 use penumbra::scene::{builtin, LightShape, Scene};
@@ -324,8 +325,16 @@ fn pw_restructured_culls_tiles_only_with_culling_on() {
         let frame = Frame::render(scene, penumbra::render::gpu_settings(scene).unwrap()).unwrap();
         let (s, _) = pw_restructured::read_settings(&frame).unwrap();
         let set = pw2002::frame_wedges(&frame, &s.wedge).unwrap();
-        let (_, passes) = pw_restructured::render_li(&frame, &set, &s);
-        let bytes: u64 = passes.iter().map(|p| p.counters.hiz_read_bytes).sum();
+        let mut rec = PassRecorder::new(&frame, "pw-restructured");
+        pw_restructured::render_li(&mut rec, &set, &s);
+        let out = rec.finish(
+            penumbra::visibility::Visibility::Gray(vec![]),
+            Default::default(),
+        );
+        let bytes: u64 = out.stats.passes[1..]
+            .iter()
+            .map(|p| p.counters.hiz_read_bytes)
+            .sum();
         bytes / frame.gpu.depth.bytes()
     };
     let (reads_on, reads_off) = (tile_reads(&on), tile_reads(&off));

@@ -7,6 +7,7 @@ use penumbra::geometry::penumbra_wedge::li_amount;
 use penumbra::methods::light_average;
 use penumbra::methods::pw2002::{self, SidePlanes};
 use penumbra::methods::pw_restructured::{self, Culling, Passes, RestructuredSettings, WedgeTest};
+use penumbra::methods::recorder::PassRecorder;
 use penumbra::render::{render_scene, MethodRun};
 use penumbra::scene::OptionValue;
 use penumbra::scene::{builtin, Scene};
@@ -143,7 +144,8 @@ fn pw2002_and_restructured_agree_on_the_shared_li_buffer_of_two_lights() {
             passes,
             culling: Culling::ZminZmax,
         };
-        let (t, _) = pw_restructured::render_li(&frame, &set, &s);
+        let t =
+            pw_restructured::render_li(&mut PassRecorder::new(&frame, "pw-restructured"), &set, &s);
         let b = pw2002::li_row_major(&frame, &t);
         let diff: Vec<_> = (0..a.len())
             .filter(|&i| a[i] != b[i])

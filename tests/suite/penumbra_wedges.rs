@@ -26,7 +26,7 @@ fn li_pw2002(frame: &Frame, s: &WedgeSettings) -> Vec<i32> {
 
 fn li_restructured(frame: &Frame, s: &RestructuredSettings) -> Vec<i32> {
     let set = pw2002::frame_wedges(frame, &s.wedge).expect("wedges");
-    let (t, _) = pw_restructured::render_li(frame, &set, s);
+    let t = pw_restructured::render_li(&mut PassRecorder::new(frame, "pw-restructured"), &set, s);
     pw2002::li_row_major(frame, &t)
 }
 
@@ -131,6 +131,7 @@ fn pw2002_and_restructured_agree_bit_for_bit_with_the_eye_outside_shadow() {
 }
 
 use penumbra::gpu::li_buffer::{LiFormat, LiOverflow};
+use penumbra::methods::recorder::PassRecorder;
 use penumbra::scene::LightShape;
 
 fn mean_abs(a: &[f32], b: &[f32]) -> f64 {

@@ -216,7 +216,8 @@ fn repair_scene(obj: &Path, keys: &str, size: u32, methods: &str) -> PathBuf {
 }
 
 /// The light of [`repair_scene`]: a rectangle above the floor.
-const RECT_LIGHT: &str = "type = \"rect\"\ncenter = [0.5, 3.5, 0.3]\nu = [0.4, 0, 0]\nv = [0, 0, 0.4]";
+const RECT_LIGHT: &str =
+    "type = \"rect\"\ncenter = [0.5, 3.5, 0.3]\nu = [0.4, 0, 0]\nv = [0, 0, 0.4]";
 /// A sphere light where [`RECT_LIGHT`] is, for the methods of Papers I, II and Wyman & Hansen.
 const SPHERE_LIGHT: &str = "type = \"sphere\"\ncenter = [0.5, 3.5, 0.3]\nradius = 0.3";
 /// A disk light facing down where [`RECT_LIGHT`] is, for the D-buffer (CGI 2004).
@@ -357,7 +358,10 @@ fn a_mesh_with_a_hole_renders_with_every_method() {
         }
     }
     for m in penumbra::methods::names() {
-        assert!(seen.iter().any(|s| s == m), "{m} ran under none of the lights");
+        assert!(
+            seen.iter().any(|s| s == m),
+            "{m} ran under none of the lights"
+        );
     }
 }
 
