@@ -54,24 +54,9 @@ pub struct Pass<'f, 's> {
 }
 
 impl<'f, 's> Pass<'f, 's> {
-    /// The pass name.
-    pub fn name(&self) -> &str {
-        &self.name
-    }
-
     /// Add `c` to the pass's counters.
     pub fn count(&mut self, c: Counters) {
         self.counters += c;
-    }
-
-    /// The counters summed so far.
-    pub fn counters(&self) -> &Counters {
-        &self.counters
-    }
-
-    /// The mutable counters (for a body that counts in place).
-    pub fn counters_mut(&mut self) -> &mut Counters {
-        &mut self.counters
     }
 
     /// Record that the pass ran `runs` times in all (its counters and time are the sum over
@@ -82,24 +67,12 @@ impl<'f, 's> Pass<'f, 's> {
 
     /// The probe's view of this pass, when a probe is attached ([`crate::gpu::probe`]).
     pub fn probe(&self) -> Option<PassProbe<'f>> {
-        self.probe_named(&self.name)
-    }
-
-    /// The probe's view of a part of this pass recorded under its own name (e.g. the
-    /// front-face half of a two-pass stencil submission, `…/front-faces`).
-    pub fn probe_named(&self, name: &str) -> Option<PassProbe<'f>> {
-        self.frame.probe_pass(name)
+        self.frame.probe_pass(&self.name)
     }
 
     /// Record one event named `name` at the probed pixel ([`Frame::probe_record`]).
     pub fn record(&self, name: &str, event: impl FnOnce(Tap, usize) -> ProbeEvent) {
         self.frame.probe_record(name, event)
-    }
-
-    /// Whether the frame asks for every buffer the method resolved (`--dump-buffers`): a
-    /// pass then records its buffers' overflow events.
-    pub fn dumping(&self) -> bool {
-        self.frame.dump_buffers
     }
 
     /// Keep the buffer dump `make` builds, when the frame asks for dumps; `make` is not called
