@@ -14,6 +14,9 @@
 //!   lights), computed once per light shape and cached in the process and on disk
 //!   ([`texture_cache`]).
 //!
+//! - [`horizon`]: the part of a light in front of a receiver's own tangent plane (issue 28:
+//!   the *horizon receivers*, whose plane cuts the light).
+//!
 //! - [`radial_parts`]: the light split into four radial parts and the occluded area and
 //!   bounding rectangle of one edge per part (Forest et al. 2006 §3.1, §4.2, §4.3).
 //!
@@ -22,6 +25,7 @@
 
 pub mod coverage;
 pub mod coverage_texture;
+pub mod horizon;
 pub mod lookup_tables;
 pub mod radial_parts;
 pub mod sampling;
