@@ -10,20 +10,14 @@
 //!   depth pass and hierarchical Z);
 //! * `hard-sv/zpass`, `hard-sv/zfail`: one hard shadow-volume stencil pass from the light
 //!   center ([`stencil_shadow`]) against a frame rendered once up front;
-//! * `raycast-samples16`: the `raycast` reference with `samples = 16`;
-//! * `nsample-n16`: the `nsample` method with `n = 16` (16 stencil passes and their
-//!   accumulation);
-//! * `hard-sv`, `ssv-optimized`, `ssv`: the methods that take the rectangular light as it is;
-//! * `wedge-blending-8bit`, `wedge-blending-f32`: penumbra-wedges blending (Forest et al.
-//!   2006), packed (the default) and unpacked (`packing = "f32"`);
-//! * `pw2002`, `pw-restructured`, `penumbra-map`: the methods that take only sphere lights, on
-//!   the same occluders, camera and size with the rectangle swapped for a sphere of radius the
+//! * one function per method of [`penumbra::methods::ALL`], named after it: the method with
+//!   its defaults (but `raycast.samples = 16` and `nsample.n = 16`) on the first of these
+//!   frames whose light it supports — the scene's rectangle; a sphere of radius the
 //!   rectangle's half extent at the same center (for `cube-of-spheres` that is the built-in
-//!   `cube-of-spheres-sphere`);
-//! * `dbuffer`: the D-buffer (CGI 2004), which takes only disk lights, on the same occluders
-//!   under a disk of that radius at the same center facing straight down onto the floor (the
-//!   construction of the built-in disk scenes, `disk_down` in `src/scene/builtin.rs`). Every
-//!   method runs on every scene here; none refuses one.
+//!   `cube-of-spheres-sphere`); a disk of that radius at the same center facing straight down
+//!   onto the floor (the construction of the built-in disk scenes, `disk_down` in
+//!   `src/scene/builtin.rs`). A method added to the registry is benchmarked without editing
+//!   this file.
 //!
 //! `forest-spheres-256` also has `raycast-samples1024`: the reference with 1024 samples, the
 //! sample count the issue compares with 16 on that scene.
@@ -58,38 +52,10 @@ const SCENES: &[&str] = &["cube-of-spheres", "forest-spheres"];
 /// Image widths (and heights) in pixels.
 const SIZES: &[u32] = &[256, 512];
 
-/// How the frame of a benchmark is lit: the scene's rectangle, or its occluders under another
-/// light or with another option (index into the frames of [`variants`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Variant {
-    /// The scene as built in (rectangular light), `nsample.n = 16`, `raycast.samples = 16`.
-    Rect = 0,
-    /// [`Variant::Rect`] with `wedge-blending.packing = "f32"`.
-    RectUnpacked = 1,
-    /// The rectangle swapped for a sphere of radius its half extent, same center.
-    Sphere = 2,
-    /// The rectangle swapped for a downward-facing disk of radius its half extent.
-    Disk = 3,
-}
-
-/// Every method benchmark of a group: (function name, method, the frame it runs on).
-const METHOD_BENCHES: &[(&str, &str, Variant)] = &[
-    ("raycast-samples16", "raycast", Variant::Rect),
-    ("nsample-n16", "nsample", Variant::Rect),
-    ("hard-sv", "hard-sv", Variant::Rect),
-    ("pw2002", "pw2002", Variant::Sphere),
-    ("pw-restructured", "pw-restructured", Variant::Sphere),
-    ("ssv-optimized", "ssv-optimized", Variant::Rect),
-    ("ssv", "ssv", Variant::Rect),
-    ("wedge-blending-8bit", "wedge-blending", Variant::Rect),
-    (
-        "wedge-blending-f32",
-        "wedge-blending",
-        Variant::RectUnpacked,
-    ),
-    ("penumbra-map", "penumbra-map", Variant::Sphere),
-    ("dbuffer", "dbuffer", Variant::Disk),
-];
+/// The lights a method benchmark's frame can have, in the order a method's first supported
+/// one is chosen: the scene's rectangle, a sphere of radius its half extent at the same
+/// center, a downward-facing disk of that radius (the frames of [`variants`], in this order).
+const LIGHTS: [&str; 3] = ["rect", "sphere", "disk"];
 
 /// The scene and size whose group also times `raycast` at 1024 samples.
 const RAYCAST_1024_AT: (&str, u32) = ("forest-spheres", 256);
@@ -124,18 +90,10 @@ fn relit(scene: &Scene, shape: impl Fn(f32) -> LightShape) -> Scene {
     out
 }
 
-/// The scenes of [`Variant`], in its order, for the rect-lit `scene`.
+/// The scenes of [`LIGHTS`], in its order, for the rect-lit `scene`.
 fn variants(scene: &Scene) -> Vec<Scene> {
-    let mut unpacked = scene.clone();
-    set_option(
-        &mut unpacked,
-        "wedge-blending",
-        "packing",
-        OptionValue::Str("f32".into()),
-    );
     vec![
         scene.clone(),
-        unpacked,
         relit(scene, |radius| LightShape::Sphere { radius }),
         relit(scene, |radius| LightShape::Disk {
             radius,
@@ -151,17 +109,6 @@ fn stencil_settings(test: ShadowTest) -> StencilShadowSettings {
         test,
         overflow: StencilOverflow::Wrap,
         submission: Submission::TwoSided,
-    }
-}
-
-/// Checks that every method of [`penumbra::methods::ALL`] has a benchmark in
-/// [`METHOD_BENCHES`].
-fn check_every_method_timed() {
-    for method in penumbra::methods::names() {
-        assert!(
-            METHOD_BENCHES.iter().any(|(_, m, _)| *m == method),
-            "method {method} has no benchmark"
-        );
     }
 }
 
@@ -191,10 +138,13 @@ fn scene_at(c: &mut Criterion, name: &str, size: u32) {
             b.iter(|| stencil_shadow(black_box(&frame), black_box(center), &settings))
         });
     }
-    for &(id, method, variant) in METHOD_BENCHES {
-        let frame = &frames[variant as usize];
-        group.bench_function(id, |b| {
-            b.iter(|| penumbra::methods::run(black_box(method), black_box(frame)).expect(method))
+    // Every method of the registry, on the first frame whose light it supports.
+    for m in penumbra::methods::ALL {
+        let Some(frame) = frames.iter().find(|f| (m.supports)(&f.scene.light().shape)) else {
+            panic!("{} supports none of the lights {LIGHTS:?}", m.name);
+        };
+        group.bench_function(m.name, |b| {
+            b.iter(|| penumbra::methods::run(black_box(m.name), black_box(frame)).expect(m.name))
         });
     }
     if (name, size) == RAYCAST_1024_AT {
@@ -211,7 +161,6 @@ fn scene_at(c: &mut Criterion, name: &str, size: u32) {
 /// Registers every benchmark of this file: [`scene_at`] for every scene of [`SCENES`] at every
 /// size of [`SIZES`].
 fn pipeline(c: &mut Criterion) {
-    check_every_method_timed();
     for name in SCENES {
         for &size in SIZES {
             scene_at(c, name, size);

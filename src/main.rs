@@ -484,7 +484,7 @@ fn experiment(cmd: ExperimentCmd) -> Result<(), Box<dyn std::error::Error>> {
                 }
                 loaded.push(scene);
             }
-            let sweep = accuracy_time::run(&loaded, accuracy_time::CONFIGURATIONS, runs, shard)?;
+            let sweep = accuracy_time::run(&loaded, &accuracy_time::configurations(), runs, shard)?;
             accuracy_time::write(&sweep, &out)?;
             print!("{}", accuracy_time::summary(&sweep));
             print_accuracy_outputs(&sweep, &out);

@@ -1,5 +1,5 @@
 //! What accuracy costs in time (issue 14, item 4): `penumbra experiment accuracy-time SCENE...`
-//! renders every scene with every configuration of [`CONFIGURATIONS`] that applies to it,
+//! renders every scene with every configuration of [`configurations`] that applies to it,
 //! times each and measures its error against a high-sample reference, and draws error against
 //! time with the Pareto front. `penumbra experiment merge DIR...` joins the outputs of shards.
 //!
@@ -60,8 +60,10 @@ use std::time::Instant;
 /// table. Keys and values are written as `--opt METHOD.KEY=VALUE` takes them.
 pub type Configuration = (&'static str, &'static [(&'static str, &'static str)]);
 
-/// The configurations swept by default, in table order. Adding a method or a knob setting is
-/// one line. Every value is one the method's option reader accepts (tested):
+/// The configurations swept by default: every method of [`crate::methods::ALL`] in its
+/// order, each with its own list ([`crate::methods::Method::sweep`], declared in the method's
+/// module next to its goldens). Every value is one the method's option reader accepts
+/// (tested):
 /// - `hard-sv`, `penumbra-map`: their defaults;
 /// - `nsample`: N = 4 … 1024 light samples; `raycast`: 4 … 256 samples per pixel — the
 ///   sampling baselines a user would otherwise pick;
@@ -76,144 +78,12 @@ pub type Configuration = (&'static str, &'static [(&'static str, &'static str)])
 /// - `penumbra-map`: its defaults (the 8-bit map, the p-buffer of its time) and an f32 map;
 /// - `dbuffer`: its defaults (smoothstep, f32 channels, interpolated distances, the corrected
 ///   eq. 3), √t, f16 channels, exact distances and eq. 3 as printed.
-pub const CONFIGURATIONS: &[Configuration] = &[
-    ("hard-sv", &[]),
-    ("nsample", &[("n", "4")]),
-    ("nsample", &[("n", "16")]),
-    ("nsample", &[("n", "64")]),
-    ("nsample", &[("n", "256")]),
-    ("nsample", &[("n", "1024")]),
-    ("raycast", &[("samples", "4")]),
-    ("raycast", &[("samples", "16")]),
-    ("raycast", &[("samples", "64")]),
-    ("raycast", &[("samples", "256")]),
-    ("pw2002", &[("li", "16")]),
-    ("pw2002", &[("li", "12")]),
-    ("pw2002", &[("li", "8")]),
-    ("pw-restructured", &[("li", "16")]),
-    ("pw-restructured", &[("li", "12")]),
-    ("pw-restructured", &[("li", "8")]),
-    ("ssv", &[("coverage", "exact"), ("vbuffer", "f32")]),
-    ("ssv", &[("coverage", "exact"), ("vbuffer", "f16")]),
-    ("ssv", &[("coverage", "exact"), ("vbuffer", "8bit")]),
-    (
-        "ssv",
-        &[
-            ("coverage", "texture"),
-            ("texture-n", "8"),
-            ("filter", "nearest"),
-        ],
-    ),
-    (
-        "ssv",
-        &[
-            ("coverage", "texture"),
-            ("texture-n", "16"),
-            ("filter", "nearest"),
-        ],
-    ),
-    (
-        "ssv",
-        &[
-            ("coverage", "texture"),
-            ("texture-n", "32"),
-            ("filter", "nearest"),
-        ],
-    ),
-    (
-        "ssv",
-        &[
-            ("coverage", "texture"),
-            ("texture-n", "64"),
-            ("filter", "nearest"),
-        ],
-    ),
-    (
-        "ssv",
-        &[
-            ("coverage", "texture"),
-            ("texture-n", "8"),
-            ("filter", "bilinear"),
-        ],
-    ),
-    (
-        "ssv",
-        &[
-            ("coverage", "texture"),
-            ("texture-n", "16"),
-            ("filter", "bilinear"),
-        ],
-    ),
-    (
-        "ssv",
-        &[
-            ("coverage", "texture"),
-            ("texture-n", "32"),
-            ("filter", "bilinear"),
-        ],
-    ),
-    (
-        "ssv",
-        &[
-            ("coverage", "texture"),
-            ("texture-n", "64"),
-            ("filter", "bilinear"),
-        ],
-    ),
-    (
-        "ssv",
-        &[
-            ("coverage", "texture"),
-            ("texture-n", "8"),
-            ("filter", "quadrilinear"),
-        ],
-    ),
-    (
-        "ssv",
-        &[
-            ("coverage", "texture"),
-            ("texture-n", "16"),
-            ("filter", "quadrilinear"),
-        ],
-    ),
-    (
-        "ssv",
-        &[
-            ("coverage", "texture"),
-            ("texture-n", "32"),
-            ("filter", "quadrilinear"),
-        ],
-    ),
-    (
-        "ssv",
-        &[
-            ("coverage", "texture"),
-            ("texture-n", "64"),
-            ("filter", "quadrilinear"),
-        ],
-    ),
-    ("ssv-optimized", &[]),
-    ("ssv-optimized", &[("filter", "nearest")]),
-    ("ssv-optimized", &[("coverage", "exact")]),
-    ("ssv-optimized", &[("light-split", "2")]),
-    ("ssv-optimized", &[("light-split", "3")]),
-    ("ssv-optimized", &[("light-split", "4")]),
-    ("ssv-optimized", &[("overlap", "loops")]),
-    ("wedge-blending", &[]),
-    ("wedge-blending", &[("packing", "f32")]),
-    ("wedge-blending", &[("centroid", "on")]),
-    ("wedge-blending", &[("packing", "f32"), ("centroid", "on")]),
-    ("wedge-blending", &[("adjust", "always")]),
-    ("wedge-blending", &[("adjust", "never")]),
-    ("wedge-blending", &[("silhouettes", "meshes")]),
-    ("penumbra-map", &[]),
-    ("penumbra-map", &[("storage", "f32")]),
-    ("dbuffer", &[]),
-    ("dbuffer", &[("falloff", "sqrt")]),
-    ("dbuffer", &[("storage", "f16")]),
-    ("dbuffer", &[("distances", "exact")]),
-    ("dbuffer", &[("eq3", "printed")]),
-];
+pub fn configurations() -> Vec<Configuration> {
+    crate::methods::ALL
+        .iter()
+        .flat_map(|m| m.sweep.iter().map(|knobs| (m.name, *knobs)))
+        .collect()
+}
 
 /// The reference every configuration is measured against: `raycast` with 1024 jittered
 /// stratified samples per pixel (and the scene's other `raycast` options, e.g. its seed).

@@ -970,6 +970,35 @@ fn screen_pass<T: ShaderFloat>(
     (Visibility::Gray(values), shades, stats, counters)
 }
 
+/// `dbuffer`'s pinned golden renders ([`crate::methods::Method::goldens`]).
+const GOLDENS: &[crate::methods::Golden] = &[
+    // dbuffer (CGI 2004) on every disk-light built-in.
+    crate::methods::Golden::new("disk-block"),
+    crate::methods::Golden::new("disk-slab"),
+    crate::methods::Golden::new("disk-small-sphere"),
+    crate::methods::Golden::new("disk-acute"),
+    crate::methods::Golden::new("disk-torus"),
+    crate::methods::Golden::new("scenes/real/spot-disk.toml"),
+    crate::methods::Golden::variant("disk-block", "shader-fp24", &[]).gpu(&[("shader", "fp24")]),
+    crate::methods::Golden::variant("disk-block", "shader-fp16", &[]).gpu(&[("shader", "fp16")]),
+    // dbuffer (CGI 2004): the falloff of §6.2, f16 distance channels, eq. 3 as printed.
+    crate::methods::Golden::variant("disk-block", "sqrt", &[("falloff", "sqrt")]),
+    crate::methods::Golden::variant("disk-block", "f16", &[("storage", "f16")]),
+    crate::methods::Golden::variant("disk-block", "printed", &[("eq3", "printed")]),
+    crate::methods::Golden::variant("disk-small-sphere", "sqrt", &[("falloff", "sqrt")]),
+    crate::methods::Golden::variant("disk-small-sphere", "f16", &[("storage", "f16")]),
+    crate::methods::Golden::variant("disk-small-sphere", "printed", &[("eq3", "printed")]),
+];
+
+/// `dbuffer`'s configurations in the accuracy–time sweep ([`crate::methods::Method::sweep`]).
+const SWEEP: &[crate::methods::OptionPairs] = &[
+    &[],
+    &[("falloff", "sqrt")],
+    &[("storage", "f16")],
+    &[("distances", "exact")],
+    &[("eq3", "printed")],
+];
+
 /// `dbuffer` in the registry ([`crate::methods::ALL`]).
 pub const METHOD: crate::methods::Method = crate::methods::Method {
     name: "dbuffer",
@@ -984,6 +1013,8 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     sums_per_silhouette_edge: false,
     check: |frame| read_settings(frame).map(drop),
     run,
+    goldens: GOLDENS,
+    sweep: SWEEP,
 };
 
 /// Run `dbuffer` on a rendered frame (one light: [`super::run`] averages several).

@@ -300,6 +300,41 @@ pub fn stencil_dump(
     }
 }
 
+/// `hard-sv`'s pinned golden renders ([`crate::methods::Method::goldens`]).
+const GOLDENS: &[crate::methods::Golden] = &[
+    crate::methods::Golden::new("cube-of-spheres"),
+    crate::methods::Golden::new("single-quad"),
+    crate::methods::Golden::new("cylinder"),
+    crate::methods::Golden::new("eye-in-shadow"),
+    crate::methods::Golden::new("two-lights"),
+    // Real models (scenes/models/README): the open hand, closed by repair on load (one hole
+    // capped); Bob, genus 1 (a hole loop for the wedge methods); the scorpion's thin legs
+    // under a sphere light; Spot under a disk light.
+    crate::methods::Golden::new("scenes/real/hand.toml"),
+    crate::methods::Golden::new("scenes/real/bob.toml"),
+    crate::methods::Golden::new("scenes/real/scorpion.toml"),
+    // hard-sv: stencil overflow and submission order where 300 volumes overlap.
+    crate::methods::Golden::new("overlap-stress").sized(32),
+    crate::methods::Golden::variant("overlap-stress", "saturate", &[("stencil", "saturate")])
+        .sized(32),
+    crate::methods::Golden::variant(
+        "overlap-stress",
+        "saturate-two-pass",
+        &[("stencil", "saturate"), ("submission", "two-pass")],
+    )
+    .sized(32),
+    // Pipeline settings: depth formats and tile sizes (the output must not depend on the tile
+    // size; these goldens equal the default ones where it does not).
+    crate::methods::Golden::variant("cube-of-spheres", "d32f", &[]).gpu(&[("depth", "d32f")]),
+    crate::methods::Golden::variant("cube-of-spheres", "d16", &[]).gpu(&[("depth", "d16")]),
+    // HiZ tiles finer than the raster tile: the image of the default golden, other counters.
+    crate::methods::Golden::variant("cube-of-spheres", "tile16-hiz4", &[])
+        .gpu(&[("tile-size", "16"), ("hiz-tile-size", "4")]),
+];
+
+/// `hard-sv`'s configurations in the accuracy–time sweep ([`crate::methods::Method::sweep`]).
+const SWEEP: &[crate::methods::OptionPairs] = &[&[]];
+
 /// `hard-sv` in the registry ([`crate::methods::ALL`]).
 pub const METHOD: crate::methods::Method = crate::methods::Method {
     name: "hard-sv",
@@ -313,6 +348,8 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     sums_per_silhouette_edge: false,
     check: |frame| HardSvOptions::read(frame.scene).map(drop),
     run,
+    goldens: GOLDENS,
+    sweep: SWEEP,
 };
 
 /// Run `hard-sv` on a rendered frame.

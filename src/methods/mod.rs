@@ -78,6 +78,13 @@ pub struct Method {
     /// Run it on a rendered frame: of one light, or of every light with
     /// [`SeveralLights::OnePass`].
     pub run: fn(&Frame) -> Result<MethodOutput, InputError>,
+    /// Its pinned golden renders ([`crate::golden::cases`]): the foundation scenes it renders
+    /// with its defaults (explicit, so that a method that stops supporting one fails instead
+    /// of disappearing), then the knobs that change what it computes.
+    pub goldens: &'static [Golden],
+    /// Its configurations in the accuracy–time sweep
+    /// ([`crate::experiment::accuracy_time::configurations`]).
+    pub sweep: &'static [OptionPairs],
 }
 
 impl std::fmt::Debug for Method {
@@ -89,6 +96,63 @@ impl std::fmt::Debug for Method {
 impl PartialEq for Method {
     fn eq(&self, other: &Self) -> bool {
         self.name == other.name
+    }
+}
+
+/// Options as `(key, value)` pairs, values written as on the command line (`--opt
+/// METHOD.KEY=VALUE`).
+pub type OptionPairs = &'static [(&'static str, &'static str)];
+
+/// The default golden image side (`docs/architecture.md` "Goldens are rendered small").
+pub const GOLDEN_SIZE: u32 = 64;
+
+/// One pinned golden render of a method ([`Method::goldens`], [`crate::golden::cases`]): a
+/// scene (a built-in name, or a scene file under the crate root), a small size, and the
+/// options that differ from the defaults. Its goldens live in `golden/<scene>/<method>` for
+/// the defaults, `golden/<scene>/<method>-<variant>` otherwise.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Golden {
+    /// A built-in scene name, or a scene file path relative to the crate root.
+    pub scene: &'static str,
+    /// Width and height in pixels.
+    pub size: u32,
+    /// Empty for the method's defaults, else the suffix of its golden directory.
+    pub variant: &'static str,
+    /// The method's options.
+    pub options: OptionPairs,
+    /// `[options.gpu]`.
+    pub gpu: OptionPairs,
+}
+
+impl Golden {
+    /// The method's defaults on `scene` at [`GOLDEN_SIZE`].
+    pub const fn new(scene: &'static str) -> Self {
+        Golden {
+            scene,
+            size: GOLDEN_SIZE,
+            variant: "",
+            options: &[],
+            gpu: &[],
+        }
+    }
+
+    /// The method with `options` on `scene`, in the golden directory suffixed `variant`.
+    pub const fn variant(scene: &'static str, variant: &'static str, options: OptionPairs) -> Self {
+        Golden {
+            variant,
+            options,
+            ..Golden::new(scene)
+        }
+    }
+
+    /// At `size`×`size`.
+    pub const fn sized(self, size: u32) -> Self {
+        Golden { size, ..self }
+    }
+
+    /// With `[options.gpu]` set to `gpu`.
+    pub const fn gpu(self, gpu: OptionPairs) -> Self {
+        Golden { gpu, ..self }
     }
 }
 

@@ -92,6 +92,26 @@ pub fn options(
     Ok((samples, settings, o.shadow.mode))
 }
 
+/// `nsample`'s pinned golden renders ([`crate::methods::Method::goldens`]).
+const GOLDENS: &[crate::methods::Golden] = &[
+    crate::methods::Golden::new("cube-of-spheres"),
+    crate::methods::Golden::new("single-quad"),
+    crate::methods::Golden::new("cylinder"),
+    crate::methods::Golden::new("eye-in-shadow"),
+    crate::methods::Golden::new("two-lights"),
+    // The references' options.
+    crate::methods::Golden::variant("single-quad", "n16", &[("n", "16")]),
+];
+
+/// `nsample`'s configurations in the accuracy–time sweep ([`crate::methods::Method::sweep`]).
+const SWEEP: &[crate::methods::OptionPairs] = &[
+    &[("n", "4")],
+    &[("n", "16")],
+    &[("n", "64")],
+    &[("n", "256")],
+    &[("n", "1024")],
+];
+
 /// `nsample` in the registry ([`crate::methods::ALL`]).
 pub const METHOD: crate::methods::Method = crate::methods::Method {
     name: "nsample",
@@ -108,6 +128,8 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     sums_per_silhouette_edge: false,
     check: |frame| options(frame).map(drop),
     run,
+    goldens: GOLDENS,
+    sweep: SWEEP,
 };
 
 /// Run `nsample` on a rendered frame.

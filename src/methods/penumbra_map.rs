@@ -723,6 +723,47 @@ fn color_raw(tile: &ColorTile, i: usize) -> Raw {
     }
 }
 
+/// `penumbra-map`'s pinned golden renders ([`crate::methods::Method::goldens`]).
+const GOLDENS: &[crate::methods::Golden] = &[
+    crate::methods::Golden::new("cylinder"),
+    crate::methods::Golden::new("two-lights"),
+    crate::methods::Golden::new("cube-of-spheres-sphere"),
+    crate::methods::Golden::new("pw-columns"),
+    crate::methods::Golden::new("pw-fractal"),
+    crate::methods::Golden::new("pw-2002"),
+    crate::methods::Golden::new("scenes/real/scorpion.toml"),
+    // penumbra-map's pass-2 program (Z′ conversions, I, falloff) and dbuffer's screen program
+    // (|cx|, t, V) in fp24 and fp16.
+    crate::methods::Golden::variant("cube-of-spheres-sphere", "shader-fp24", &[])
+        .gpu(&[("shader", "fp24")]),
+    crate::methods::Golden::variant("cube-of-spheres-sphere", "shader-fp16", &[])
+        .gpu(&[("shader", "fp16")]),
+    // penumbra-map (Wyman & Hansen 2003): map sizes and storage formats.
+    crate::methods::Golden::variant(
+        "pw-columns",
+        "map32-unorm8",
+        &[("map-size", "32"), ("storage", "unorm8")],
+    ),
+    crate::methods::Golden::variant(
+        "pw-columns",
+        "map32-f32",
+        &[("map-size", "32"), ("storage", "f32")],
+    ),
+    crate::methods::Golden::variant(
+        "pw-columns",
+        "map128-unorm8",
+        &[("map-size", "128"), ("storage", "unorm8")],
+    ),
+    crate::methods::Golden::variant(
+        "pw-columns",
+        "map128-f32",
+        &[("map-size", "128"), ("storage", "f32")],
+    ),
+];
+
+/// `penumbra-map`'s configurations in the accuracy–time sweep ([`crate::methods::Method::sweep`]).
+const SWEEP: &[crate::methods::OptionPairs] = &[&[], &[("storage", "f32")]];
+
 /// `penumbra-map` in the registry ([`crate::methods::ALL`]).
 pub const METHOD: crate::methods::Method = crate::methods::Method {
     name: "penumbra-map",
@@ -737,6 +778,8 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     sums_per_silhouette_edge: false,
     check: |frame| read_settings(frame).map(drop),
     run,
+    goldens: GOLDENS,
+    sweep: SWEEP,
 };
 
 /// Run `penumbra-map` on a rendered frame (one light: [`super::run`] averages several).

@@ -470,6 +470,37 @@ pub fn options(frame: &Frame) -> Result<WedgeSettings, InputError> {
     })
 }
 
+/// `pw2002`'s pinned golden renders ([`crate::methods::Method::goldens`]).
+const GOLDENS: &[crate::methods::Golden] = &[
+    crate::methods::Golden::new("cylinder"),
+    crate::methods::Golden::new("two-lights"),
+    crate::methods::Golden::new("cube-of-spheres-sphere"),
+    crate::methods::Golden::new("pw-columns"),
+    crate::methods::Golden::new("pw-fractal"),
+    crate::methods::Golden::new("pw-2002"),
+    crate::methods::Golden::new("scenes/real/scorpion.toml"),
+    // pw2002 / pw-restructured: LI formats and overflow, falloff, corner wedges, the parallel
+    // rule, side planes, several lights, three passes, culling, z-fail with the eye in shadow.
+    crate::methods::Golden::variant("pw-2002", "li12", &[("li", "12")]),
+    crate::methods::Golden::variant("pw-2002", "li8", &[("li", "8")]),
+    crate::methods::Golden::variant("pw-2002", "saturate", &[("overflow", "saturate")]),
+    crate::methods::Golden::variant("pw-2002", "smoothstep", &[("falloff", "smoothstep")]),
+    crate::methods::Golden::variant("pw-columns", "no-corners", &[("corner-wedges", "off")]),
+    crate::methods::Golden::variant("cylinder", "no-parallel-rule", &[("parallel-rule", "off")]),
+    crate::methods::Golden::variant("pw-columns", "cancel", &[("side-planes", "cancel")]),
+    crate::methods::Golden::variant("two-lights", "separate", &[("lights", "separate")]),
+    crate::methods::Golden::new("scenes/hard/eye-in-shadow-sphere.toml"),
+    // pw2002's (Paper I, a sphere light) and ssv-optimized's (Paper IV) fragment programs in
+    // fp24 and fp16, and ssv-optimized's 16-bit float position buffer (Paper IV §4.2).
+    crate::methods::Golden::variant("cube-of-spheres-sphere", "shader-fp24", &[])
+        .gpu(&[("shader", "fp24")]),
+    crate::methods::Golden::variant("cube-of-spheres-sphere", "shader-fp16", &[])
+        .gpu(&[("shader", "fp16")]),
+];
+
+/// `pw2002`'s configurations in the accuracy–time sweep ([`crate::methods::Method::sweep`]).
+const SWEEP: &[crate::methods::OptionPairs] = &[&[("li", "16")], &[("li", "12")], &[("li", "8")]];
+
 /// `pw2002` in the registry ([`crate::methods::ALL`]).
 pub const METHOD: crate::methods::Method = crate::methods::Method {
     name: "pw2002",
@@ -483,6 +514,8 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     sums_per_silhouette_edge: true,
     check: |frame| options(frame).map(drop),
     run,
+    goldens: GOLDENS,
+    sweep: SWEEP,
 };
 
 /// Run `pw2002` on a rendered frame.

@@ -681,6 +681,24 @@ fn stencil_pass(
     )
 }
 
+/// `pw-restructured`'s pinned golden renders ([`crate::methods::Method::goldens`]).
+const GOLDENS: &[crate::methods::Golden] = &[
+    crate::methods::Golden::new("cylinder"),
+    crate::methods::Golden::new("two-lights"),
+    crate::methods::Golden::new("cube-of-spheres-sphere"),
+    crate::methods::Golden::new("pw-columns"),
+    crate::methods::Golden::new("pw-fractal"),
+    crate::methods::Golden::new("pw-2002"),
+    crate::methods::Golden::new("scenes/real/scorpion.toml"),
+    crate::methods::Golden::variant("pw-2002", "three", &[("passes", "three")]),
+    crate::methods::Golden::variant("pw-columns", "zmax", &[("culling", "zmax")]),
+    crate::methods::Golden::variant("pw-columns", "no-culling", &[("culling", "off")]),
+    crate::methods::Golden::new("scenes/hard/eye-in-shadow-sphere.toml"),
+];
+
+/// `pw-restructured`'s configurations in the accuracy–time sweep ([`crate::methods::Method::sweep`]).
+const SWEEP: &[crate::methods::OptionPairs] = &[&[("li", "16")], &[("li", "12")], &[("li", "8")]];
+
 /// `pw-restructured` in the registry ([`crate::methods::ALL`]).
 pub const METHOD: crate::methods::Method = crate::methods::Method {
     name: "pw-restructured",
@@ -694,6 +712,8 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     sums_per_silhouette_edge: true,
     check: |frame| read_settings(frame).map(drop),
     run,
+    goldens: GOLDENS,
+    sweep: SWEEP,
 };
 
 /// Run `pw-restructured` on a rendered frame.

@@ -986,6 +986,26 @@ pub fn raycast_visibility(
     }
 }
 
+/// `raycast`'s pinned golden renders ([`crate::methods::Method::goldens`]).
+const GOLDENS: &[crate::methods::Golden] = &[
+    crate::methods::Golden::new("cube-of-spheres"),
+    crate::methods::Golden::new("single-quad"),
+    crate::methods::Golden::new("cylinder"),
+    crate::methods::Golden::new("eye-in-shadow"),
+    crate::methods::Golden::new("two-lights"),
+    crate::methods::Golden::new("scenes/fire.toml").sized(32),
+    crate::methods::Golden::new("scenes/hard/eye-in-shadow-sphere.toml"),
+    crate::methods::Golden::variant("single-quad", "primary-ray", &[("receiver", "primary-ray")]),
+];
+
+/// `raycast`'s configurations in the accuracy–time sweep ([`crate::methods::Method::sweep`]).
+const SWEEP: &[crate::methods::OptionPairs] = &[
+    &[("samples", "4")],
+    &[("samples", "16")],
+    &[("samples", "64")],
+    &[("samples", "256")],
+];
+
 /// `raycast` in the registry ([`super::ALL`]).
 pub const METHOD: super::Method = super::Method {
     name: "raycast",
@@ -999,6 +1019,8 @@ pub const METHOD: super::Method = super::Method {
     sums_per_silhouette_edge: false,
     check: |frame| raycast_options(frame.scene).map(drop),
     run,
+    goldens: GOLDENS,
+    sweep: SWEEP,
 };
 
 /// `raycast` (the ground truth by definition): per pixel, the fraction of the light visible

@@ -750,6 +750,109 @@ fn hard_quads_pass<V: VBufferTile>(frame: &Frame, test: ShadowTest, vbuf: &mut [
     counters
 }
 
+/// `ssv`'s pinned golden renders ([`crate::methods::Method::goldens`]).
+const GOLDENS: &[crate::methods::Golden] = &[
+    crate::methods::Golden::new("cube-of-spheres"),
+    crate::methods::Golden::new("single-quad"),
+    crate::methods::Golden::new("cylinder"),
+    crate::methods::Golden::new("eye-in-shadow"),
+    crate::methods::Golden::new("two-lights"),
+    crate::methods::Golden::new("scenes/real/hand.toml"),
+    crate::methods::Golden::new("scenes/real/bob.toml"),
+    crate::methods::Golden::new("scenes/real/scorpion.toml"),
+    // ssv: coverage texture and filters, V-buffer formats, z-fail, a textured light.
+    crate::methods::Golden::variant("single-quad", "texture-nearest", &[("coverage", "texture")]),
+    crate::methods::Golden::variant(
+        "single-quad",
+        "texture-bilinear",
+        &[("coverage", "texture"), ("filter", "bilinear")],
+    ),
+    crate::methods::Golden::variant(
+        "single-quad",
+        "texture-quadrilinear",
+        &[("coverage", "texture"), ("filter", "quadrilinear")],
+    ),
+    crate::methods::Golden::variant("cube-of-spheres", "f16", &[("vbuffer", "f16")]),
+    crate::methods::Golden::variant("cube-of-spheres", "8bit", &[("vbuffer", "8bit")]),
+    crate::methods::Golden::variant("single-quad", "zfail", &[("mode", "zfail")]),
+    crate::methods::Golden::new("scenes/fire.toml").sized(32),
+    crate::methods::Golden::variant("cube-of-spheres", "d32f", &[]).gpu(&[("depth", "d32f")]),
+    crate::methods::Golden::variant("cube-of-spheres", "tile16", &[]).gpu(&[("tile-size", "16")]),
+    crate::methods::Golden::variant("cube-of-spheres", "tile2", &[]).gpu(&[("tile-size", "2")]),
+    // Shader precision (issue 11): ssv's fragment program in ATI R300 fp24 and in fp16.
+    crate::methods::Golden::variant("cube-of-spheres", "shader-fp24", &[])
+        .gpu(&[("shader", "fp24")]),
+    crate::methods::Golden::variant("cube-of-spheres", "shader-fp16", &[])
+        .gpu(&[("shader", "fp16")]),
+];
+
+/// `ssv`'s configurations in the accuracy–time sweep ([`crate::methods::Method::sweep`]).
+const SWEEP: &[crate::methods::OptionPairs] = &[
+    &[("coverage", "exact"), ("vbuffer", "f32")],
+    &[("coverage", "exact"), ("vbuffer", "f16")],
+    &[("coverage", "exact"), ("vbuffer", "8bit")],
+    &[
+        ("coverage", "texture"),
+        ("texture-n", "8"),
+        ("filter", "nearest"),
+    ],
+    &[
+        ("coverage", "texture"),
+        ("texture-n", "16"),
+        ("filter", "nearest"),
+    ],
+    &[
+        ("coverage", "texture"),
+        ("texture-n", "32"),
+        ("filter", "nearest"),
+    ],
+    &[
+        ("coverage", "texture"),
+        ("texture-n", "64"),
+        ("filter", "nearest"),
+    ],
+    &[
+        ("coverage", "texture"),
+        ("texture-n", "8"),
+        ("filter", "bilinear"),
+    ],
+    &[
+        ("coverage", "texture"),
+        ("texture-n", "16"),
+        ("filter", "bilinear"),
+    ],
+    &[
+        ("coverage", "texture"),
+        ("texture-n", "32"),
+        ("filter", "bilinear"),
+    ],
+    &[
+        ("coverage", "texture"),
+        ("texture-n", "64"),
+        ("filter", "bilinear"),
+    ],
+    &[
+        ("coverage", "texture"),
+        ("texture-n", "8"),
+        ("filter", "quadrilinear"),
+    ],
+    &[
+        ("coverage", "texture"),
+        ("texture-n", "16"),
+        ("filter", "quadrilinear"),
+    ],
+    &[
+        ("coverage", "texture"),
+        ("texture-n", "32"),
+        ("filter", "quadrilinear"),
+    ],
+    &[
+        ("coverage", "texture"),
+        ("texture-n", "64"),
+        ("filter", "quadrilinear"),
+    ],
+];
+
 /// `ssv` in the registry ([`crate::methods::ALL`]).
 pub const METHOD: crate::methods::Method = crate::methods::Method {
     name: "ssv",
@@ -768,6 +871,8 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     sums_per_silhouette_edge: true,
     check: |frame| read_settings(frame).map(drop),
     run,
+    goldens: GOLDENS,
+    sweep: SWEEP,
 };
 
 /// Run `ssv` on a rendered frame.

@@ -1058,6 +1058,46 @@ pub fn overlap_combine(a: f32, b: f32) -> f32 {
     a.max(b) + 0.5 * a.min(b)
 }
 
+/// `ssv-optimized`'s pinned golden renders ([`crate::methods::Method::goldens`]).
+const GOLDENS: &[crate::methods::Golden] = &[
+    crate::methods::Golden::new("cube-of-spheres"),
+    crate::methods::Golden::new("single-quad"),
+    crate::methods::Golden::new("cylinder"),
+    crate::methods::Golden::new("eye-in-shadow"),
+    crate::methods::Golden::new("two-lights"),
+    crate::methods::Golden::new("scenes/real/hand.toml"),
+    crate::methods::Golden::new("scenes/real/bob.toml"),
+    // ssv-optimized: overlap approximation, light split, plane split, exact coverage, filter,
+    // bounding-sphere wedges, a sphere's tight wedges over squares.
+    crate::methods::Golden::variant("cube-of-spheres", "overlap", &[("overlap", "loops")]),
+    crate::methods::Golden::variant("single-quad", "split2", &[("light-split", "2")]),
+    crate::methods::Golden::variant("single-quad", "plane", &[("split", "plane")]),
+    crate::methods::Golden::variant("cube-of-spheres", "exact", &[("coverage", "exact")]),
+    crate::methods::Golden::variant("cube-of-spheres", "nearest", &[("filter", "nearest")]),
+    crate::methods::Golden::variant(
+        "cylinder",
+        "bounding-sphere",
+        &[("wedge", "bounding-sphere")],
+    ),
+    crate::methods::Golden::variant("cylinder", "sides4", &[("sphere-sides", "4")]),
+    crate::methods::Golden::variant("cube-of-spheres", "shader-fp24", &[])
+        .gpu(&[("shader", "fp24")]),
+    crate::methods::Golden::variant("cube-of-spheres", "shader-fp16", &[])
+        .gpu(&[("shader", "fp16")]),
+    crate::methods::Golden::variant("cube-of-spheres", "position-f16", &[("position", "f16")]),
+];
+
+/// `ssv-optimized`'s configurations in the accuracy–time sweep ([`crate::methods::Method::sweep`]).
+const SWEEP: &[crate::methods::OptionPairs] = &[
+    &[],
+    &[("filter", "nearest")],
+    &[("coverage", "exact")],
+    &[("light-split", "2")],
+    &[("light-split", "3")],
+    &[("light-split", "4")],
+    &[("overlap", "loops")],
+];
+
 /// `ssv-optimized` in the registry ([`crate::methods::ALL`]).
 pub const METHOD: crate::methods::Method = crate::methods::Method {
     name: "ssv-optimized",
@@ -1071,6 +1111,8 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     sums_per_silhouette_edge: true,
     check: |frame| options(frame).map(drop),
     run,
+    goldens: GOLDENS,
+    sweep: SWEEP,
 };
 
 /// Run `ssv-optimized` on a rendered frame.

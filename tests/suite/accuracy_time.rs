@@ -4,9 +4,7 @@
 //! command line. Small frames (32² and 48²), short configuration lists and one timed run:
 //! timing decides nothing here.
 
-use penumbra::experiment::accuracy_time::{
-    self, merge, pareto_front, Configuration, Shard, Sweep, CONFIGURATIONS,
-};
+use penumbra::experiment::accuracy_time::{self, merge, pareto_front, Configuration, Shard, Sweep};
 use penumbra::experiment::{configured, sized};
 use penumbra::frame::Frame;
 use penumbra::scene::{builtin, Scene};
@@ -231,7 +229,7 @@ fn every_default_configuration_is_accepted_somewhere() {
         .iter()
         .map(|s| Frame::render(s, penumbra::render::gpu_settings(s).unwrap()).unwrap())
         .collect();
-    for &(method, knobs) in CONFIGURATIONS {
+    for (method, knobs) in accuracy_time::configurations() {
         let accepted: Vec<bool> = scenes
             .iter()
             .zip(&frames)

@@ -354,6 +354,67 @@ fn a_hole_loop_needs_signed_storage_or_one_silhouette_per_mesh() {
     assert!(dark > 20, "{dark} lit hole pixels went dark");
 }
 
+/// The hole is detected at run time (issue 28): the packed default warns, naming the mesh, the
+/// loop count and the remedies; the unpacked storage and one silhouette per mesh hold the hole
+/// and do not warn; a scene of convex occluders has no hole loop and does not warn.
+#[test]
+fn a_hole_loop_under_the_8bit_packing_is_warned_about() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenes/hard/torus-hole-rect.toml"
+    );
+    let mut torus = penumbra::scene::file::resolve(path).unwrap();
+    torus.width = 64;
+    torus.height = 64;
+    let warnings = |scene: &Scene, opts: &[(&str, &str)]| {
+        let scene = with_options(scene.clone(), opts);
+        let frame = Frame::render(&scene, GpuSettings::default()).unwrap();
+        let out = penumbra::methods::run("wedge-blending", &frame).unwrap();
+        out.stats.warnings
+    };
+    let packed = blend(&torus, &[]);
+    // One mesh, the torus (not the floor); some of its loops (the hole's; not every loop: the rim's count is +1) read
+    // −1 where they are alone.
+    assert_eq!(packed.hole_loops.len(), 1, "{:?}", packed.hole_loops);
+    assert!(torus.meshes[packed.hole_loops[0].mesh]
+        .name
+        .contains("torus"));
+    let loops = packed.hole_loops[0].loops;
+    assert!(
+        loops >= 1 && loops < packed.counters.silhouettes,
+        "{loops} of {}",
+        packed.counters.silhouettes
+    );
+    assert_eq!(packed.hole_loops[0].pixels, packed.counters.negative_counts);
+    assert!(packed.counters.negative_counts > 20);
+    let w = warnings(&torus, &[]);
+    assert_eq!(w.len(), 1, "{w:?}");
+    let count = format!("{loops} silhouette loop(s) around a hole");
+    for needle in [count.as_str(), "packing = \"f32\"", "torus"] {
+        assert!(w[0].contains(needle), "{needle:?} not in {:?}", w[0]);
+    }
+    // Unpacked, the same negative counts are read and kept: no warning.
+    assert_eq!(
+        blend(&torus, &[("packing", "f32")])
+            .counters
+            .negative_counts,
+        packed.counters.negative_counts
+    );
+    assert!(warnings(&torus, &[("packing", "f32")]).is_empty());
+    // One silhouette per mesh: the rim's +1 and the hole's −1 sum in one stencil, no
+    // negative count is read.
+    assert_eq!(
+        blend(&torus, &[("silhouettes", "meshes")])
+            .counters
+            .negative_counts,
+        0
+    );
+    assert!(warnings(&torus, &[("silhouettes", "meshes")]).is_empty());
+    let spheres = sized("cube-of-spheres", 48);
+    assert_eq!(blend(&spheres, &[]).counters.negative_counts, 0);
+    assert!(warnings(&spheres, &[]).is_empty());
+}
+
 /// The plan's buffers: depth, stencil and two vBuffers of two RGBA32F targets each — 48 MiB
 /// at the paper's 1024×768 for the two vBuffers, as Forest et al. §4.3 says.
 #[test]

@@ -103,7 +103,11 @@
 //!   Green sum over the loops is exact; packed, PK4UB clamps it to 0 and the hole stays as
 //!   dark as the rest of the mesh's shadow (`torus-hole-rect`: RMSE 0.237 packed, 0.0073
 //!   unpacked, 0.0075 with `silhouettes = meshes`, `ssv` 0.0074) — the per-loop silhouettes
-//!   of the paper cannot represent a hole in 8 bits.
+//!   of the paper cannot represent a hole in 8 bits. This is detected at run time: the
+//!   initialization counts the negative hard counts it reads (`negative_counts`), per mesh
+//!   the loops that had some ([`BlendingRender::hole_loops`]), and with `packing = 8bit` the
+//!   method warns (`stats.json` and the terminal) naming the mesh and the remedies
+//!   (`packing = f32`, `silhouettes = meshes`).
 //! * **Only where the silhouette was drawn.** Per tile, a flag records whether any fragment of
 //!   the silhouette reached it; the initialization, blend and clear passes visit only those
 //!   tiles (a tile-level fast clear: the GPU of the paper would clear and blend the whole
@@ -384,6 +388,10 @@ pub struct BlendingCounters {
     pub parts_limited: u64,
     /// Occlusion values PK4UB clamped to [0, 1] at a write.
     pub packing_clamps: u64,
+    /// Pixels where the initialization read a negative hard count: inside a silhouette loop
+    /// around a hole of its mesh where that loop is alone (module doc, "Holes"). Unpacked
+    /// they are kept; the 8-bit packing clamps them to 0 ([`BlendingRender::hole_loops`]).
+    pub negative_counts: u64,
     /// Special float patterns written to the RGBA32F targets.
     pub stores: StoreEvents,
     /// Pixels whose resolved visibility was outside [0, 1] before the final clamp.
@@ -407,6 +415,7 @@ impl std::ops::AddAssign for BlendingCounters {
         self.parts_accumulated += o.parts_accumulated;
         self.parts_limited += o.parts_limited;
         self.packing_clamps += o.packing_clamps;
+        self.negative_counts += o.negative_counts;
         self.stores += o.stores;
         self.clamped_pixels += o.clamped_pixels;
     }
@@ -436,6 +445,21 @@ pub struct BlendingRender {
     pub counters: BlendingCounters,
     /// The buffer dumps of `--dump-buffers` (module doc), empty otherwise.
     pub dumps: Vec<BufferDump>,
+    /// Per mesh with any, its silhouette loops around holes (module doc, "Holes"), in mesh
+    /// order.
+    pub hole_loops: Vec<HoleLoops>,
+}
+
+/// The silhouette loops of one mesh that bound a hole: the initialization read a negative
+/// hard count from the light center inside them (module doc, "Holes").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct HoleLoops {
+    /// Index of the mesh in the scene.
+    pub mesh: usize,
+    /// Its silhouettes (loops) with a negative count somewhere.
+    pub loops: u64,
+    /// The pixels where those counts were read, summed over the loops.
+    pub pixels: u64,
 }
 
 /// One silhouette blended at a probed pixel, decoded from the probe's trace ([`blend_steps`]):
@@ -759,6 +783,10 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
         centroid: s.centroid,
     };
 
+    // The negative counts the initialization has read so far, and per mesh the loops that
+    // had some (silhouettes come mesh by mesh; reversed, in reverse mesh order).
+    let mut negative_seen = 0;
+    let mut hole_loops: Vec<HoleLoops> = Vec::new();
     for (si, sil) in silhouettes.iter().enumerate() {
         counters.silhouettes += 1;
         // Pass 1: the shadow volume into the stencil.
@@ -822,6 +850,7 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
                 }
                 let before = tile.silhouette[i];
                 let mut clamps = 0;
+                tile.counters.negative_counts += u64::from(count < 0);
                 if count != 0 {
                     let (px, c) = storage.store(
                         &[PartState::hard(count); PART_COUNT],
@@ -851,6 +880,21 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
             });
         });
         passes[1].1 += t0.elapsed().as_secs_f64();
+        let negative: u64 = tiles.iter().map(|t| t.counters.negative_counts).sum();
+        if negative > negative_seen {
+            match hole_loops.last_mut() {
+                Some(h) if h.mesh == sil.mesh => {
+                    h.loops += 1;
+                    h.pixels += negative - negative_seen;
+                }
+                _ => hole_loops.push(HoleLoops {
+                    mesh: sil.mesh,
+                    loops: 1,
+                    pixels: negative - negative_seen,
+                }),
+            }
+            negative_seen = negative;
+        }
 
         // Pass 2: outer halves of every edge, then inner halves.
         let t0 = Instant::now();
@@ -1189,6 +1233,7 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
         passes,
         counters,
         dumps,
+        hole_loops,
     }
 }
 
@@ -1243,6 +1288,54 @@ fn blending_dumps<S: VBufferStorage>(
     dumps
 }
 
+/// `wedge-blending`'s pinned golden renders ([`crate::methods::Method::goldens`]).
+const GOLDENS: &[crate::methods::Golden] = &[
+    crate::methods::Golden::new("cube-of-spheres"),
+    crate::methods::Golden::new("single-quad"),
+    crate::methods::Golden::new("eye-in-shadow"),
+    crate::methods::Golden::new("scenes/real/hand.toml"),
+    crate::methods::Golden::new("scenes/real/bob.toml"),
+    // wedge-blending's regions in the shader precision, its vBuffer arithmetic capped at fp32.
+    crate::methods::Golden::variant("cube-of-spheres", "shader-fp24", &[])
+        .gpu(&[("shader", "fp24")]),
+    crate::methods::Golden::variant("cube-of-spheres", "shader-fp16", &[])
+        .gpu(&[("shader", "fp16")]),
+    crate::methods::Golden::variant("cube-of-spheres", "tile32", &[]).gpu(&[("tile-size", "32")]),
+    // wedge-blending (Forest et al. 2006): packing, knobs, float targets, order.
+    crate::methods::Golden::variant("forest-spheres", "packed", &[]),
+    crate::methods::Golden::variant("forest-spheres", "f32", &[("packing", "f32")]),
+    crate::methods::Golden::variant("cube-of-spheres", "f32", &[("packing", "f32")]),
+    crate::methods::Golden::variant("cube-of-spheres", "centroid", &[("centroid", "on")]),
+    crate::methods::Golden::variant("cube-of-spheres", "adjust-always", &[("adjust", "always")]),
+    crate::methods::Golden::variant("cube-of-spheres", "reverse", &[("order", "reverse")]),
+    crate::methods::Golden::variant(
+        "cube-of-spheres",
+        "flush-denormals",
+        &[("target", "flush-denormals")],
+    ),
+    crate::methods::Golden::variant(
+        "cube-of-spheres",
+        "canonical-nans",
+        &[("target", "canonical-nans")],
+    ),
+    crate::methods::Golden::variant(
+        "cube-of-spheres",
+        "meshes-zfail",
+        &[("silhouettes", "meshes"), ("mode", "zfail")],
+    ),
+];
+
+/// `wedge-blending`'s configurations in the accuracy–time sweep ([`crate::methods::Method::sweep`]).
+const SWEEP: &[crate::methods::OptionPairs] = &[
+    &[],
+    &[("packing", "f32")],
+    &[("centroid", "on")],
+    &[("packing", "f32"), ("centroid", "on")],
+    &[("adjust", "always")],
+    &[("adjust", "never")],
+    &[("silhouettes", "meshes")],
+];
+
 /// `wedge-blending` in the registry ([`crate::methods::ALL`]).
 pub const METHOD: crate::methods::Method = crate::methods::Method {
     name: "wedge-blending",
@@ -1257,7 +1350,27 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     sums_per_silhouette_edge: true,
     check: |frame| options(frame).map(drop),
     run,
+    goldens: GOLDENS,
+    sweep: SWEEP,
 };
+
+/// The warning for a mesh whose hole loops the 8-bit packing cannot hold (module doc,
+/// "Holes"; the costs measured in `docs/wedge-blending.md`).
+fn hole_warning(frame: &Frame, h: &HoleLoops) -> String {
+    let name = frame
+        .scene
+        .meshes
+        .get(h.mesh)
+        .map_or("?", |m| m.name.as_str());
+    format!(
+        "mesh {name}: {} silhouette loop(s) around a hole (hard count −1 on {} \
+         pixels); the paper's 8-bit packing (PK4UB) clamps a negative count to 0, so the light \
+         through the hole is lost (scenes/hard/torus-hole-rect.toml: RMSE 0.237 against \
+         0.0073 unpacked); use [options.wedge-blending] packing = \"f32\" or silhouettes = \
+         \"meshes\"",
+        h.loops, h.pixels
+    )
+}
 
 /// Run `wedge-blending` on a rendered frame.
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
@@ -1303,6 +1416,11 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         });
     }
     rec.clamped(r.counters.clamped_pixels);
+    if s.packing == Packing::Bit8 {
+        for h in &r.hole_loops {
+            rec.warn(hole_warning(frame, h));
+        }
+    }
     rec.output(BufferDump::new(
         "penumbrae",
         "per pixel, the number of silhouettes whose occlusion (mean over the radial parts) \
