@@ -570,9 +570,10 @@ pub fn claims(s: &Study) -> Vec<String> {
         .any(|r| r.config == "pw2002 li=16 overflow=wrap")
     {
         out.push(format!(
-            "Paper I §6: the signed 16-bit LI buffer \"guarantees\" at least 127 overlapping \
+            "Paper II §2: the signed 16-bit LI buffer \"guarantees\" at least 127 overlapping \
              umbra volumes — measured (wrap): {}; {}. The arithmetic: 255 − 255·N leaves \
-             [−32768, 32767] at N = 130. {}",
+             [−32768, 32767] at N = 130 (so Paper I §4's \"at least 256 overlapping … \
+             penumbra wedges\" with k = 255 does not hold: the buffer wraps at 130). {}",
             first("pw2002 li=16 overflow=wrap"),
             clean("pw2002 li=16 overflow=wrap"),
             if li16.is_none_or(|n| n > 127) {
@@ -626,7 +627,7 @@ pub fn claims(s: &Study) -> Vec<String> {
     if !f16.is_empty() {
         let ok = f16.iter().all(|r| r.all.pct_over_1_255 < 0.1);
         out.push(format!(
-            "Paper III §4.2: a 16-bit float V-buffer \"would suffice for most scenes\" — against \
+            "Paper III §4.1: a 16-bit float V-buffer \"would suffice for most scenes\" — against \
              f32: {}. {}",
             per_scene(&f16),
             if ok {
@@ -990,9 +991,10 @@ mod tests {
             .unwrap()
     }
 
-    /// Paper I §6's claim, from the LI arithmetic: ±255 per umbra in a signed 16-bit buffer
-    /// cleared to 255 holds 255 − 255·129 = −32640 and wraps at N = 130 (Paper I guarantees
-    /// 127). The experiment must find exactly that: no event at 129, corrupted pixels at 130.
+    /// Paper II §2's claim, from the LI arithmetic: ±255 per umbra in a signed 16-bit buffer
+    /// cleared to 255 holds 255 − 255·129 = −32640 and wraps at N = 130 (Paper II guarantees
+    /// 127; Paper I §4's "at least 256" with k = 255 is contradicted). The experiment must
+    /// find exactly that: no event at 129, corrupted pixels at 130.
     #[test]
     fn li16_wraps_first_at_130_stacked_umbrae() {
         let rows = overflow_rows(

@@ -20,17 +20,18 @@
 //!
 //! # The loop
 //!
-//! - Missing golden file: [`check`] writes it and fails once with
-//!   `golden missing, written: PATH — review and commit it`.
+//! - Missing golden file: [`check`] fails naming it and writes what the method produced to the
+//!   failure directory below (`target/golden-failures/<scene>/<method>/`), never to the golden
+//!   root: a new case gets its goldens only through `penumbra golden --bless`.
 //! - Mismatch: [`check`] writes `target/golden-failures/<scene>/<method>/actual.pfm` and
 //!   `expected_diff_actual.png` (expected | diff mask | actual, visibility shown as sRGB gray;
 //!   for raw images `actual_<raw>.png` and `expected_diff_actual_<raw>.png`) and fails naming
 //!   the first differing pixel, both values with their bits, the number of differing pixels
 //!   and the paths. `target/` is the sibling of the golden root (`<crate>/golden` →
 //!   `<crate>/target`).
-//! - Re-blessing is explicit: `PENUMBRA_BLESS=1` makes [`check`] rewrite instead of
-//!   compare, and the CLI's `golden --bless` calls [`bless`]. Goldens are never loosened
-//!   silently: there is no tolerance.
+//! - Re-blessing is explicit and only on the command line: the CLI's `golden --bless` calls
+//!   [`bless`]; nothing in `cargo test` (no environment variable) writes a golden. Goldens are
+//!   never loosened silently: there is no tolerance.
 
 use crate::methods::dump::{BufferDump, DumpValues};
 use crate::methods::output::MethodOutput;
@@ -46,9 +47,6 @@ use std::path::{Path, PathBuf};
 pub mod cases;
 
 pub use cases::{run_cases, GoldenCase, GOLDEN_SIZE};
-
-/// The environment variable that turns [`check`] into [`bless`]: set it to `1`.
-pub const BLESS_ENV: &str = "PENUMBRA_BLESS";
 
 /// The file name of the visibility golden.
 pub const VISIBILITY_FILE: &str = "visibility.pfm";
@@ -94,11 +92,8 @@ fn failures_root(root: &Path) -> PathBuf {
     parent.join("target").join("golden-failures")
 }
 
-/// True when [`BLESS_ENV`] is set to `1`.
-fn bless_requested() -> bool {
-    std::env::var(BLESS_ENV).is_ok_and(|v| v == "1")
-}
-
+/// `s` as one plain path component (not empty, no separator, not starting with `.`), or an
+/// error naming `what`.
 fn check_component(what: &str, s: &str) -> Result<(), String> {
     if s.is_empty() || s.starts_with('.') || s.contains(['/', '\\']) {
         return Err(format!(
@@ -185,17 +180,7 @@ pub fn bless(
     method: &str,
     out: &MethodOutput,
 ) -> Result<Vec<PathBuf>, String> {
-    bless_sized(root, scene, method, out.stats.width, out.stats.height, out)
-}
-
-fn bless_sized(
-    root: &Path,
-    scene: &str,
-    method: &str,
-    width: u32,
-    height: u32,
-    out: &MethodOutput,
-) -> Result<Vec<PathBuf>, String> {
+    let (width, height) = (out.stats.width, out.stats.height);
     check_component("scene", scene)?;
     check_component("method", method)?;
     let dir = golden_dir(root, scene, method);
@@ -227,8 +212,7 @@ fn bless_sized(
 
 /// Checks `out` (a `width×height` render of `scene` by `method`) against the goldens under
 /// `root` (usually `<crate>/golden`), bit for bit on decoded values. See the module docs for
-/// what happens when a golden is missing or differs; with `PENUMBRA_BLESS=1` the goldens are
-/// rewritten instead ([`bless`]) and the check passes.
+/// what happens when a golden is missing or differs.
 ///
 /// Stale failure files of this scene and method are removed first, so
 /// `target/golden-failures` only shows current failures.
@@ -240,13 +224,6 @@ pub fn check(
     height: u32,
     out: &MethodOutput,
 ) -> Result<(), String> {
-    if bless_requested() {
-        let changed = bless_sized(root, scene, method, width, height, out)?;
-        for p in changed {
-            eprintln!("blessed {}", p.display());
-        }
-        return Ok(());
-    }
     check_against(
         root,
         &failures_root(root),
@@ -258,8 +235,8 @@ pub fn check(
     )
 }
 
-/// [`check`] without the environment: compares, writes missing goldens and failures under
-/// `failures_root/scene/method`.
+/// [`check`] with the failures under `failures_root/scene/method`: compares, and writes there
+/// what differs or has no golden.
 fn check_against(
     root: &Path,
     failures_root: &Path,
@@ -281,7 +258,7 @@ fn check_against(
     let files = golden_files(out, width, height)?;
 
     let mut problems: Vec<String> = Vec::new();
-    let mut missing: Vec<(String, Vec<u8>)> = Vec::new();
+    let mut missing: Vec<String> = Vec::new();
     let mut failure_files: Vec<(String, Vec<u8>)> = Vec::new();
     let what = format!("{scene}/{method}");
 
@@ -290,7 +267,12 @@ fn check_against(
         let expected = match std::fs::read(&path) {
             Ok(b) => b,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                missing.push((name.clone(), bytes.clone()));
+                missing.push(format!(
+                    "golden missing: {} (what the method produced: {})",
+                    path.display(),
+                    fail_dir.join(name).display()
+                ));
+                failure_files.push((name.clone(), bytes.clone()));
                 continue;
             }
             Err(e) => {
@@ -370,31 +352,16 @@ fn check_against(
             ));
         }
     }
-    if !missing.is_empty() {
-        match write_files_all_or_nothing(&dir, &missing) {
-            Ok(()) => {
-                for (name, _) in &missing {
-                    problems.push(format!(
-                        "golden missing, written: {} — review and commit it",
-                        dir.join(name).display()
-                    ));
-                }
-            }
-            Err(e) => problems.push(format!(
-                "golden missing for {what} and could not be written to {}: {e}",
-                dir.display()
-            )),
-        }
-    }
+    problems.extend(missing);
 
     if problems.is_empty() {
         Ok(())
     } else {
-        if !failure_files.is_empty() || problems.iter().any(|p| p.contains("no longer")) {
-            problems.push(format!(
-                "  if the change is intended: {BLESS_ENV}=1 cargo test, or `penumbra golden --bless`"
-            ));
-        }
+        problems.push(
+            "  if the change is intended: `cargo run --release -- golden --bless`, review the \
+             diff of golden/ and commit it"
+                .into(),
+        );
         Err(problems.join("\n"))
     }
 }
@@ -504,6 +471,18 @@ fn compare_raw(
     height: u32,
 ) -> Result<(), Mismatch> {
     let expected = decoded(decode_gray8_png(expected_bytes), width, height)?;
+    if actual.len() != expected.len() {
+        return Err(Mismatch {
+            summary: format!(
+                "{} values produced for the golden's {}×{} = {}",
+                actual.len(),
+                width,
+                height,
+                expected.len()
+            ),
+            panels: None,
+        });
+    }
     let w = width as usize;
     let differing = expected.iter().zip(actual).filter(|(a, b)| a != b).count();
     let Some(first) = expected.iter().zip(actual).position(|(a, b)| a != b) else {
@@ -656,19 +635,24 @@ mod tests {
     }
 
     #[test]
-    fn missing_is_written_and_fails_once() {
+    fn missing_fails_every_time_and_writes_only_failures() {
         let (base, root, fails) = roots("missing");
         let out = base_out();
-        let err = run(&root, &fails, &out).unwrap_err();
-        assert!(err.contains("golden missing, written:"), "{err}");
-        assert!(
-            err.contains("visibility.pfm") && err.contains("stencil.png"),
-            "{err}"
-        );
-        assert!(root.join("scene/hard-sv/visibility.pfm").exists());
-        assert!(root.join("scene/hard-sv/stencil.png").exists());
+        for _ in 0..2 {
+            let err = run(&root, &fails, &out).unwrap_err();
+            assert!(err.contains("golden missing:"), "{err}");
+            assert!(err.contains("golden --bless"), "{err}");
+            assert!(
+                err.contains("visibility.pfm") && err.contains("stencil.png"),
+                "{err}"
+            );
+            assert!(!root.join("scene/hard-sv").exists());
+            assert!(fails.join("scene/hard-sv/visibility.pfm").exists());
+            assert!(fails.join("scene/hard-sv/stencil.png").exists());
+        }
+        bless(&root, "scene", "hard-sv", &out).unwrap();
         run(&root, &fails, &out).unwrap();
-        assert!(!fails.exists());
+        assert!(!fails.join("scene/hard-sv").exists());
         std::fs::remove_dir_all(&base).unwrap();
     }
 

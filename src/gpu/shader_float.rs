@@ -278,17 +278,29 @@ pub trait ShaderFloat:
         Self::from_f64(self.to_f64().abs())
     }
 
-    /// The smaller of the two (f64 `min`: a NaN operand gives the other).
+    /// The smaller of the two; NaN when either is NaN (issue 31: f64 `min` returns the other
+    /// operand, which would turn a NaN coverage into a valid-looking 0 or 1 — a NaN must stay
+    /// visible; the GL specs leave `min` of a NaN undefined, so this is the choice).
     fn min(self, other: Self) -> Self {
-        Self::from_f64(self.to_f64().min(other.to_f64()))
+        let (a, b) = (self.to_f64(), other.to_f64());
+        Self::from_f64(if a.is_nan() || b.is_nan() {
+            f64::NAN
+        } else {
+            a.min(b)
+        })
     }
 
-    /// The larger of the two (f64 `max`: a NaN operand gives the other).
+    /// The larger of the two; NaN when either is NaN (as [`ShaderFloat::min`]).
     fn max(self, other: Self) -> Self {
-        Self::from_f64(self.to_f64().max(other.to_f64()))
+        let (a, b) = (self.to_f64(), other.to_f64());
+        Self::from_f64(if a.is_nan() || b.is_nan() {
+            f64::NAN
+        } else {
+            a.max(b)
+        })
     }
 
-    /// `self` clamped to `[lo, hi]` (f64 `clamp`).
+    /// `self` clamped to `[lo, hi]` (f64 `clamp`: NaN stays NaN).
     fn clamp(self, lo: Self, hi: Self) -> Self {
         Self::from_f64(self.to_f64().clamp(lo.to_f64(), hi.to_f64()))
     }
@@ -427,6 +439,30 @@ macro_rules! with_shader_float {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A NaN operand of `min`, `max` and `clamp` gives NaN in every format, on either side: it
+    /// never becomes the other operand (a NaN coverage must not read as 0 or full coverage).
+    #[test]
+    fn min_max_and_clamp_keep_a_nan() {
+        fn check<T: ShaderFloat>() {
+            let (nan, one) = (T::from_f64(f64::NAN), T::one());
+            for v in [
+                nan.min(one),
+                one.min(nan),
+                nan.max(one),
+                one.max(nan),
+                nan.clamp(T::zero(), one),
+            ] {
+                assert!(v.to_f64().is_nan(), "{v:?}");
+            }
+            assert_eq!(one.min(T::zero()).to_f64(), 0.0);
+            assert_eq!(one.max(T::zero()).to_f64(), 1.0);
+        }
+        check::<f64>();
+        check::<Fp32>();
+        check::<Fp24>();
+        check::<Fp16>();
+    }
 
     /// fp32's fast path gives the bits of rounding on the grid: random doubles over the whole
     /// range, the denormal range, the overflow boundary and ties.
@@ -672,8 +708,10 @@ mod tests {
             prop_assert!(same((-a).to_f64(), -x));
             prop_assert!(same(a.sqrt().to_f64(), x.sqrt()));
             prop_assert!(same(a.abs().to_f64(), x.abs()));
-            prop_assert!(same(a.min(c).to_f64(), x.min(y)));
-            prop_assert!(same(a.max(c).to_f64(), x.max(y)));
+            // min and max keep a NaN operand (f32's give the other one; ShaderFloat::min).
+            let nan_or = |v: f32| if x.is_nan() || y.is_nan() { f32::NAN } else { v };
+            prop_assert!(same(a.min(c).to_f64(), nan_or(x.min(y))));
+            prop_assert!(same(a.max(c).to_f64(), nan_or(x.max(y))));
             prop_assert!(same(a.floor().to_f64(), x.floor()));
             prop_assert_eq!(a < c, x < y);
             prop_assert_eq!(a == c, x == y);

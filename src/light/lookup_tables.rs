@@ -11,9 +11,10 @@
 //! - [`SplitTable`]: 1024 entries of four 8-bit channels converting a coverage value into the
 //!   split V-buffer value of §4.3 ([`crate::gpu::split_blend`]).
 //!
-//! Total texture memory: 196,608 + 131,072 + 4,096 bytes ≈ 324 KB for the sphere shader and
-//! 196,608 + 65,536 + 4,096 ≈ 266 KB for the rectangle, as §6 reports ("about 324KB", "about
-//! 270KB"). Every table is built once per process from the exact functions below and cached;
+//! Total texture memory: 196,608 + 131,072 + 4,096 = 331,776 bytes = 324 KiB for the sphere
+//! shader and 196,608 + 65,536 + 4,096 = 266,240 bytes = 260 KiB for the rectangle. §6 reports
+//! "about 324KB" (KiB: exact) and "about 270KB" (4 % above the 260 KiB, 1.4 % above 266 kB in
+//! powers of ten: the paper's KB is KiB in the first figure, so the second is rounded up). Every table is built once per process from the exact functions below and cached;
 //! building is deterministic (f64, no parallel sums).
 //!
 //! Choices where the paper is silent (each tested below):
