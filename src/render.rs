@@ -183,7 +183,7 @@ pub fn write_runs(
         let comparison = match (reference, &r.error) {
             (None, _) => Comparison::NoReference,
             (Some(reference), Some(report)) => Comparison::Against {
-                report: report.clone(),
+                report,
                 reference: &reference.output.visibility,
             },
             (Some(_), None) => Comparison::Reference {
