@@ -7,6 +7,7 @@ use crate::error::InputError;
 use crate::frame::{Frame, GpuOptions, GpuSettings, BACKGROUND};
 use crate::methods::{self, output::MethodOutput};
 use crate::metrics::error_report::{error_report, ErrorReport};
+use crate::metrics::horizon::{receiver_classes, HorizonSplit};
 use crate::metrics::ErrorStats;
 use crate::options::OptionTable;
 use crate::output::Comparison;
@@ -29,8 +30,8 @@ pub struct MethodRun {
     pub output: MethodOutput,
     /// The shaded image, linear RGB, row-major.
     pub shaded: Vec<[f32; 3]>,
-    /// Error against the reference (whole image and the reference's penumbra), when the
-    /// reference ran and this is not it.
+    /// Error against the reference (whole image, the reference's penumbra, and split by the
+    /// receiver's horizon), when the reference ran and this is not it.
     pub error: Option<ErrorReport>,
     /// For the reference: its own sampling noise, the reference against itself with the next
     /// seed ([`methods::raycast::reference_noise_floor`]).
@@ -125,6 +126,7 @@ pub fn render_scene_dumping(
     methods::check_option_tables(scene)?;
     let order = render_order(scene)?;
     let frame = checked_frame(scene)?.dumping(dump_buffers);
+    let classes = receiver_classes(&frame.scene.lights, frame.receivers());
     let mut runs: Vec<MethodRun> = Vec::new();
     for m in &order {
         starting(m);
@@ -134,7 +136,14 @@ pub fn render_scene_dumping(
             .iter()
             .find(|r| r.method == methods::REFERENCE)
             .filter(|_| m != methods::REFERENCE)
-            .map(|r| error_report(&output.visibility, &r.output.visibility, methods::REFERENCE));
+            .map(|r| {
+                error_report(
+                    &output.visibility,
+                    &r.output.visibility,
+                    methods::REFERENCE,
+                    &classes,
+                )
+            });
         let noise_floor = if m == methods::REFERENCE {
             Some(methods::raycast::reference_noise_floor(
                 &frame,
@@ -174,7 +183,7 @@ pub fn write_runs(
         let comparison = match (reference, &r.error) {
             (None, _) => Comparison::NoReference,
             (Some(reference), Some(report)) => Comparison::Against {
-                report: report.clone(),
+                report,
                 reference: &reference.output.visibility,
             },
             (Some(_), None) => Comparison::Reference {
@@ -203,6 +212,9 @@ pub struct TableRow<'a> {
     pub error: Option<&'a ErrorStats>,
     /// Its error over the reference's penumbra (not for the reference itself).
     pub penumbra_error: Option<&'a ErrorStats>,
+    /// Its error over whole-light and horizon receivers (not for the reference itself;
+    /// [`crate::metrics::horizon`]).
+    pub horizon: Option<&'a HorizonSplit>,
     /// Buffer traffic of the whole method, in MB (10⁶ bytes).
     pub traffic_mb: f64,
 }
@@ -226,6 +238,7 @@ pub fn table_rows(runs: &[MethodRun]) -> Vec<TableRow<'_>> {
             run: r,
             error: r.error.as_ref().map(|e| &e.all).or(r.noise_floor.as_ref()),
             penumbra_error: r.error.as_ref().map(|e| &e.penumbra_only),
+            horizon: r.error.as_ref().map(|e| &e.horizon_split),
             traffic_mb: r.output.stats.totals.total_mb(),
         })
         .collect()
@@ -287,28 +300,49 @@ pub fn scene_title(scene: &Scene) -> String {
 }
 
 /// The table the default run prints: time and error vs the reference per method
-/// ([`table_rows`]), then the notes ([`table_notes`]).
+/// ([`table_rows`]), the mean |e| over whole-light and horizon receivers, the horizon
+/// receivers' share of the image and of the method's error ([`HorizonSplit`]), then the notes
+/// ([`table_notes`]).
 pub fn table(scene: &Scene, runs: &[MethodRun]) -> String {
     let mut s = format!("scene {}\n", scene_title(scene));
     s += &format!(
-        "{:<18} {:>10} {:>10} {:>10} {:>10} {:>12} {:>12}\n",
-        "method", "time [s]", "RMSE", "mean |e|", "max |e|", "% > 1/255", "MB traffic"
+        "{:<18} {:>10} {:>10} {:>10} {:>10} {:>12} {:>12} {:>12} {:>12} {:>10} {:>10}\n",
+        "method",
+        "time [s]",
+        "RMSE",
+        "mean |e|",
+        "max |e|",
+        "% > 1/255",
+        "MB traffic",
+        "whole |e|",
+        "horizon |e|",
+        "% horizon",
+        "h. share"
     );
     for row in table_rows(runs) {
         let (m, t, mb) = (&row.run.method, row.seconds(), row.traffic_mb);
         match row.error {
             Some(e) => {
                 s += &format!(
-                    "{:<18} {:>10.3} {:>10.5} {:>10.5} {:>10.5} {:>12.3} {:>12.2}\n",
+                    "{:<18} {:>10.3} {:>10.5} {:>10.5} {:>10.5} {:>12.3} {:>12.2}",
                     m, t, e.rmse, e.mean_abs, e.max_abs, e.pct_over_1_255, mb
                 )
             }
             None => {
                 s += &format!(
-                    "{:<18} {:>10.3} {:>10} {:>10} {:>10} {:>12} {:>12.2}\n",
+                    "{:<18} {:>10.3} {:>10} {:>10} {:>10} {:>12} {:>12.2}",
                     m, t, "—", "—", "—", "—", mb
                 )
             }
+        }
+        match row.horizon {
+            Some(h) => {
+                s += &format!(
+                    " {:>12.5} {:>12.5} {:>10.2} {:>10.3}\n",
+                    h.whole_light.mean_abs, h.horizon.mean_abs, h.horizon_pct, h.horizon_share
+                )
+            }
+            None => s += &format!(" {:>12} {:>12} {:>10} {:>10}\n", "—", "—", "—", "—"),
         }
     }
     for note in table_notes(scene, runs) {

@@ -19,7 +19,8 @@
 //!
 //! **A measurement** of one configuration: one untimed render gives its error
 //! ([`error_report`]: whole-image RMSE, mean and max |e|, % of pixels off by more than 1/255
-//! and 4/255, and the same over the reference's penumbra) and warms the process-wide caches
+//! and 4/255, the same over the reference's penumbra, and split into whole-light and horizon
+//! receivers, [`crate::metrics::horizon`]) and warms the process-wide caches
 //! (coverage textures, lookup tables), then `runs` timed renders (default [`TIMING_RUNS`])
 //! give the median, min and max. The timed renders are interleaved: round 1 renders every
 //! configuration of the shard once, then round 2, …, so a slow phase of the machine affects
@@ -47,6 +48,7 @@ use crate::error::InputError;
 use crate::frame::Frame;
 use crate::methods;
 use crate::metrics::error_report::error_report;
+use crate::metrics::horizon::{receiver_classes, HorizonSplit};
 use crate::metrics::ErrorStats;
 use crate::render::gpu_settings;
 use crate::scene::Scene;
@@ -223,6 +225,8 @@ pub struct Row {
     pub error: ErrorStats,
     /// Error over the reference's penumbra (pixels strictly between 0 and 1).
     pub penumbra: ErrorStats,
+    /// Error over the whole-light and the horizon receivers ([`crate::metrics::horizon`]).
+    pub horizon: HorizonSplit,
     /// Whether it is on its scene's Pareto front of (median time, RMSE) ([`pareto_front`];
     /// depends on the times).
     pub pareto: bool,
@@ -409,12 +413,21 @@ pub fn run(
         .iter()
         .map(|&k| frames[item_scenes[k].0].lit_by(&item_scenes[k].2))
         .collect();
+    let classes: Vec<_> = frames
+        .iter()
+        .map(|f| receiver_classes(&f.scene.lights, f.receivers()))
+        .collect();
     let mut errors = Vec::new();
     for (j, &k) in mine.iter().enumerate() {
         let (si, method, _) = &item_scenes[k];
         let out = methods::run(method, &item_frames[j])?;
         let reference = reference_vis[*si].as_ref().expect("rendered above");
-        errors.push(error_report(&out.visibility, reference, REFERENCE.0));
+        errors.push(error_report(
+            &out.visibility,
+            reference,
+            REFERENCE.0,
+            &classes[*si],
+        ));
     }
     // The timed renders, interleaved.
     let mut times: Vec<Vec<f64>> = vec![Vec::with_capacity(runs); mine.len()];
@@ -440,6 +453,7 @@ pub fn run(
                 runs,
                 error: e.all,
                 penumbra: e.penumbra_only,
+                horizon: e.horizon_split,
                 pareto: false,
             }
         })
@@ -569,7 +583,8 @@ fn csv_field(s: &str) -> String {
 pub const CSV_HEADER: &str = "scene,width,height,method,knobs,median_seconds,min_seconds,\
 max_seconds,runs,rmse,mean_abs,max_abs,pct_over_1_255,pct_over_4_255,pixels,penumbra_rmse,\
 penumbra_mean_abs,penumbra_max_abs,penumbra_pct_over_1_255,penumbra_pct_over_4_255,\
-penumbra_pixels,pareto";
+penumbra_pixels,whole_light_mean_abs,whole_light_pixels,horizon_mean_abs,horizon_pixels,\
+horizon_pct,horizon_share,pareto";
 
 /// `accuracy-time.csv`: [`CSV_HEADER`], then one line per row (floats written exactly, as
 /// Rust's shortest round-trip form).
@@ -584,7 +599,7 @@ pub fn csv(sweep: &Sweep) -> String {
         };
         let _ = writeln!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             csv_field(&r.item.scene),
             r.item.width,
             r.item.height,
@@ -596,6 +611,12 @@ pub fn csv(sweep: &Sweep) -> String {
             r.runs,
             e(&r.error),
             e(&r.penumbra),
+            r.horizon.whole_light.mean_abs,
+            r.horizon.whole_light.pixels,
+            r.horizon.horizon.mean_abs,
+            r.horizon.horizon.pixels,
+            r.horizon.horizon_pct,
+            r.horizon.horizon_share,
             r.pareto
         );
     }
@@ -666,13 +687,15 @@ pub fn summary(sweep: &Sweep) -> String {
         let _ = writeln!(
             s,
             "| # | method | knobs | median [ms] | min–max [ms] | RMSE | max \\|e\\| | % > 1/255 | \
-             penumbra RMSE | Pareto |"
+             penumbra RMSE | whole-light mean \\|e\\| | horizon mean \\|e\\| | horizon share | \
+             Pareto |"
         );
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
+        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
         for (n, r) in rows.iter().enumerate() {
             let _ = writeln!(
                 s,
-                "| {} | {} | {} | {} | {}–{} | {:.5} | {:.4} | {:.2} | {:.5} | {} |",
+                "| {} | {} | {} | {} | {}–{} | {:.5} | {:.4} | {:.2} | {:.5} | {:.5} | {:.5} | {:.3} \
+                 | {} |",
                 n + 1,
                 r.item.method,
                 r.item.knobs,
@@ -683,6 +706,9 @@ pub fn summary(sweep: &Sweep) -> String {
                 r.error.max_abs,
                 r.error.pct_over_1_255,
                 r.penumbra.rmse,
+                r.horizon.whole_light.mean_abs,
+                r.horizon.horizon.mean_abs,
+                r.horizon.horizon_share,
                 if r.pareto { "★" } else { "" }
             );
         }

@@ -1,8 +1,9 @@
 //! What a run writes about a method's error against the reference (issue 14, "Error maps and
-//! metrics in every run"): the metrics over the whole image and over the reference's penumbra
-//! ([`ErrorReport`], in `stats.json`), and the signed error as a picture ([`signed_error_map`],
+//! metrics in every run"): the metrics over the whole image, over the reference's penumbra and
+//! split by the receiver's own horizon (issue 28; [`ErrorReport`], in `stats.json`), and the signed error as a picture ([`signed_error_map`],
 //! `error.png`) on one fixed scale, so that two runs can be compared by eye.
 
+use super::horizon::{horizon_split, HorizonSplit, ReceiverClass};
 use super::{compare, compare_where, ErrorStats};
 use crate::visibility::Visibility;
 use serde::Serialize;
@@ -19,18 +20,28 @@ pub struct ErrorReport {
     /// strictly between 0 and 1 (elsewhere most methods are exact, and whole-image numbers
     /// are diluted by the lit and umbra areas).
     pub penumbra_only: ErrorStats,
+    /// Over the whole-light receivers, the horizon receivers and those facing away
+    /// ([`super::horizon`]).
+    pub horizon_split: HorizonSplit,
 }
 
-/// The error of `method` against `reference` (named `reference_name`), see [`ErrorReport`].
+/// The error of `method` against `reference` (named `reference_name`), see [`ErrorReport`];
+/// `classes` holds each pixel's [`ReceiverClass`]
+/// ([`receiver_classes`](super::horizon::receiver_classes)).
+///
+/// # Panics
+/// If the buffers and `classes` have different pixel counts.
 pub fn error_report(
     method: &Visibility,
     reference: &Visibility,
     reference_name: &str,
+    classes: &[Option<ReceiverClass>],
 ) -> ErrorReport {
     ErrorReport {
         reference: reference_name.into(),
         all: compare(method, reference),
         penumbra_only: compare_where(method, reference, |i| in_penumbra(reference, i)),
+        horizon_split: horizon_split(method, reference, classes),
     }
 }
 
@@ -106,7 +117,10 @@ mod tests {
     fn penumbra_only_counts_the_reference_penumbra() {
         let reference = Visibility::Gray(vec![0.0, 0.5, 1.0, 0.25]);
         let method = Visibility::Gray(vec![0.5, 0.5, 1.0, 0.0]);
-        let r = error_report(&method, &reference, "raycast");
+        // Pixels 0 and 1 are whole-light receivers, 2 a horizon receiver, 3 background.
+        use crate::metrics::horizon::ReceiverClass::{Horizon, WholeLight};
+        let classes = [Some(WholeLight), Some(WholeLight), Some(Horizon), None];
+        let r = error_report(&method, &reference, "raycast", &classes);
         assert_eq!(r.all.pixels, 4);
         assert_eq!(r.penumbra_only.pixels, 2);
         assert_eq!(r.penumbra_only.max_abs, 0.25);
@@ -115,6 +129,10 @@ mod tests {
         assert_eq!(json["reference"], "raycast");
         assert_eq!(json["rmse"], r.all.rmse);
         assert_eq!(json["penumbra_only"]["pixels"], 2);
+        assert_eq!(json["horizon_split"]["whole_light"]["pixels"], 2);
+        assert_eq!(json["horizon_split"]["whole_light"]["mean_abs"], 0.25);
+        assert_eq!(json["horizon_split"]["horizon"]["mean_abs"], 0.0);
+        assert_eq!(json["horizon_split"]["horizon_pct"], 25.0);
         let map = signed_error_map(&method, &reference);
         assert_eq!(map[0][0], 255); // too bright: red
         assert_eq!(map[1], [255, 255, 255]);

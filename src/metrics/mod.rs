@@ -1,5 +1,6 @@
 //! Image error metrics: how far a method's visibility is from the reference
-//! (`docs/architecture.md` "Layout": RMSE, max abs, % pixels off by more than 1/255), and a diff mask for viewing.
+//! (`docs/architecture.md` "Layout": RMSE, max abs, % pixels off by more than 1/255), split by
+//! the receiver's own horizon ([`horizon`]), and a diff mask for viewing.
 //!
 //! Differences are taken per channel in f64 (`f64::from(a) − f64::from(b)`, exact for f32
 //! inputs) and accumulated sequentially in pixel order, channel order inside a pixel, so the
@@ -9,6 +10,7 @@ use crate::visibility::Visibility;
 use serde::{Deserialize, Serialize};
 
 pub mod error_report;
+pub mod horizon;
 
 /// Error of one visibility buffer against another (usually: a method against `raycast`).
 ///

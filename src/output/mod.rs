@@ -581,7 +581,7 @@ pub enum Comparison<'a> {
     /// Compared with the reference: `"error"` holds the report, `error.png` the signed map.
     Against {
         /// The metrics.
-        report: ErrorReport,
+        report: &'a ErrorReport,
         /// The reference's visibility.
         reference: &'a Visibility,
     },

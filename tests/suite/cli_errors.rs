@@ -856,6 +856,63 @@ fn a_run_with_the_reference_writes_error_maps_and_metrics() {
     std::fs::remove_dir_all(&out).unwrap();
 }
 
+/// `stats.json`'s error holds the split by the receiver's horizon (issue 28): on
+/// `cube-of-spheres` the spheres' terminators are horizon receivers and the floor sees the
+/// whole light; the three classes count exactly the pixels that show a surface, the percentage
+/// and the share follow from the counts and means, and the table prints the same numbers.
+#[test]
+fn stats_json_splits_the_error_into_whole_light_and_horizon_receivers() {
+    let (output, out) = render(
+        "horizon-split",
+        &[
+            "cube-of-spheres",
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--methods",
+            "raycast,hard-sv",
+        ],
+    );
+    assert_eq!(output.status.code(), Some(0));
+    let stats: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("hard-sv/stats.json")).unwrap()).unwrap();
+    let e = &stats["error"];
+    let split = &e["horizon_split"];
+    let count = |class: &str| split[class]["pixels"].as_u64().unwrap();
+    let (whole, horizon, away) = (count("whole_light"), count("horizon"), count("facing_away"));
+    // The pixels that show a surface, counted from the scene pass.
+    let scene = penumbra::experiment::sized(
+        penumbra::scene::builtin::load("cube-of-spheres").unwrap(),
+        32,
+    );
+    let frame =
+        penumbra::frame::Frame::render(&scene, penumbra::render::gpu_settings(&scene).unwrap())
+            .unwrap();
+    let surface = frame.receivers().iter().filter(|r| r.is_some()).count() as u64;
+    assert_eq!(whole + horizon + away, surface, "{split}");
+    assert!(horizon > 0 && whole > horizon, "{split}");
+    let pixels = e["pixels"].as_u64().unwrap();
+    assert_eq!(
+        split["horizon_pct"].as_f64().unwrap(),
+        100.0 * horizon as f64 / pixels as f64
+    );
+    let mean = |v: &serde_json::Value| v["mean_abs"].as_f64().unwrap();
+    let share = mean(&split["horizon"]) * horizon as f64 / (mean(e) * pixels as f64);
+    assert_eq!(split["horizon_share"].as_f64().unwrap(), share);
+    // A hard shadow errs on the spheres' terminators far more than on the floor.
+    assert!(
+        mean(&split["horizon"]) > mean(&split["whole_light"]),
+        "{split}"
+    );
+    let table = String::from_utf8_lossy(&output.stdout);
+    let row = table.lines().find(|l| l.starts_with("hard-sv")).unwrap();
+    for v in [mean(&split["whole_light"]), mean(&split["horizon"])] {
+        assert!(row.contains(&format!("{v:.5}")), "{row} vs {split}");
+    }
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
 /// `penumbra golden` outside the repository refuses (exit 2, one line naming the directory)
 /// and writes nothing where it was run: before, `--bless` wrote a whole golden tree into the
 /// current directory and then failed.

@@ -37,6 +37,7 @@ mod penumbra_wedges;
 mod penumbra_wedges_threads;
 mod probe;
 mod raster_properties;
+mod real_model_catalog;
 mod receiver_only;
 mod reference_agreement;
 mod report;
