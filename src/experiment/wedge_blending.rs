@@ -36,6 +36,7 @@ use crate::geometry::near_plane::segment_hits_mesh;
 use crate::gpu::probe;
 use crate::light::coverage::RectLight;
 use crate::light::radial_parts::{PART_COUNT, PART_SIGNS};
+use crate::methods::recorder::PassRecorder;
 use crate::methods::wedge_blending::{self, blend_steps, BlendStep};
 use crate::metrics::{compare_where, ErrorStats};
 use crate::scene::{builtin, Scene};
@@ -246,7 +247,10 @@ pub fn measure_scene(scene: &Scene) -> Result<SceneReport, InputError> {
         f32_variant.options,
     )))?
     .0;
-    let mask_render = wedge_blending::render(&frame, &unpacked)?;
+    let mask_render = wedge_blending::render(
+        &mut PassRecorder::new(&frame, wedge_blending::METHOD.name),
+        &unpacked,
+    )?;
     let overlap: Vec<bool> = mask_render.penumbrae.iter().map(|n| *n >= 2).collect();
     let mut errors = Vec::new();
     let mut packed = None;
@@ -268,7 +272,11 @@ pub fn measure_scene(scene: &Scene) -> Result<SceneReport, InputError> {
         reverse: true,
         ..unpacked
     };
-    let rev = wedge_blending::render(&frame, &reversed)?.visibility;
+    let rev = wedge_blending::render(
+        &mut PassRecorder::new(&frame, wedge_blending::METHOD.name),
+        &reversed,
+    )?
+    .visibility;
     let diffs: Vec<f64> = rev
         .iter()
         .zip(&mask_render.visibility)
@@ -281,7 +289,11 @@ pub fn measure_scene(scene: &Scene) -> Result<SceneReport, InputError> {
     );
     let reference = gray(&reference);
     let packed_settings = wedge_blending::options(&frame)?.0;
-    let counters = wedge_blending::render(&frame, &packed_settings)?.counters;
+    let counters = wedge_blending::render(
+        &mut PassRecorder::new(&frame, wedge_blending::METHOD.name),
+        &packed_settings,
+    )?
+    .counters;
     // The probe: overlap pixels by decreasing error (ties by index) among receivers that see
     // the whole light in front of their tangent plane (elsewhere the receiver's own surface
     // hides part of the light, which no wedge method models, ssv as little); the first whose
@@ -308,7 +320,10 @@ pub fn measure_scene(scene: &Scene) -> Result<SceneReport, InputError> {
         let mut probed = frame.lit_by(scene);
         let recorder = std::sync::Arc::new(probe::Probe::new(xy.0, xy.1));
         probed.probe = Some(recorder.clone());
-        wedge_blending::render(&probed, &packed_settings)?;
+        wedge_blending::render(
+            &mut PassRecorder::new(&probed, wedge_blending::METHOD.name),
+            &packed_settings,
+        )?;
         let trace = blend_steps(&recorder.events(), &packed_settings);
         if trace.iter().all(|st| st.mesh != receiver_mesh) {
             let p = receivers[i].expect("an overlap pixel has a receiver").point;

@@ -135,6 +135,22 @@ impl<'f, 's> PassRecorder<'f, 's> {
         out
     }
 
+    /// Run pass `name` once more: a pass a method runs once per silhouette, between its other
+    /// passes (`wedge-blending`). Like [`Self::pass`] the first time; later runs add their
+    /// time and counters to that entry and count one more run.
+    pub fn pass_again<R>(&mut self, name: &str, body: impl FnOnce(&mut Pass<'f, 's>) -> R) -> R {
+        let earlier = self.passes.iter().skip(1).position(|p| p.name == name);
+        let out = self.pass(name, body);
+        if let Some(k) = earlier {
+            let run = self.passes.pop().expect("the pass just recorded");
+            let entry = &mut self.passes[k + 1];
+            entry.wall_seconds += run.wall_seconds;
+            entry.runs += run.runs;
+            entry.counters += run.counters;
+        }
+        out
+    }
+
     /// Record a pass that was run elsewhere and handed back its stats (a building block shared
     /// by methods, or a method run inside another one), after the passes before it.
     pub fn record_pass(&mut self, stats: PassStats) {

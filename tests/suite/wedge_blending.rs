@@ -5,6 +5,7 @@
 
 use glam::{DVec3, Vec3};
 use penumbra::frame::{Frame, GpuSettings};
+use penumbra::methods::recorder::PassRecorder;
 use penumbra::methods::wedge_blending::{options, render, BlendingRender};
 use penumbra::metrics::compare_where;
 use penumbra::scene::procedural::{box_mesh, two_sided_quad};
@@ -25,7 +26,7 @@ fn blend(scene: &Scene, opts: &[(&str, &str)]) -> BlendingRender {
     let scene = with_options(scene.clone(), opts);
     let frame = Frame::render(&scene, GpuSettings::default()).unwrap();
     let (s, _) = options(&frame).unwrap();
-    render(&frame, &s).unwrap()
+    render(&mut PassRecorder::new(&frame, "wedge-blending"), &s).unwrap()
 }
 
 /// The visibility of `method` on `scene`.

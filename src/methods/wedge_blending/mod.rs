@@ -159,13 +159,13 @@ use crate::methods::hard_sv::CountMode;
 use crate::methods::output::BufferPlan;
 use crate::methods::recorder::PassRecorder;
 use crate::options::{option_names, option_table, OptionTable, OptionType, Switch};
-use crate::pass::PassStats;
+
 use crate::scene::LightShape;
 use crate::visibility::Visibility;
 use blend::{blend_part, BlendCase, InnerAdjust, PartState, Rules};
 use glam::DVec3;
 use rayon::prelude::*;
-use std::time::Instant;
+
 use vbuffer::{Packed8, PixelParts, UnpackedF32, VBufferStorage};
 
 /// How the vBuffers store a pixel (module doc, [`vbuffer`]).
@@ -439,8 +439,6 @@ pub struct BlendingRender {
     pub unclamped: Vec<f32>,
     /// Per pixel, the number of silhouettes in whose penumbra it lies (module doc).
     pub penumbrae: Vec<u8>,
-    /// Counters and wall seconds of each pass of [`PASS_NAMES`], summed over silhouettes.
-    pub passes: [(Counters, f64); 5],
     /// Method counters.
     pub counters: BlendingCounters,
     /// The buffer dumps of `--dump-buffers` (module doc), empty otherwise.
@@ -647,7 +645,8 @@ struct PrimRole {
 
 /// Render `wedge-blending` on `frame` with settings `s`. A probe attached to the frame records
 /// every pass at its pixel ([`crate::gpu::probe`]; the blend steps: [`blend_steps`]).
-pub fn render(frame: &Frame, s: &Settings) -> Result<BlendingRender, InputError> {
+pub fn render(rec: &mut PassRecorder, s: &Settings) -> Result<BlendingRender, InputError> {
+    let frame = rec.frame();
     let silhouettes = silhouettes(frame, s)?;
     let packed = Packed8 {
         target: s.target,
@@ -660,13 +659,13 @@ pub fn render(frame: &Frame, s: &Settings) -> Result<BlendingRender, InputError>
     Ok(
         crate::with_shader_float!(frame.gpu.shader, T => match s.packing {
             Packing::Bit8 => render_with::<_, T>(
-                frame,
+                rec,
                 s,
                 &silhouettes,
                 &packed,
             ),
             Packing::F32 => render_with::<_, T>(
-                frame,
+                rec,
                 s,
                 &silhouettes,
                 &unpacked,
@@ -728,11 +727,12 @@ fn on_dirty_tiles<P: Send>(
 }
 
 fn render_with<S: VBufferStorage, T: ShaderFloat>(
-    frame: &Frame,
+    rec: &mut PassRecorder,
     s: &Settings,
     silhouettes: &[Silhouette],
     storage: &S,
 ) -> BlendingRender {
+    let frame = rec.frame();
     let tiling = &frame.tiling;
     let light = RectLight::from_light(frame.scene.light()).expect("options checked a rect light");
     let c = light.center;
@@ -771,7 +771,6 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
         )
         .value("mesh", silhouettes[si].mesh as f64)
     };
-    let mut passes = [(Counters::default(), 0.0f64); 5];
     let mut counters = BlendingCounters::default();
     let less = DepthState {
         func: DepthFunc::Less,
@@ -790,96 +789,98 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
     for (si, sil) in silhouettes.iter().enumerate() {
         counters.silhouettes += 1;
         // Pass 1: the shadow volume into the stencil.
-        let t0 = Instant::now();
-        let (tris, mut c1) = setup_all(&sil.volume, CullMode::None, tiling);
-        let bins = bin(tiling, &tris);
-        c1 += draw(
-            tiling,
-            &mut tiles,
-            &tris,
-            &bins,
-            probes[0].as_ref(),
-            // The hierarchical-Z unit skips a tile where every fragment of the volume face
-            // would count nothing ([`Frame::hiz_depth_draw`]); such a tile is not marked
-            // as drawn, and a tile the silhouette left alone is skipped by the later passes
-            // without changing the result (module doc, "Only where the silhouette was drawn").
-            |t, _, tri, cnt| {
-                let idle = (less.func, s.test.idle_outcome());
-                frame.hiz_depth_draw(t, tri, idle, cnt, probes[0].as_ref(), |tap| {
-                    tap.event().primitive(
-                        PrimitiveKind::VolumeTriangle,
-                        tri.prim,
-                        format!("of silhouette {si}"),
-                        Some(tri.front_facing),
-                    )
-                })
-            },
-            |t, tile, tri, f, cnt, tap| {
-                let (pass, z) = frame.tiles[t].depth.test(&less, &f, cnt);
-                count!(cnt.depth_passed += pass as u64);
-                let update = tile
-                    .stencil
-                    .apply(&stencil_state, tri.front_facing, &f, pass, cnt);
-                tile.dirty = true;
-                if let Some(tap) = tap {
-                    let e = tap.event().primitive(
-                        PrimitiveKind::VolumeTriangle,
-                        tri.prim,
-                        format!("of silhouette {si}"),
-                        Some(tri.front_facing),
-                    );
-                    let e = frame.tiles[t]
-                        .depth
-                        .record_test(e, less.func, f.local, z, pass);
-                    tap.push(update.record(e, "stencil"));
-                }
-            },
-        );
-        passes[0].0 += c1;
-        passes[0].1 += t0.elapsed().as_secs_f64();
+        rec.pass_again(PASS_NAMES[0], |pass| {
+            let (tris, mut c1) = setup_all(&sil.volume, CullMode::None, tiling);
+            let bins = bin(tiling, &tris);
+            c1 += draw(
+                tiling,
+                &mut tiles,
+                &tris,
+                &bins,
+                probes[0].as_ref(),
+                // The hierarchical-Z unit skips a tile where every fragment of the volume face
+                // would count nothing ([`Frame::hiz_depth_draw`]); such a tile is not marked
+                // as drawn, and a tile the silhouette left alone is skipped by the later passes
+                // without changing the result (module doc, "Only where the silhouette was drawn").
+                |t, _, tri, cnt| {
+                    let idle = (less.func, s.test.idle_outcome());
+                    frame.hiz_depth_draw(t, tri, idle, cnt, probes[0].as_ref(), |tap| {
+                        tap.event().primitive(
+                            PrimitiveKind::VolumeTriangle,
+                            tri.prim,
+                            format!("of silhouette {si}"),
+                            Some(tri.front_facing),
+                        )
+                    })
+                },
+                |t, tile, tri, f, cnt, tap| {
+                    let (pass, z) = frame.tiles[t].depth.test(&less, &f, cnt);
+                    count!(cnt.depth_passed += pass as u64);
+                    let update =
+                        tile.stencil
+                            .apply(&stencil_state, tri.front_facing, &f, pass, cnt);
+                    tile.dirty = true;
+                    if let Some(tap) = tap {
+                        let e = tap.event().primitive(
+                            PrimitiveKind::VolumeTriangle,
+                            tri.prim,
+                            format!("of silhouette {si}"),
+                            Some(tri.front_facing),
+                        );
+                        let e = frame.tiles[t]
+                            .depth
+                            .record_test(e, less.func, f.local, z, pass);
+                        tap.push(update.record(e, "stencil"));
+                    }
+                },
+            );
+            pass.count(c1);
+        });
 
         // Initialization: shaded pixels get the hard count in every part.
-        let t0 = Instant::now();
-        passes[1].0 += on_dirty_tiles(&mut tiles, |t, tile, cnt| {
-            let watched = probes[1].as_ref().filter(|p| p.watches_tile(t));
-            tile_pixels(tiling, t, |i, _| {
-                count!(cnt.stencil_read_bytes += 1);
-                let count = tile.stencil.values[i] as i8 as i32;
-                if let Some(sum) = tile.stencil_sum.get_mut(i) {
-                    *sum += count;
-                }
-                let before = tile.silhouette[i];
-                let mut clamps = 0;
-                tile.counters.negative_counts += u64::from(count < 0);
-                if count != 0 {
-                    let (px, c) = storage.store(
-                        &[PartState::hard(count); PART_COUNT],
-                        &mut tile.counters.stores,
-                    );
-                    clamps = c;
-                    tile.silhouette[i] = px;
-                    tile.counters.packing_clamps += clamps;
-                    count!(cnt.color_write_bytes += sil_bytes);
-                }
-                if let Some(tap) = watched.and_then(|p| p.tap(t, i)) {
-                    let e = silhouette_primitive(tap.event(), si).value("count", count as f64);
-                    let e = e.read("stencil", Raw::U8(tile.stencil.values[i]));
-                    if count == 0 {
-                        return tap.push(e.note("count 0: nothing stored"));
+        rec.pass_again(PASS_NAMES[1], |pass| {
+            pass.count(on_dirty_tiles(&mut tiles, |t, tile, cnt| {
+                let watched = probes[1].as_ref().filter(|p| p.watches_tile(t));
+                tile_pixels(tiling, t, |i, _| {
+                    count!(cnt.stencil_read_bytes += 1);
+                    let count = tile.stencil.values[i] as i8 as i32;
+                    if let Some(sum) = tile.stencil_sum.get_mut(i) {
+                        *sum += count;
                     }
-                    tap.push(e);
-                    let e = silhouette_primitive(tap.event(), si).write(
-                        "silhouette-vbuffer",
-                        storage.raw(&before),
-                        storage.raw(&tile.silhouette[i]),
-                        Overflow::Clamp,
-                        clamps,
-                    );
-                    tap.push(e.note("every part: occlusion = count, the whole part as rectangle"));
-                }
-            });
+                    let before = tile.silhouette[i];
+                    let mut clamps = 0;
+                    tile.counters.negative_counts += u64::from(count < 0);
+                    if count != 0 {
+                        let (px, c) = storage.store(
+                            &[PartState::hard(count); PART_COUNT],
+                            &mut tile.counters.stores,
+                        );
+                        clamps = c;
+                        tile.silhouette[i] = px;
+                        tile.counters.packing_clamps += clamps;
+                        count!(cnt.color_write_bytes += sil_bytes);
+                    }
+                    if let Some(tap) = watched.and_then(|p| p.tap(t, i)) {
+                        let e = silhouette_primitive(tap.event(), si).value("count", count as f64);
+                        let e = e.read("stencil", Raw::U8(tile.stencil.values[i]));
+                        if count == 0 {
+                            return tap.push(e.note("count 0: nothing stored"));
+                        }
+                        tap.push(e);
+                        let e = silhouette_primitive(tap.event(), si).write(
+                            "silhouette-vbuffer",
+                            storage.raw(&before),
+                            storage.raw(&tile.silhouette[i]),
+                            Overflow::Clamp,
+                            clamps,
+                        );
+                        tap.push(
+                            e.note("every part: occlusion = count, the whole part as rectangle"),
+                        );
+                    }
+                });
+            }));
         });
-        passes[1].1 += t0.elapsed().as_secs_f64();
         let negative: u64 = tiles.iter().map(|t| t.counters.negative_counts).sum();
         if negative > negative_seen {
             match hole_loops.last_mut() {
@@ -897,312 +898,324 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
         }
 
         // Pass 2: outer halves of every edge, then inner halves.
-        let t0 = Instant::now();
-        let mut jobs: Vec<HalfJob> = Vec::new();
-        let mut prims: Vec<[ClipVertex; 3]> = Vec::new();
-        let mut roles: Vec<PrimRole> = Vec::new();
-        let mut halves = Vec::with_capacity(sil.edges.len());
-        let mut quads = Vec::with_capacity(sil.edges.len());
-        for [a, b] in &sil.edges {
-            halves.push(wedge_halves_and_planes(c, &corners, *a, *b, lo, hi));
-            quads.push(HardQuad::new(frame, *a, *b));
-        }
-        for inner in [false, true] {
-            for (k, (pair, planes)) in halves.iter().enumerate() {
-                let [a, b] = sil.edges[k];
-                let cut = quad_inner_halfspace(c, a, b);
-                let half = &pair[if inner { 0 } else { 1 }];
-                if half.is_empty() {
-                    continue;
-                }
-                let full_screen = half.contains(eye, eye_radius);
-                let job = jobs.len() as u32;
-                jobs.push(HalfJob {
-                    edge: k,
-                    inner,
-                    planes: bounding_planes(half, planes)
-                        .iter()
-                        .map(|h| frame.proj.window_plane(h.normal, h.offset))
-                        .collect(),
-                    full_screen,
-                });
-                if full_screen {
-                    for f in FULL_SCREEN {
-                        prims.push(f);
-                        roles.push(PrimRole {
-                            job,
-                            cull: CullMode::None,
-                            depth_tested: false,
-                        });
+        rec.pass_again(PASS_NAMES[2], |pass| {
+            let mut jobs: Vec<HalfJob> = Vec::new();
+            let mut prims: Vec<[ClipVertex; 3]> = Vec::new();
+            let mut roles: Vec<PrimRole> = Vec::new();
+            let mut halves = Vec::with_capacity(sil.edges.len());
+            let mut quads = Vec::with_capacity(sil.edges.len());
+            for [a, b] in &sil.edges {
+                halves.push(wedge_halves_and_planes(c, &corners, *a, *b, lo, hi));
+                quads.push(HardQuad::new(frame, *a, *b));
+            }
+            for inner in [false, true] {
+                for (k, (pair, planes)) in halves.iter().enumerate() {
+                    let [a, b] = sil.edges[k];
+                    let cut = quad_inner_halfspace(c, a, b);
+                    let half = &pair[if inner { 0 } else { 1 }];
+                    if half.is_empty() {
+                        continue;
                     }
-                    continue;
-                }
-                let size = half
-                    .vertices()
-                    .map(|v| v.abs().max_element())
-                    .fold(1.0, f64::max);
-                for face in &half.faces {
-                    // The face in the hard quad's plane is not depth tested (module doc).
-                    let on_quad = face.iter().all(|v| cut.distance(*v).abs() <= 1e-9 * size);
-                    for i in 1..face.len() - 1 {
-                        prims.push(
-                            [face[0], face[i], face[i + 1]]
-                                .map(|x| frame.proj.clip_point(x.as_vec3())),
-                        );
-                        roles.push(PrimRole {
-                            job,
-                            cull: CullMode::Back,
-                            depth_tested: !on_quad,
-                        });
+                    let full_screen = half.contains(eye, eye_radius);
+                    let job = jobs.len() as u32;
+                    jobs.push(HalfJob {
+                        edge: k,
+                        inner,
+                        planes: bounding_planes(half, planes)
+                            .iter()
+                            .map(|h| frame.proj.window_plane(h.normal, h.offset))
+                            .collect(),
+                        full_screen,
+                    });
+                    if full_screen {
+                        for f in FULL_SCREEN {
+                            prims.push(f);
+                            roles.push(PrimRole {
+                                job,
+                                cull: CullMode::None,
+                                depth_tested: false,
+                            });
+                        }
+                        continue;
+                    }
+                    let size = half
+                        .vertices()
+                        .map(|v| v.abs().max_element())
+                        .fold(1.0, f64::max);
+                    for face in &half.faces {
+                        // The face in the hard quad's plane is not depth tested (module doc).
+                        let on_quad = face.iter().all(|v| cut.distance(*v).abs() <= 1e-9 * size);
+                        for i in 1..face.len() - 1 {
+                            prims.push(
+                                [face[0], face[i], face[i + 1]]
+                                    .map(|x| frame.proj.clip_point(x.as_vec3())),
+                            );
+                            roles.push(PrimRole {
+                                job,
+                                cull: CullMode::Back,
+                                depth_tested: !on_quad,
+                            });
+                        }
                     }
                 }
             }
-        }
-        counters.half_wedges += jobs.len() as u64;
-        counters.half_wedges_full_screen += jobs.iter().filter(|j| j.full_screen).count() as u64;
-        let mut c2 = Counters::default();
-        let mut tris: Vec<RasterTriangle> = Vec::new();
-        for (k, p) in prims.iter().enumerate() {
-            setup_triangle(
-                p,
-                k as u32,
-                roles[k].cull,
-                tiling.width,
-                tiling.height,
-                &mut tris,
-                &mut c2,
-            );
-        }
-        let bins = bin(tiling, &tris);
-        c2 += draw(
-            tiling,
-            &mut tiles,
-            &tris,
-            &bins,
-            probes[2].as_ref(),
-            // The hierarchical-Z unit skips a depth-tested face in a tile where LESS fails at
-            // every sample ([`Frame::hiz_depth_draw`], idle outcome `false`): there the
-            // fragment program below returns at the depth test, having counted the fragment
-            // in `rejected_depth` and written no buffer — neither the silhouette vBuffer nor
-            // the tile's `dirty` flag, which only a shaded fragment sets. Faces drawn without
-            // the depth test (the face in the hard quad's plane, full-screen quads) are never
-            // skipped: their fragments do not depend on the scene depth's outcome.
-            |t, _, tri, cnt| {
-                let role = roles[tri.prim as usize];
-                if !role.depth_tested {
-                    return TileDraw::Whole;
-                }
-                frame.hiz_depth_draw(t, tri, (less.func, false), cnt, probes[2].as_ref(), |tap| {
-                    half_wedge_event(tap, &jobs[role.job as usize], role.job, tri, si)
-                })
-            },
-            |t, tile, tri, f, cnt, tap| {
-                let role = roles[tri.prim as usize];
-                let job = &jobs[role.job as usize];
-                let depth = &frame.tiles[t].depth;
-                // The watched fragment's event, built only there: what it saw up to where it
-                // stopped.
-                let record = |build: &dyn Fn(ProbeEvent) -> ProbeEvent| {
-                    if let Some(tap) = tap {
-                        tap.push(build(half_wedge_event(tap, job, role.job, tri, si)));
+            counters.half_wedges += jobs.len() as u64;
+            counters.half_wedges_full_screen +=
+                jobs.iter().filter(|j| j.full_screen).count() as u64;
+            let mut c2 = Counters::default();
+            let mut tris: Vec<RasterTriangle> = Vec::new();
+            for (k, p) in prims.iter().enumerate() {
+                setup_triangle(
+                    p,
+                    k as u32,
+                    roles[k].cull,
+                    tiling.width,
+                    tiling.height,
+                    &mut tris,
+                    &mut c2,
+                );
+            }
+            let bins = bin(tiling, &tris);
+            c2 += draw(
+                tiling,
+                &mut tiles,
+                &tris,
+                &bins,
+                probes[2].as_ref(),
+                // The hierarchical-Z unit skips a depth-tested face in a tile where LESS fails at
+                // every sample ([`Frame::hiz_depth_draw`], idle outcome `false`): there the
+                // fragment program below returns at the depth test, having counted the fragment
+                // in `rejected_depth` and written no buffer — neither the silhouette vBuffer nor
+                // the tile's `dirty` flag, which only a shaded fragment sets. Faces drawn without
+                // the depth test (the face in the hard quad's plane, full-screen quads) are never
+                // skipped: their fragments do not depend on the scene depth's outcome.
+                |t, _, tri, cnt| {
+                    let role = roles[tri.prim as usize];
+                    if !role.depth_tested {
+                        return TileDraw::Whole;
                     }
-                };
-                let (stored, test) = if !role.depth_tested {
-                    (depth.read(f.local, cnt), None)
-                } else {
-                    let (pass, z) = depth.test(&less, &f, cnt);
-                    if !pass {
-                        tile.counters.rejected_depth += 1;
+                    frame.hiz_depth_draw(
+                        t,
+                        tri,
+                        (less.func, false),
+                        cnt,
+                        probes[2].as_ref(),
+                        |tap| half_wedge_event(tap, &jobs[role.job as usize], role.job, tri, si),
+                    )
+                },
+                |t, tile, tri, f, cnt, tap| {
+                    let role = roles[tri.prim as usize];
+                    let job = &jobs[role.job as usize];
+                    let depth = &frame.tiles[t].depth;
+                    // The watched fragment's event, built only there: what it saw up to where it
+                    // stopped.
+                    let record = |build: &dyn Fn(ProbeEvent) -> ProbeEvent| {
+                        if let Some(tap) = tap {
+                            tap.push(build(half_wedge_event(tap, job, role.job, tri, si)));
+                        }
+                    };
+                    let (stored, test) = if !role.depth_tested {
+                        (depth.read(f.local, cnt), None)
+                    } else {
+                        let (pass, z) = depth.test(&less, &f, cnt);
+                        if !pass {
+                            tile.counters.rejected_depth += 1;
+                            return record(&|e| {
+                                depth
+                                    .record_test(e, less.func, f.local, z, pass)
+                                    .note("depth test failed: the receiver is in front")
+                            });
+                        }
+                        count!(cnt.depth_passed += 1);
+                        (depth.values[f.local], Some(z))
+                    };
+                    let seen = |e: ProbeEvent| match test {
+                        Some(z) => depth.record_test(e, less.func, f.local, z, true),
+                        None => e,
+                    };
+                    let Some(rcv) = receivers[(f.y * tiling.width + f.x) as usize] else {
+                        return record(&|e| seen(e).note("background"));
+                    };
+                    let z_w = frame.gpu.depth.to_window(stored);
+                    if job
+                        .planes
+                        .iter()
+                        .any(|pl| pl.footprint_outside(f.x, f.y, z_w))
+                    {
+                        tile.counters.rejected_outside_planes += 1;
+                        return record(&|e| seen(e).note("outside a bounding plane (Fig. 7)"));
+                    }
+                    let [a, b] = sil.edges[job.edge];
+                    let (side, p) =
+                        quads[job.edge].side(f.x, f.y, stored, rcv.point.as_dvec3(), frame);
+                    if side == 0.0 || (side > 0.0) != job.inner {
+                        tile.counters.rejected_quad_side += 1;
                         return record(&|e| {
-                            depth
-                                .record_test(e, less.func, f.local, z, pass)
-                                .note("depth test failed: the receiver is in front")
+                            seen(e).note("the other side of the hard quad (Fig. 8)")
                         });
                     }
-                    count!(cnt.depth_passed += 1);
-                    (depth.values[f.local], Some(z))
-                };
-                let seen = |e: ProbeEvent| match test {
-                    Some(z) => depth.record_test(e, less.func, f.local, z, true),
-                    None => e,
-                };
-                let Some(rcv) = receivers[(f.y * tiling.width + f.x) as usize] else {
-                    return record(&|e| seen(e).note("background"));
-                };
-                let z_w = frame.gpu.depth.to_window(stored);
-                if job
-                    .planes
-                    .iter()
-                    .any(|pl| pl.footprint_outside(f.x, f.y, z_w))
-                {
-                    tile.counters.rejected_outside_planes += 1;
-                    return record(&|e| seen(e).note("outside a bounding plane (Fig. 7)"));
-                }
-                let [a, b] = sil.edges[job.edge];
-                let (side, p) = quads[job.edge].side(f.x, f.y, stored, rcv.point.as_dvec3(), frame);
-                if side == 0.0 || (side > 0.0) != job.inner {
-                    tile.counters.rejected_quad_side += 1;
-                    return record(&|e| seen(e).note("the other side of the hard quad (Fig. 8)"));
-                }
-                count!(cnt.fragments_shaded += 1);
-                tile.dirty = true;
-                let regions = edge_in_parts::<T>(&light, p, a, b);
-                if regions.iter().all(Option::is_none) {
-                    tile.counters.missed_light += 1;
-                    return record(&|e| seen(e).note("the edge reaches no part of the light"));
-                }
-                count!(cnt.color_read_bytes += sil_bytes);
-                let before = tile.silhouette[f.local];
-                let mut parts = storage.load(&before);
-                for (part, region) in parts.iter_mut().zip(&regions) {
-                    let Some(r) = region else { continue };
-                    tile.counters.part_updates += 1;
-                    if job.inner {
-                        part.add_inner::<T::AtMostFp32>(r);
-                    } else {
-                        part.add_outer::<T::AtMostFp32>(r);
+                    count!(cnt.fragments_shaded += 1);
+                    tile.dirty = true;
+                    let regions = edge_in_parts::<T>(&light, p, a, b);
+                    if regions.iter().all(Option::is_none) {
+                        tile.counters.missed_light += 1;
+                        return record(&|e| seen(e).note("the edge reaches no part of the light"));
                     }
-                }
-                let (px, clamps) = storage.store(&parts, &mut tile.counters.stores);
-                tile.silhouette[f.local] = px;
-                tile.counters.packing_clamps += clamps;
-                count!(cnt.color_write_bytes += sil_bytes);
-                record(&|e| {
-                    let areas = regions
-                        .iter()
-                        .enumerate()
-                        .filter_map(|(k, r)| Some((k, r.as_ref()?)));
-                    let e = areas.fold(seen(e), |e, (k, r)| e.value(&format!("area{k}"), r.area));
-                    let e = e.write(
-                        "silhouette-vbuffer",
-                        storage.raw(&before),
-                        storage.raw(&px),
-                        Overflow::Clamp,
-                        clamps,
-                    );
-                    e.note(if job.inner {
-                        "inner: the regions' areas subtracted, max X/Y raised"
-                    } else {
-                        "outer: the regions' areas added, rectangles grown"
-                    })
-                });
-            },
-        );
-        passes[2].0 += c2;
-        passes[2].1 += t0.elapsed().as_secs_f64();
+                    count!(cnt.color_read_bytes += sil_bytes);
+                    let before = tile.silhouette[f.local];
+                    let mut parts = storage.load(&before);
+                    for (part, region) in parts.iter_mut().zip(&regions) {
+                        let Some(r) = region else { continue };
+                        tile.counters.part_updates += 1;
+                        if job.inner {
+                            part.add_inner::<T::AtMostFp32>(r);
+                        } else {
+                            part.add_outer::<T::AtMostFp32>(r);
+                        }
+                    }
+                    let (px, clamps) = storage.store(&parts, &mut tile.counters.stores);
+                    tile.silhouette[f.local] = px;
+                    tile.counters.packing_clamps += clamps;
+                    count!(cnt.color_write_bytes += sil_bytes);
+                    record(&|e| {
+                        let areas = regions
+                            .iter()
+                            .enumerate()
+                            .filter_map(|(k, r)| Some((k, r.as_ref()?)));
+                        let e =
+                            areas.fold(seen(e), |e, (k, r)| e.value(&format!("area{k}"), r.area));
+                        let e = e.write(
+                            "silhouette-vbuffer",
+                            storage.raw(&before),
+                            storage.raw(&px),
+                            Overflow::Clamp,
+                            clamps,
+                        );
+                        e.note(if job.inner {
+                            "inner: the regions' areas subtracted, max X/Y raised"
+                        } else {
+                            "outer: the regions' areas added, rectangles grown"
+                        })
+                    });
+                },
+            );
+            pass.count(c2);
+        });
 
         // Pass 3: blend into the final vBuffer, then clear the silhouette vBuffer and stencil.
-        let t0 = Instant::now();
-        passes[3].0 += on_dirty_tiles(&mut tiles, |t, tile, cnt| {
-            let watched = probes[3].as_ref().filter(|p| p.watches_tile(t));
-            tile_pixels(tiling, t, |i, _| {
-                count!(cnt.color_read_bytes += sil_bytes);
-                let sp = storage.load(&tile.silhouette[i]);
-                let tap = watched.and_then(|p| p.tap(t, i));
-                if let Some(tap) = tap {
-                    let e = silhouette_primitive(tap.event(), si);
-                    tap.push(e.read("silhouette-vbuffer", storage.raw(&tile.silhouette[i])));
-                }
-                if sp.iter().all(|p| p.occlusion == 0.0) {
-                    return;
-                }
-                let mean = sp.iter().map(|p| p.occlusion).sum::<f32>() / PART_COUNT as f32;
-                if mean > 0.5 / 255.0 && mean < 1.0 - 0.5 / 255.0 {
-                    tile.penumbrae[i] = tile.penumbrae[i].saturating_add(1);
-                }
-                tile.counters.blended_pixels += 1;
-                count!(cnt.color_read_bytes += fin_bytes);
-                let mut fp = storage.load(&tile.last[i]);
-                let mut eps = [0.0; PART_COUNT];
-                for (k, (f, sp)) in fp.iter_mut().zip(&sp).enumerate() {
-                    let (out, o) = blend_part::<T::AtMostFp32>(f, sp, rules);
-                    *f = out;
-                    eps[k] = o.eps;
-                    let k = &mut tile.counters;
-                    k.parts_limited += o.limited as u64;
-                    match o.case {
-                        BlendCase::Skipped => {}
-                        BlendCase::Copied => k.parts_copied += 1,
-                        BlendCase::Blended => {
-                            k.parts_blended += 1;
-                            k.parts_corrected += (o.eps > 0.0) as u64;
-                        }
-                        BlendCase::Accumulated => k.parts_accumulated += 1,
+        rec.pass_again(PASS_NAMES[3], |pass| {
+            pass.count(on_dirty_tiles(&mut tiles, |t, tile, cnt| {
+                let watched = probes[3].as_ref().filter(|p| p.watches_tile(t));
+                tile_pixels(tiling, t, |i, _| {
+                    count!(cnt.color_read_bytes += sil_bytes);
+                    let sp = storage.load(&tile.silhouette[i]);
+                    let tap = watched.and_then(|p| p.tap(t, i));
+                    if let Some(tap) = tap {
+                        let e = silhouette_primitive(tap.event(), si);
+                        tap.push(e.read("silhouette-vbuffer", storage.raw(&tile.silhouette[i])));
                     }
-                }
-                let special = |e: &StoreEvents| e.denormal + e.nan + e.infinite;
-                let before_store = special(&tile.counters.stores);
-                let (px, clamps) = storage.store(&fp, &mut tile.counters.stores);
-                let specials = special(&tile.counters.stores) - before_store;
-                record_overflow(&mut tile.final_events[0], i, clamps as u32);
-                record_overflow(&mut tile.final_events[1], i, specials as u32);
-                if let Some(tap) = tap {
-                    let e = eps
-                        .iter()
-                        .enumerate()
-                        .fold(silhouette_primitive(tap.event(), si), |e, (k, x)| {
-                            e.value(&format!("eps{k}"), *x as f64)
-                        });
-                    let e = e.write(
-                        "final-vbuffer",
-                        storage.raw(&tile.last[i]),
-                        storage.raw(&px),
-                        Overflow::Clamp,
-                        clamps,
-                    );
-                    tap.push(e.note("A = A_f + A_s − ε per part (§3.2)"));
-                }
-                tile.last[i] = px;
-                tile.counters.packing_clamps += clamps;
-                count!(cnt.color_write_bytes += fin_bytes);
-            });
-            let pixels = tiling.rect(t).area() as u64;
-            tile.silhouette.fill(cleared);
-            tile.stencil.values.fill(0);
-            count!(cnt.color_write_bytes += pixels * sil_bytes);
-            count!(cnt.stencil_write_bytes += pixels);
-            tile.dirty = false;
-            if let Some(p) = watched {
-                p.record(|tap| tap.event().clear("stencil", Raw::U8(0)));
-                p.record(|tap| {
-                    tap.event()
-                        .clear("silhouette-vbuffer", storage.raw(&cleared))
+                    if sp.iter().all(|p| p.occlusion == 0.0) {
+                        return;
+                    }
+                    let mean = sp.iter().map(|p| p.occlusion).sum::<f32>() / PART_COUNT as f32;
+                    if mean > 0.5 / 255.0 && mean < 1.0 - 0.5 / 255.0 {
+                        tile.penumbrae[i] = tile.penumbrae[i].saturating_add(1);
+                    }
+                    tile.counters.blended_pixels += 1;
+                    count!(cnt.color_read_bytes += fin_bytes);
+                    let mut fp = storage.load(&tile.last[i]);
+                    let mut eps = [0.0; PART_COUNT];
+                    for (k, (f, sp)) in fp.iter_mut().zip(&sp).enumerate() {
+                        let (out, o) = blend_part::<T::AtMostFp32>(f, sp, rules);
+                        *f = out;
+                        eps[k] = o.eps;
+                        let k = &mut tile.counters;
+                        k.parts_limited += o.limited as u64;
+                        match o.case {
+                            BlendCase::Skipped => {}
+                            BlendCase::Copied => k.parts_copied += 1,
+                            BlendCase::Blended => {
+                                k.parts_blended += 1;
+                                k.parts_corrected += (o.eps > 0.0) as u64;
+                            }
+                            BlendCase::Accumulated => k.parts_accumulated += 1,
+                        }
+                    }
+                    let special = |e: &StoreEvents| e.denormal + e.nan + e.infinite;
+                    let before_store = special(&tile.counters.stores);
+                    let (px, clamps) = storage.store(&fp, &mut tile.counters.stores);
+                    let specials = special(&tile.counters.stores) - before_store;
+                    record_overflow(&mut tile.final_events[0], i, clamps as u32);
+                    record_overflow(&mut tile.final_events[1], i, specials as u32);
+                    if let Some(tap) = tap {
+                        let e = eps
+                            .iter()
+                            .enumerate()
+                            .fold(silhouette_primitive(tap.event(), si), |e, (k, x)| {
+                                e.value(&format!("eps{k}"), *x as f64)
+                            });
+                        let e = e.write(
+                            "final-vbuffer",
+                            storage.raw(&tile.last[i]),
+                            storage.raw(&px),
+                            Overflow::Clamp,
+                            clamps,
+                        );
+                        tap.push(e.note("A = A_f + A_s − ε per part (§3.2)"));
+                    }
+                    tile.last[i] = px;
+                    tile.counters.packing_clamps += clamps;
+                    count!(cnt.color_write_bytes += fin_bytes);
                 });
-            }
+                let pixels = tiling.rect(t).area() as u64;
+                tile.silhouette.fill(cleared);
+                tile.stencil.values.fill(0);
+                count!(cnt.color_write_bytes += pixels * sil_bytes);
+                count!(cnt.stencil_write_bytes += pixels);
+                tile.dirty = false;
+                if let Some(p) = watched {
+                    p.record(|tap| tap.event().clear("stencil", Raw::U8(0)));
+                    p.record(|tap| {
+                        tap.event()
+                            .clear("silhouette-vbuffer", storage.raw(&cleared))
+                    });
+                }
+            }));
         });
-        passes[3].1 += t0.elapsed().as_secs_f64();
     }
 
     // Resolve.
-    let t0 = Instant::now();
-    let n = frame.pixel_count();
-    let mut unclamped = vec![1.0f32; n];
-    let mut penumbrae = vec![0u8; n];
-    let mut resolve = Counters::default();
-    for (t, tile) in tiles.iter_mut().enumerate() {
-        counters += tile.counters;
-        tile_pixels(tiling, t, |i, g| {
-            penumbrae[g] = tile.penumbrae[i];
-            if receivers[g].is_none() {
-                return;
-            }
-            count!(resolve.color_read_bytes += fin_bytes);
-            let parts = storage.load(&tile.last[i]);
-            let sum = parts.iter().fold(T::AtMostFp32::zero(), |sum, p| {
-                sum + read::<T::AtMostFp32>(p.occlusion)
+    let (unclamped, penumbrae, visibility, clamped) = rec.pass(PASS_NAMES[4], |pass| {
+        let n = frame.pixel_count();
+        let mut unclamped = vec![1.0f32; n];
+        let mut penumbrae = vec![0u8; n];
+        let mut resolve = Counters::default();
+        for (t, tile) in tiles.iter_mut().enumerate() {
+            counters += tile.counters;
+            tile_pixels(tiling, t, |i, g| {
+                penumbrae[g] = tile.penumbrae[i];
+                if receivers[g].is_none() {
+                    return;
+                }
+                count!(resolve.color_read_bytes += fin_bytes);
+                let parts = storage.load(&tile.last[i]);
+                let sum = parts.iter().fold(T::AtMostFp32::zero(), |sum, p| {
+                    sum + read::<T::AtMostFp32>(p.occlusion)
+                });
+                let quarter = T::AtMostFp32::from_f64(0.25);
+                unclamped[g] = stored(T::AtMostFp32::one() - sum * quarter);
             });
-            let quarter = T::AtMostFp32::from_f64(0.25);
-            unclamped[g] = stored(T::AtMostFp32::one() - sum * quarter);
-        });
-    }
-    let visibility: Vec<f32> = unclamped.iter().map(|v| v.clamp(0.0, 1.0)).collect();
-    let clamped: Vec<bool> = unclamped
-        .iter()
-        .zip(&visibility)
-        .map(|(u, v)| u != v)
-        .collect();
-    counters.clamped_pixels = clamped.iter().filter(|&&c| c).count() as u64;
-    passes[4] = (resolve, t0.elapsed().as_secs_f64());
+        }
+        let visibility: Vec<f32> = unclamped.iter().map(|v| v.clamp(0.0, 1.0)).collect();
+        let clamped: Vec<bool> = unclamped
+            .iter()
+            .zip(&visibility)
+            .map(|(u, v)| u != v)
+            .collect();
+        counters.clamped_pixels = clamped.iter().filter(|&&c| c).count() as u64;
+        pass.count(resolve);
+        (unclamped, penumbrae, visibility, clamped)
+    });
     if let Some(p) = &probes[4] {
         let [x, y] = p.probe().pixel();
         let (g, t) = ((y * tiling.width + x) as usize, tiling.tile_of(x, y));
@@ -1230,7 +1243,6 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
         visibility,
         unclamped,
         penumbrae,
-        passes,
         counters,
         dumps,
         hole_loops,
@@ -1404,17 +1416,8 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     });
     rec.uses_hiz_depth();
     let footprint = rec.buffer_bytes();
-    // The passes time and count themselves, summed over silhouettes ([`render`]).
-    let r = render(frame, &s)?;
-    let runs = r.counters.silhouettes;
-    for (name, (counters, seconds)) in PASS_NAMES.iter().zip(r.passes) {
-        rec.record_pass(PassStats {
-            name: name.to_string(),
-            wall_seconds: seconds,
-            runs: if *name == "wb-resolve" { 1 } else { runs },
-            counters,
-        });
-    }
+    // The passes of each silhouette run through the recorder, summed per pass ([`render`]).
+    let r = render(&mut rec, &s)?;
     rec.clamped(r.counters.clamped_pixels);
     if s.packing == Packing::Bit8 {
         for h in &r.hole_loops {
