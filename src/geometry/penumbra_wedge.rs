@@ -50,7 +50,7 @@
 //!
 //! # Folds (the zigzag the papers cannot handle)
 //! The thesis's introduction (Fig. 5b) names the silhouettes Papers I and II cannot build
-//! wedges for: "silhouette edges [that] form a zigzag pattern along the direction to the light
+//! wedges for: "silhouette edges \[that\] form a zigzag pattern along the direction to the light
 //! source". Seen from the light center such a loop turns back on itself: at a cusp the quad
 //! normals of consecutive edges are nearly opposite. The possible silhouettes of finely
 //! tessellated real meshes do this wherever the surface is seen at a grazing angle (Spot the

@@ -162,7 +162,9 @@ use super::output::MethodOutput;
 use super::penumbra_map::ShadowMapKeys;
 use crate::error::InputError;
 use crate::frame::Frame;
-use crate::geometry::umbra_penumbra::{build_volumes, Disk, Extrusion, VolumeStats, VolumeVertex};
+use crate::geometry::umbra_penumbra::{
+    build_volumes, Disk, Extrusion, VolumeStats, VolumeVertex, Volumes,
+};
 use crate::gpu::buffers::{alloc_tiles, DepthTile};
 use crate::gpu::color::{ColorFormat, ColorMask, RgbaTile};
 use crate::gpu::counters::{count, Counters};
@@ -473,8 +475,8 @@ struct DTile {
     /// Per texel and volume (umbra, penumbra), the fragments its ray met: how often the ray
     /// crosses the volume's surface (module doc, "Several crossings").
     crossings: Vec<[u32; 2]>,
-    /// Per texel and volume, the mesh whose fragment the channel holds.
-    farthest_mesh: Vec<[u32; 2]>,
+    /// Per texel and volume, the volume triangle whose fragment the channel holds.
+    farthest_prim: Vec<[u32; 2]>,
 }
 
 /// The result of the passes.
@@ -500,7 +502,7 @@ pub struct DBufferRender {
     pub shades: Vec<Option<Shade>>,
     /// Per caster mesh ([`Frame::caster_meshes`] order), the receiver pixels whose texel's ray
     /// crosses the volume they read more than once, that mesh's fragment held
-    /// ([`several_crossings`]).
+    /// (module doc, "Several crossings").
     pub several_crossings: Vec<u64>,
     /// The passes after the scene pass: volumes, the three D-buffer draws, screen.
     pub passes: Vec<PassStats>,
@@ -572,7 +574,7 @@ fn texel_raw(tile: &RgbaTile, i: usize) -> Raw {
 
 /// Run one D-buffer draw of `input` into `tiles` (module doc, pass 2), recording at the texel
 /// `probe` watches. A volume draw counts, per texel, the fragments its ray meets and records
-/// the mesh of the fragment the channel holds (`mesh_of`: a volume triangle's mesh).
+/// the triangle of the fragment the channel holds.
 fn draw_dbuffer(
     view: &LightView,
     range: f64,
@@ -580,7 +582,6 @@ fn draw_dbuffer(
     tiles: &mut [DTile],
     input: &DrawInput,
     kind: DrawKind,
-    mesh_of: &(dyn Fn(usize) -> u32 + Sync),
     probe: Option<&PassProbe>,
 ) -> Counters {
     let cull = match kind {
@@ -682,7 +683,7 @@ fn draw_dbuffer(
                     tile.crossings[f.local][k] += 1;
                     let pass = tile.depth.test_and_write(&DepthState::GREATER_WRITE, &f, c);
                     if pass {
-                        tile.farthest_mesh[f.local][k] = mesh_of(prim);
+                        tile.farthest_prim[f.local][k] = tri.prim;
                         tile.color
                             .write_masked(f.local, [0.0, d, d, at(1)], mask, c);
                         if umbra {
@@ -805,7 +806,7 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
         depth: DepthTile::cleared_in(view.depth, &view.tiling, t, hiz_tile),
         stats: DBufferStats::default(),
         crossings: vec![[0; 2]; len],
-        farthest_mesh: vec![[0; 2]; len],
+        farthest_prim: vec![[0; 2]; len],
     });
     let texel = frame.probe.as_ref().and_then(|p| {
         let [x, y] = p.pixel();
@@ -849,7 +850,6 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
             offset: s.offset,
             early_z: early_z.is_some(),
         },
-        &|_| 0,
         map_probe("dbuffer-scene").as_ref(),
     );
     let pass_scene = PassStats::since("dbuffer-scene", t, c1);
@@ -868,7 +868,6 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
         }
         let input = volume_input(&view, range, &disk, tris, &mut not_finite);
         let kind = DrawKind::Volume(ColorMask(mask));
-        let umbra = mask[1];
         let counters = draw_dbuffer(
             &view,
             range,
@@ -876,7 +875,6 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
             &mut tiles,
             &input,
             kind,
-            &|prim| volumes.mesh_of(umbra, prim) as u32,
             probe.as_ref(),
         );
         PassStats::since(name, t, counters)
@@ -902,7 +900,7 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
             .filter(|v| v[1] != 0 && v[2] != 0)
             .count() as u64;
         dbuffer.push(tile.color);
-        crossings.push((tile.crossings, tile.farthest_mesh));
+        crossings.push((tile.crossings, tile.farthest_prim));
     }
 
     // Pass 3: the screen.
@@ -911,7 +909,7 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
         screen_pass::<T>(frame, &view, &dbuffer, c, s)
     });
     let pass_screen = PassStats::since("screen", t, c3);
-    let several_crossings = several_crossings(frame, &view, &crossings, &shades, meshes.len());
+    let several_crossings = several_crossings(frame, &view, &crossings, &shades, &volumes);
 
     Ok(DBufferRender {
         visibility,
@@ -933,20 +931,23 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
     })
 }
 
-/// Per caster mesh (of `mesh_count`), the receiver pixels whose texel's ray crosses the volume
+/// Per tile of the D-buffer, per texel and volume (umbra, penumbra): the fragments its ray met
+/// and the volume triangle whose fragment the channel holds.
+type TexelCrossings = (Vec<[u32; 2]>, Vec<[u32; 2]>);
+
+/// Per caster mesh (of `volumes`), the receiver pixels whose texel's ray crosses the volume
 /// their side of the shadow reads (the umbra volume on the umbra side, the penumbra volume on
 /// the other) more than once (module doc, "Several crossings"), counted for the mesh whose
-/// fragment the channel holds. `crossings`: per tile, the fragment counts and the held meshes
-/// per texel and volume. Counted from the screen pass's shades, after it: a measurement of the
-/// frame, not part of the method.
+/// fragment the channel holds. Counted from the screen pass's shades, after it: a measurement
+/// of the frame, not part of the method.
 fn several_crossings(
     frame: &Frame,
     view: &LightView,
-    crossings: &[(Vec<[u32; 2]>, Vec<[u32; 2]>)],
+    crossings: &[TexelCrossings],
     shades: &[Option<Shade>],
-    mesh_count: usize,
+    volumes: &Volumes,
 ) -> Vec<u64> {
-    let mut found = vec![0; mesh_count];
+    let mut found = vec![0; volumes.mesh_ends.len()];
     for (r, shade) in frame.primary_ray_receivers().iter().zip(shades) {
         let (Some(r), Some(shade)) = (r, shade) else {
             continue;
@@ -959,9 +960,9 @@ fn several_crossings(
             Region::Lit | Region::OuterPenumbra => 1,
         };
         let (tile, local) = view.nearest_texel(x, y);
-        let (counts, meshes) = &crossings[tile];
+        let (counts, prims) = &crossings[tile];
         if counts[local][k] > 1 {
-            found[meshes[local][k] as usize] += 1;
+            found[volumes.mesh_of(k == 0, prims[local][k] as usize)] += 1;
         }
     }
     found
@@ -1119,7 +1120,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
 }
 
 /// The warning for `n` receiver pixels whose texel's ray crosses a volume of the mesh `object`
-/// more than once ([`several_crossings`], module doc "Several crossings").
+/// more than once (module doc, "Several crossings").
 pub fn several_crossings_warning(object: &str, n: u64) -> String {
     format!(
         "{object}: at {n} receiver pixels the ray from the light center crosses this mesh's \
