@@ -48,6 +48,22 @@
 //!   without it. The moved vertices no longer lie on the top caps' boundary, so the rule also
 //!   adds patch triangles to the top caps that keep the outer soft shadow volume closed.
 //!
+//! # Folds (the zigzag the papers cannot handle)
+//! The thesis's introduction (Fig. 5b) names the silhouettes Papers I and II cannot build
+//! wedges for: "silhouette edges \[that\] form a zigzag pattern along the direction to the light
+//! source". Seen from the light center such a loop turns back on itself: at a cusp the quad
+//! normals of consecutive edges are nearly opposite. The possible silhouettes of finely
+//! tessellated real meshes do this wherever the surface is seen at a grazing angle (Spot the
+//! cow in `scenes/real/spot-sphere.toml`: 116 folds, every one a turn of more than 150°; the
+//! built-in spheres, boxes and columns: none). There the corner wedges of Fig. 7 sweep half a turn around the
+//! cusp vertex and the neighbouring wedges overlap instead of partitioning the penumbra, so an
+//! eye ray enters a wedge through its back face (s = 0) without having crossed that loop's
+//! front faces (−255) and the loop *adds* light: bright streaks and specks inside the umbra.
+//! [`silhouette_folds`] counts the folds per mesh ([`WedgeSet::folds`]): corners turning by
+//! more than [`FOLD_TURN`], or by more than 90° at a reflex corner (which gets no corner
+//! wedges). `pw2002` and `pw-restructured` warn with the count (the condition is the papers',
+//! not fixed here).
+//!
 //! # Light intensity (Paper I §4.2, equations 1–3)
 //! [`light_intensity`]: s_l and s_r from the front/back distances along the left and right side
 //! directions, interpolated with the distances to the side planes along the edge direction;
@@ -81,6 +97,11 @@ pub const PARALLEL_SIN: f64 = 0.02;
 /// Interior angle below which a convex corner gets extra wedges: the quad normals turn by more
 /// than this (90°).
 pub const ACUTE_TURN: f64 = std::f64::consts::FRAC_PI_2;
+
+/// The turn of the quad normals (150°) beyond which a silhouette corner is a fold, convex or
+/// not ([`silhouette_folds`]): the loop seen from the light runs out and back within an
+/// interior angle below 30°.
+pub const FOLD_TURN: f64 = 5.0 * std::f64::consts::PI / 6.0;
 
 /// Angular step of the extra wedges at an acute corner (18°).
 pub const EXTRA_WEDGE_STEP: f64 = std::f64::consts::PI / 10.0;
@@ -328,6 +349,9 @@ pub struct WedgeSet {
     /// Per set appended ([`WedgeSet::append`], one per light): the index of its first wedge,
     /// top cap and bottom cap.
     pub appended_at: Vec<[usize; 3]>,
+    /// The silhouette folds of each mesh that has any ([`silhouette_folds`], module doc,
+    /// "Folds"): the mesh's name and its count, in mesh order (one entry per light and mesh).
+    pub folds: Vec<(String, usize)>,
 }
 
 impl WedgeSet {
@@ -345,6 +369,12 @@ impl WedgeSet {
         self.removed_parallel += other.removed_parallel;
         self.extra_wedges += other.extra_wedges;
         self.open_wedges += other.open_wedges;
+        self.folds.extend(other.folds);
+    }
+
+    /// The total of [`WedgeSet::folds`].
+    pub fn fold_count(&self) -> usize {
+        self.folds.iter().map(|(_, n)| n).sum()
     }
 
     /// The light (the set appended, in order) of wedge `wi`; `None` for a set built at once.
@@ -505,6 +535,36 @@ pub fn extra_wedge_count(n1: DVec3, n2: DVec3, dir1: DVec3) -> usize {
         return 0;
     }
     ((turn / EXTRA_WEDGE_STEP).ceil() as usize).saturating_sub(1)
+}
+
+/// The folds of a closed loop of vertex positions seen from the light center `c` (module doc,
+/// "Folds"): the corners where the loop turns back on itself — quad normals more than
+/// [`FOLD_TURN`] apart at any corner (a cusp: the silhouette runs out and back), or more than
+/// 90° apart at a reflex corner (`n2 · dir1 < 0`, which gets no corner wedges). Edges without
+/// a quad normal or direction (zero length, or along the light ray) are skipped, as the wedge
+/// construction skips them.
+pub fn silhouette_folds(lp: &[DVec3], c: DVec3) -> usize {
+    let m = lp.len();
+    let edges: Vec<(DVec3, DVec3)> = (0..m)
+        .map(|i| {
+            let (a, b) = (lp[i], lp[(i + 1) % m]);
+            ((b - a).normalize_or_zero(), quad_normal(a, b, c))
+        })
+        .filter(|(d, n)| *d != DVec3::ZERO && *n != DVec3::ZERO)
+        .collect();
+    let k = edges.len();
+    if k < 2 {
+        return 0;
+    }
+    let cusp = libm::cos(FOLD_TURN);
+    (0..k)
+        .filter(|&i| {
+            let (d1, n1) = edges[i];
+            let (_, n2) = edges[(i + 1) % k];
+            let cos = n1.dot(n2);
+            cos < cusp || (cos < 0.0 && n2.dot(d1) < 0.0)
+        })
+        .count()
 }
 
 /// Build the wedges of one loop of vertex positions (edge i = v_i → v_{i+1}).
@@ -860,14 +920,19 @@ pub fn build_wedges(meshes: &[(&Mesh, &Adjacency)], o: &WedgeOptions) -> Result<
             }
         }
         let sil = possible_silhouettes(mesh, adj, &facing);
+        let mut folds = 0;
         for lp in silhouette_loops(&sil).map_err(|e| format!("mesh {}: {e}", mesh.name))? {
             let mut pts: Vec<DVec3> = lp.iter().map(|&k| sil[k].a.as_dvec3()).collect();
             if o.parallel_rule {
                 set.removed_parallel += apply_parallel_rule(&mut pts, o.center, &mut set.top_caps);
             }
             if pts.len() >= 2 {
+                folds += silhouette_folds(&pts, o.center);
                 loop_wedges(&pts, o, &mut set);
             }
+        }
+        if folds > 0 {
+            set.folds.push((mesh.name.clone(), folds));
         }
     }
     Ok(set)
@@ -1042,6 +1107,40 @@ impl ScreenWedge {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Loops in the plane z = 0 under a light at (0, 0, 10), counter-clockwise seen from it
+    /// (the orientation of silhouette loops: quad normals point out of the loop). The angles
+    /// below are those of the plane figures; the perspective from c moves them by well under a
+    /// degree, far from the thresholds (90° and 150°).
+    #[test]
+    fn folds_are_cusps_and_sharp_reflex_corners() {
+        let c = DVec3::new(0.0, 0.0, 10.0);
+        let lp = |pts: &[(f64, f64)]| -> Vec<DVec3> {
+            pts.iter().map(|&(x, y)| DVec3::new(x, y, 0.0)).collect()
+        };
+        let h = libm::sqrt(3.0) / 2.0;
+        // Equilateral triangle: three convex corners turning by 120° (Fig. 7's acute corners,
+        // which get corner wedges), no fold.
+        assert_eq!(
+            silhouette_folds(&lp(&[(0.0, 0.0), (1.0, 0.0), (0.5, h)]), c),
+            0
+        );
+        // A spike: the corner at (4, 0) has an interior angle of atan(1/8) = 7.1° (a turn of
+        // 172.9° > 150°: a fold); (0, 0.5) turns by 97.1° and (0, 0) by 90°, both convex.
+        assert_eq!(
+            silhouette_folds(&lp(&[(0.0, 0.0), (4.0, 0.0), (0.0, 0.5)]), c),
+            1
+        );
+        // A dart: the cusps at (4, −2) and (4, 2) (7.1° interior, turns of 172.9°) and the
+        // reflex corner at (1, 0) (turning back by 112.6° > 90°) are folds; the convex corner
+        // at (0, 0) turns by 126.9° < 150° and is not.
+        let dart = lp(&[(0.0, 0.0), (4.0, -2.0), (1.0, 0.0), (4.0, 2.0)]);
+        assert_eq!(silhouette_folds(&dart, c), 3);
+        // Reversed, (0, 0) becomes the reflex corner (126.9° > 90°: a fold) and (1, 0) a
+        // convex one turning by 112.6° (not): three again.
+        let reversed: Vec<DVec3> = dart.iter().rev().copied().collect();
+        assert_eq!(silhouette_folds(&reversed, c), 3);
+    }
 
     /// Opposite quad normals (a silhouette spike) have no great circle: the corner normals turn
     /// from the first toward the incoming edge direction, finite and of unit length (the slerp

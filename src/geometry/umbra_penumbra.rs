@@ -409,8 +409,20 @@ pub struct Volumes {
     pub umbra: Vec<[VolumeVertex; 3]>,
     /// Penumbra-volume triangles (quads, corner fans), in submission order.
     pub penumbra: Vec<[VolumeVertex; 3]>,
+    /// Per mesh (in the order given), the end of its triangles in `umbra` and in `penumbra`:
+    /// mesh i's are `ends[i - 1]..ends[i]` (from 0 for the first).
+    pub mesh_ends: Vec<[usize; 2]>,
     /// What was found.
     pub stats: VolumeStats,
+}
+
+impl Volumes {
+    /// The index of the mesh (in the order given to [`build_volumes`]) whose volume triangle
+    /// `prim` is, in the umbra volume (`umbra`) or the penumbra volume.
+    pub fn mesh_of(&self, umbra: bool, prim: usize) -> usize {
+        let k = usize::from(!umbra);
+        self.mesh_ends.partition_point(|e| e[k] <= prim)
+    }
 }
 
 /// The extrusion of one volume edge a → b: its tangent point and the directions of the quad's
@@ -703,6 +715,7 @@ pub fn build_volumes(
                 v.umbra.push(tri.map(on_silhouette));
             }
         }
+        v.mesh_ends.push([v.umbra.len(), v.penumbra.len()]);
     }
     v.stats.umbra_triangles = v.umbra.len() as u64;
     v.stats.penumbra_triangles = v.penumbra.len() as u64;

@@ -546,6 +546,9 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
                 .into(),
         );
     }
+    for w in fold_warnings(&set) {
+        rec.warn(w);
+    }
     rec.dump(|| li_dump(frame, &s, &tiles, &li, clamped, "Paper I §4"));
     Ok(rec.finish(
         visibility,
@@ -555,9 +558,33 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             "extra_corner_wedges": set.extra_wedges,
             "removed_parallel_edges": set.removed_parallel,
             "open_wedges": set.open_wedges,
+            "silhouette_folds": set.fold_count(),
             "gpu": frame.gpu,
         }),
     ))
+}
+
+/// One warning per mesh whose silhouette seen from the light center folds back on itself
+/// ([`crate::geometry::penumbra_wedge::silhouette_folds`]): the zigzag that Papers I and II
+/// cannot build wedges for (the thesis's introduction, Fig. 5b: "zigzag patterns along the
+/// direction to the light source cannot be handled with the wedge generation method in I and
+/// II"). Their wedges overlap instead of partitioning the penumbra, so an eye ray adds a
+/// wedge's light without the umbra step that should cancel it — light streaks and specks
+/// inside the umbra (measured in `docs/methods.md`, "pw2002"). Shared by `pw-restructured`.
+pub fn fold_warnings(set: &WedgeSet) -> Vec<String> {
+    set.folds
+        .iter()
+        .map(|(mesh, n)| {
+            format!(
+                "mesh `{mesh}`: its silhouette seen from the light center folds back on itself \
+                 at {n} corners (a zigzag along the light direction, which Paper I's and \
+                 Paper II's wedges cannot represent); the wedges there overlap and add light \
+                 inside the umbra, so this result can be worse than hard-sv — ssv or \
+                 ssv-optimized (Paper III's wedges with per-wedge coverage) handle such \
+                 silhouettes"
+            )
+        })
+        .collect()
 }
 
 /// The plan entry of the LI buffer in format `li`.
@@ -566,5 +593,41 @@ pub fn li_buffer_plan(li: LiFormat) -> BufferPlan {
         name: "li".into(),
         format: format!("{li:?}"),
         bytes_per_sample: li.bytes() as u32,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The warnings of `method` on `scene` at 48², and its wedges' fold count.
+    fn warnings_at_48(mut scene: Scene, method: &str) -> (Vec<String>, usize) {
+        scene.resize(Some(48), Some(48));
+        let frame = Frame::render(&scene, crate::frame::GpuSettings::default()).unwrap();
+        let folds = frame_wedges(&frame, &options(&frame).unwrap())
+            .unwrap()
+            .fold_count();
+        let out = crate::methods::run(method, &frame).unwrap();
+        (out.stats.warnings, folds)
+    }
+
+    /// Spot the cow under a sphere light (`scenes/real/spot-sphere.toml`) has a zigzag
+    /// silhouette and both penumbra-wedge methods say so, naming the mesh and the count; the
+    /// tessellated spheres of `cube-of-spheres-sphere` (convex loops) do not fold.
+    #[test]
+    fn folds_are_warned_on_a_real_model_and_not_on_spheres() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/real/spot-sphere.toml");
+        for method in ["pw2002", "pw-restructured"] {
+            let scene = crate::scene::file::load_scene_file(&path).unwrap();
+            let (warnings, folds) = warnings_at_48(scene, method);
+            assert_eq!(folds, 116, "module doc of penumbra_wedge, \"Folds\"");
+            assert_eq!(warnings.len(), 1, "{warnings:?}");
+            assert!(warnings[0].contains("spot.obj"), "{}", warnings[0]);
+            assert!(warnings[0].contains("at 116 corners"), "{}", warnings[0]);
+            assert!(warnings[0].contains("ssv"), "{}", warnings[0]);
+            let spheres = crate::scene::builtin::load("cube-of-spheres-sphere").unwrap();
+            assert_eq!(warnings_at_48(spheres, method), (Vec::new(), 0));
+        }
     }
 }

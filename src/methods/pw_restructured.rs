@@ -728,6 +728,9 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let li = li_row_major(frame, &tiles);
     let (visibility, clamped) = resolve(frame, &li);
     rec.clamped(clamped.iter().filter(|&&c| c).count() as u64);
+    for w in super::pw2002::fold_warnings(&set) {
+        rec.warn(w);
+    }
     rec.dump(|| li_dump(frame, &s.wedge, &tiles, &li, clamped, "Paper II §3, §6"));
     Ok(rec.finish(
         visibility,
@@ -736,6 +739,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             "resolved": s,
             "wedges": set.wedges.len(),
             "open_wedges": set.open_wedges,
+            "silhouette_folds": set.fold_count(),
             "gpu": frame.gpu,
         }),
     ))
