@@ -1,6 +1,7 @@
 //! The shared first pass of every frame: the scene rendered into the depth buffer (D24 by
 //! default, LESS, back faces culled) with the id of the visible triangle per pixel, the
-//! per-tile hierarchical-Z bounds, and the receiver point and normal each pixel shows.
+//! per-tile hierarchical-Z bounds, and the receiver point and normal each pixel shows (the
+//! normals also as the receiver-normal buffer of `horizon = clip`, [`Frame::receiver_normals`]).
 //!
 //! Every method reads this depth buffer (Paper III §3.2.2: "p = point(x, y, z); z is the depth
 //! buffer value") and never writes it. Scene triangles are submitted mesh by mesh in file order;
