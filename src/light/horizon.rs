@@ -371,7 +371,7 @@ mod tests {
                     let dist = (c - pd).length();
                     let (g, slope, table) = match light.shape {
                         LightShape::Rect { u, v } => (
-                            n.dot(u.as_dvec3()).hypot(n.dot(v.as_dvec3())),
+                            libm::hypot(n.dot(u.as_dvec3()), n.dot(v.as_dvec3())),
                             2f64.sqrt() / 2.0,
                             0.0,
                         ),
