@@ -1,6 +1,7 @@
 //! The shared first pass of every frame: the scene rendered into the depth buffer (D24 by
 //! default, LESS, back faces culled) with the id of the visible triangle per pixel, the
-//! per-tile hierarchical-Z bounds, and the receiver point and normal each pixel shows.
+//! per-tile hierarchical-Z bounds, and the receiver point and normal each pixel shows (the
+//! normals also as the receiver-normal buffer of `horizon = clip`, [`Frame::receiver_normals`]).
 //!
 //! Every method reads this depth buffer (Paper III §3.2.2: "p = point(x, y, z); z is the depth
 //! buffer value") and never writes it. Scene triangles are submitted mesh by mesh in file order;
@@ -175,6 +176,9 @@ pub struct Frame<'s> {
     /// Per-tile bounds of [`Frame::receivers`], computed on first use
     /// ([`Frame::receiver_bounds`]).
     receiver_bounds: OnceLock<TileReceiverBounds>,
+    /// The receiver-normal buffer, row-major, computed on first use
+    /// ([`Frame::receiver_normals`]).
+    receiver_normals: OnceLock<Vec<DVec3>>,
     /// Whether methods hand back every buffer they resolved, with its event map
     /// ([`crate::methods::dump`], `--dump-buffers`); false after [`Frame::render`], set with
     /// [`Frame::dumping`].
@@ -282,6 +286,7 @@ impl<'s> Frame<'s> {
             prim_planes: OnceLock::new(),
             depth_receivers: OnceLock::new(),
             receiver_bounds: OnceLock::new(),
+            receiver_normals: OnceLock::new(),
             dump_buffers: false,
             probe: None,
         })
@@ -331,6 +336,7 @@ impl<'s> Frame<'s> {
             prim_planes: self.prim_planes.clone(),
             depth_receivers: self.depth_receivers.clone(),
             receiver_bounds: self.receiver_bounds.clone(),
+            receiver_normals: self.receiver_normals.clone(),
             dump_buffers: self.dump_buffers,
             probe: self.probe.clone(),
         }
@@ -438,6 +444,25 @@ impl<'s> Frame<'s> {
             TileReceiverBounds::new(&self.tiling, |x, y| {
                 receivers[(y * self.scene.width + x) as usize].map(|r| r.point.as_dvec3())
             })
+        })
+    }
+
+    /// The receiver-normal buffer ([`crate::gpu::normal_buffer`]): row-major, the normal of
+    /// each pixel's receiver ([`Frame::receivers`]) as the scene pass writes it to its second
+    /// render target (RGBA16F, each component rounded to fp16), zero where nothing was drawn.
+    /// Only the methods run with `horizon = clip` read it, and only they count its memory and
+    /// the scene pass's writes to it ([`crate::methods::horizon_clip`]); computed once per
+    /// frame, on first use.
+    pub fn receiver_normals(&self) -> &[DVec3] {
+        self.receiver_normals.get_or_init(|| {
+            self.receivers()
+                .par_iter()
+                .map(|r| {
+                    r.map_or(DVec3::ZERO, |r| {
+                        crate::gpu::normal_buffer::quantize(r.normal)
+                    })
+                })
+                .collect()
         })
     }
 

@@ -9,7 +9,7 @@
 //! zmin/zmax), [`hiz`] (the hierarchical-Z unit's tile rejection), [`vbuffer`] (the V-buffer formats of Paper III §4), [`pack4ub`] (8-bit values
 //! packed into 32-bit float channels, Forest et al. 2006 §4.3), [`counters`], [`probe`] (what
 //! the passes did to one pixel),
-//! [`texture`] (texel addressing and filtering), [`shader_float`] (the fragment programs'
+//! [`texture`] (texel addressing and filtering), [`normal_buffer`] (the scene pass's receiver normals), [`shader_float`] (the fragment programs'
 //! scalar at the shader precision), [`color`] (colour-buffer formats) and
 //! [`light_view`] (render targets seen from a light: shadow maps and the maps built on them).
 
@@ -22,6 +22,7 @@ pub mod fixed;
 pub mod hiz;
 pub mod li_buffer;
 pub mod light_view;
+pub mod normal_buffer;
 pub mod pack4ub;
 pub mod probe;
 pub mod raster;

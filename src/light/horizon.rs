@@ -21,34 +21,22 @@
 //! point exactly on the plane of a clipped polygon — such a light sends no light to the
 //! receiver anyway (its cosine is 0).
 
+use crate::gpu::shader_float::ShaderFloat;
+use crate::gpu::shader_vec::{SVec2, SVec3};
+use crate::gpu::texture::{linear_taps, Wrap};
 use crate::scene::{Light, LightShape};
-use glam::{DVec2, DVec3, Vec3};
+use glam::{DVec3, Vec3};
+use std::sync::OnceLock;
 
 /// The fraction in `[0, 1]` of `light`'s area in front of (or on) the plane through `point`
 /// with normal `normal` (module doc). `normal` need not be unit length but must not be zero.
 pub fn fraction_in_front(light: &Light, point: Vec3, normal: Vec3) -> f64 {
-    let n = normal.as_dvec3();
-    let p = point.as_dvec3();
-    let c = light.center.as_dvec3();
-    let d0 = n.dot(c - p);
-    match &light.shape {
-        LightShape::Point => f64::from(u8::from(d0 >= 0.0)),
-        LightShape::Rect { u, v } | LightShape::TexturedRect { u, v, .. } => {
-            square_fraction_in_front(d0, n.dot(u.as_dvec3()), n.dot(v.as_dvec3()))
-        }
-        LightShape::Disk { radius, normal: dn } => {
-            disk_fraction_in_front(d0, f64::from(*radius), n, dn.as_dvec3())
-        }
-        LightShape::Sphere { radius } => {
-            let toward = p - c;
-            let facing = if toward.length_squared() > 0.0 {
-                toward
-            } else {
-                DVec3::Z
-            };
-            disk_fraction_in_front(d0, f64::from(*radius), n, facing)
-        }
-    }
+    fraction_with::<f64>(
+        light,
+        SVec3::from_f64(point.as_dvec3()),
+        SVec3::from_f64(normal.as_dvec3()),
+        exact_segment,
+    )
 }
 
 /// Whether the plane through `point` with normal `normal` cuts `light`: part of it is in
@@ -58,44 +46,195 @@ pub fn plane_cuts_light(light: &Light, point: Vec3, normal: Vec3) -> bool {
     f > 0.0 && f < 1.0
 }
 
+/// [`fraction_in_front`] as a fragment program computes it (`horizon = clip`,
+/// [`crate::methods::horizon_clip`]): every operation rounded to the shader precision `T`
+/// ([`crate::gpu::shader_float`]), the light's parameters uniforms rounded to `T`, `point`
+/// and `normal` as the program reads them (the depth-buffer point, the normal buffer's
+/// value), and a disk's circular segment looked up in [`SegmentTable`] instead of computed
+/// with `acos`. The same arithmetic as the f64 reference otherwise (one generic function:
+/// at `T = f64` only the segment differs).
+///
+/// Its error against [`fraction_in_front`], for a unit normal and coordinates of magnitude at
+/// most `m` and a light of half-extent `h` at distance at most `D` from the point: the plane
+/// distances `d` carry a relative rounding of a few units of `ε = 2^−(mantissa bits + 1)` of
+/// `m` (the subtraction `c − p`) and of `D` (the dot product), so the clipped line moves by
+/// about `4ε·(m + D) / h` in the light's `[−1, 1]` parameters, and the fraction by at most half
+/// that per unit of the line's length (≤ 2√2), plus the segment table's error for a disk
+/// ([`SEGMENT_TABLE_MAX_ERROR`]): tested with these constants in
+/// `tests::the_shader_fraction_is_within_its_precision_bound`.
+pub fn shader_fraction_in_front<T: ShaderFloat>(light: &Light, point: DVec3, normal: DVec3) -> T {
+    let table = SegmentTable::get();
+    fraction_with::<T>(
+        light,
+        SVec3::from_f64(point),
+        SVec3::from_f64(normal),
+        |t| table.sample(t),
+    )
+}
+
+/// The fraction of `light` in front of the plane through `p` with normal `n`, in the
+/// arithmetic of `T`, a disk's circular segment of cut `t ∈ [−1, 1]` given by `segment`
+/// (module doc).
+fn fraction_with<T: ShaderFloat>(
+    light: &Light,
+    p: SVec3<T>,
+    n: SVec3<T>,
+    segment: impl Fn(T) -> T,
+) -> T {
+    let uniform = |v: Vec3| SVec3::<T>::from_f64(v.as_dvec3());
+    let c = uniform(light.center);
+    let d0 = n.dot(c - p);
+    match &light.shape {
+        LightShape::Point => in_front_or_not(d0),
+        LightShape::Rect { u, v } | LightShape::TexturedRect { u, v, .. } => {
+            square_fraction_in_front(d0, n.dot(uniform(*u)), n.dot(uniform(*v)))
+        }
+        LightShape::Disk { radius, normal: dn } => disk_fraction_in_front(
+            d0,
+            T::from_f64(f64::from(*radius)),
+            n,
+            uniform(*dn),
+            segment,
+        ),
+        LightShape::Sphere { radius } => {
+            let toward = p - c;
+            let facing = if toward.dot(toward) > T::zero() {
+                toward
+            } else {
+                SVec3::from_f64(DVec3::Z)
+            };
+            disk_fraction_in_front(d0, T::from_f64(f64::from(*radius)), n, facing, segment)
+        }
+    }
+}
+
+/// 1 when the signed distance `d` is ≥ 0, else 0.
+fn in_front_or_not<T: ShaderFloat>(d: T) -> T {
+    if d >= T::zero() {
+        T::one()
+    } else {
+        T::zero()
+    }
+}
+
 /// The fraction of the square `[-1, 1]²` where `d0 + s·ds + t·dt ≥ 0`: the square clipped by
 /// the half-plane (Sutherland–Hodgman, one edge), its area by the shoelace formula, over 4.
-fn square_fraction_in_front(d0: f64, ds: f64, dt: f64) -> f64 {
+/// With every corner in front the polygon is the square itself and the area is exactly 1 in
+/// every format (the corners' cross products are ±2).
+fn square_fraction_in_front<T: ShaderFloat>(d0: T, ds: T, dt: T) -> T {
+    let one = T::one();
     let corners = [
-        DVec2::new(-1.0, -1.0),
-        DVec2::new(1.0, -1.0),
-        DVec2::new(1.0, 1.0),
-        DVec2::new(-1.0, 1.0),
+        SVec2::new(-one, -one),
+        SVec2::new(one, -one),
+        SVec2::new(one, one),
+        SVec2::new(-one, one),
     ];
-    let d = |q: DVec2| d0 + q.x * ds + q.y * dt;
-    let mut clipped: Vec<DVec2> = Vec::with_capacity(5);
+    let zero = T::zero();
+    let d = |q: SVec2<T>| d0 + q.x * ds + q.y * dt;
+    let mut clipped: Vec<SVec2<T>> = Vec::with_capacity(5);
     for (i, &a) in corners.iter().enumerate() {
         let b = corners[(i + 1) % 4];
         let (da, db) = (d(a), d(b));
-        if da >= 0.0 {
+        if da >= zero {
             clipped.push(a);
         }
-        if (da >= 0.0) != (db >= 0.0) {
+        if (da >= zero) != (db >= zero) {
             clipped.push(a + (b - a) * (da / (da - db)));
         }
     }
-    let twice_area: f64 = (0..clipped.len())
+    let twice_area = (0..clipped.len())
         .map(|i| clipped[i].perp_dot(clipped[(i + 1) % clipped.len()]))
-        .sum();
-    (twice_area / 8.0).clamp(0.0, 1.0)
+        .fold(zero, |sum, x| sum + x);
+    (twice_area / T::from_f64(8.0)).clamp(zero, one)
 }
 
 /// The fraction of a disk (center at signed distance `d0` from the receiver's plane, `radius`,
 /// facing `disk_normal`) in front of the plane of normal `n`: the circular segment cut at
-/// `t = d0 / (radius·|n⊥|)`, of area fraction `1 − (acos t − t·√(1 − t²)) / π`.
-fn disk_fraction_in_front(d0: f64, radius: f64, n: DVec3, disk_normal: DVec3) -> f64 {
-    let dn = disk_normal.normalize();
+/// `t = d0 / (radius·|n⊥|)`, its area fraction given by `segment` (for the reference
+/// [`exact_segment`]).
+fn disk_fraction_in_front<T: ShaderFloat>(
+    d0: T,
+    radius: T,
+    n: SVec3<T>,
+    disk_normal: SVec3<T>,
+    segment: impl Fn(T) -> T,
+) -> T {
+    let dn = disk_normal * (T::one() / disk_normal.length());
     let reach = radius * (n - dn * n.dot(dn)).length();
-    if reach <= 0.0 {
-        return f64::from(u8::from(d0 >= 0.0));
+    if reach <= T::zero() {
+        return in_front_or_not(d0);
     }
-    let t = (d0 / reach).clamp(-1.0, 1.0);
+    let one = T::one();
+    segment((d0 / reach).clamp(-one, one))
+}
+
+/// The area fraction of the unit disk on the far side of the chord at signed distance `−t`
+/// from its center (the part in front of a plane the center is `t` in front of),
+/// `1 − (acos t − t·√(1 − t²)) / π`: 0 at `t = −1`, ½ at 0, 1 at 1. In f64.
+fn exact_segment(t: f64) -> f64 {
     (1.0 - (libm::acos(t) - t * libm::sqrt(1.0 - t * t)) / std::f64::consts::PI).clamp(0.0, 1.0)
+}
+
+/// The largest error of [`SegmentTable::sample`] against the exact segment at f64 (its doc).
+pub const SEGMENT_TABLE_MAX_ERROR: f64 = 7e-5;
+
+/// Texels of [`SegmentTable`].
+pub const SEGMENT_TABLE_SIZE: usize = 256;
+
+/// The circular-segment area of a disk cut by the receiver's plane, as a fragment program of
+/// `horizon = clip` reads it: a 1D texture of [`SEGMENT_TABLE_SIZE`] 16-bit unorm texels
+/// (512 bytes), linearly filtered, clamped to the edge.
+///
+/// Choice — a table rather than a polynomial: the segment fraction `g(t)` has a `(1 − t)^{3/2}`
+/// singularity at both ends (its slope `(2/π)·√(1 − t²)` has an infinite derivative there), so
+/// a low-degree polynomial in `t` is poor exactly where the horizon pixels sit, and `acos` was
+/// no instruction of the papers' GPUs (NV3x, R300); one texture fetch was. Texel `i` holds
+/// `g(t_i)` at `t_i = −1 + 2i/(N − 1)`, so the texel centers include both ends: `t = ±1` reads
+/// exactly 0 and 1 (a disk wholly in front gives exactly 1, the method's value unchanged).
+/// Its error ([`SEGMENT_TABLE_MAX_ERROR`]): the rounding to 16 bits, ≤ ½·2⁻¹⁶ ≈ 7.6·10⁻⁶, plus
+/// the linear interpolation's, largest on the end intervals where `1 − g ≈ (4√2 / 3π)·u^{3/2}`
+/// (`u = 1 − t`; the segment's area is `(4√2/3)·u^{3/2}` to first order): the chord of
+/// `u^{3/2}` over `[0, h]` is off by at most `(4/27)·h^{3/2}`, so ≤ `0.600·(4/27)·h^{3/2}` ≈
+/// 6.2·10⁻⁵ for `h = 2/255`; in the interior `h²/8·max|g″|` is smaller. In all ≤ 7·10⁻⁵
+/// (tested: `tests::the_segment_table_is_within_its_bound`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SegmentTable {
+    /// The texels, `round(g(t_i)·65535)`.
+    pub texels: Vec<u16>,
+}
+
+impl SegmentTable {
+    /// The table, built once per process (deterministic: f64, in texel order).
+    pub fn get() -> &'static Self {
+        static TABLE: OnceLock<SegmentTable> = OnceLock::new();
+        TABLE.get_or_init(|| {
+            let last = (SEGMENT_TABLE_SIZE - 1) as f64;
+            SegmentTable {
+                texels: (0..SEGMENT_TABLE_SIZE)
+                    .map(|i| {
+                        let t = -1.0 + 2.0 * i as f64 / last;
+                        (exact_segment(t) * 65535.0).round() as u16
+                    })
+                    .collect(),
+            }
+        })
+    }
+
+    /// Storage size in bytes.
+    pub fn bytes(&self) -> usize {
+        self.texels.len() * 2
+    }
+
+    /// The segment fraction at the cut `t ∈ [−1, 1]`: the texture coordinate
+    /// `(t + 1)·(N − 1)/2 + 0.5` computed in `T`, the fetch and the linear filter by the
+    /// texture unit ([`crate::gpu::texture`]), the filtered value rounded to `T`.
+    pub fn sample<T: ShaderFloat>(&self, t: T) -> T {
+        let half_span = T::from_f64((SEGMENT_TABLE_SIZE - 1) as f64 / 2.0);
+        let x = (t + T::one()) * half_span + T::from_f64(0.5);
+        let ([i, j], f) = linear_taps(x.to_f64(), SEGMENT_TABLE_SIZE as u32, Wrap::ClampToEdge);
+        let texel = |k: u32| f64::from(self.texels[k as usize]) / 65535.0;
+        T::from_f64(texel(i) * (1.0 - f) + texel(j) * f)
+    }
 }
 
 #[cfg(test)]
@@ -109,6 +248,166 @@ mod tests {
                 u: Vec3::new(1.0, 0.0, 0.0),
                 v: Vec3::new(0.0, 0.0, 1.0),
             },
+        }
+    }
+
+    use crate::gpu::shader_float::{Fp16, Fp24, Fp32, FP16, FP24, FP32};
+
+    /// The segment table against the exact segment on a fine grid, within the bound its doc
+    /// derives ([`SEGMENT_TABLE_MAX_ERROR`]), and exact at both ends.
+    #[test]
+    fn the_segment_table_is_within_its_bound() {
+        let table = SegmentTable::get();
+        assert_eq!(table.bytes(), 512);
+        assert_eq!(table.sample(1.0f64), 1.0);
+        assert_eq!(table.sample(-1.0f64), 0.0);
+        let worst = (0..=20_000)
+            .map(|k| -1.0 + k as f64 / 10_000.0)
+            .map(|t| (table.sample(t) - exact_segment(t)).abs())
+            .fold(0.0, f64::max);
+        assert!(worst <= SEGMENT_TABLE_MAX_ERROR, "{worst}");
+        // The bound is not loose: the end intervals come close to it.
+        assert!(worst >= 0.75 * SEGMENT_TABLE_MAX_ERROR, "{worst}");
+    }
+
+    /// Constructed receivers whose fraction every format computes exactly: the plane distances
+    /// are small dyadic numbers, so the clipped square's corners and area are exact.
+    #[test]
+    fn the_shader_fraction_is_exact_on_dyadic_receivers() {
+        fn check<T: ShaderFloat>() {
+            let at = |x: f64, n: DVec3| {
+                shader_fraction_in_front::<T>(&rect(), DVec3::new(x, 0.0, 0.0), n).to_f64()
+            };
+            assert_eq!(at(0.0, DVec3::X), 0.5, "{:?}", T::PRECISION);
+            assert_eq!(at(0.5, DVec3::X), 0.25);
+            assert_eq!(at(-0.5, DVec3::X), 0.75);
+            assert_eq!(at(0.0, DVec3::Y), 1.0);
+            assert_eq!(at(0.0, -DVec3::Y), 0.0);
+            // The corner triangle of legs 0.5 (1/32), with the plane s + t = 1.5 through the
+            // light's plane (x + z = 1.5, normal (1, 0, 1)/… not unit: still exact).
+            let f = shader_fraction_in_front::<T>(
+                &rect(),
+                DVec3::new(0.75, 2.0, 0.75),
+                DVec3::new(1.0, 0.0, 1.0),
+            );
+            assert_eq!(f.to_f64(), 1.0 / 32.0);
+        }
+        check::<f64>();
+        check::<Fp32>();
+        check::<Fp24>();
+        check::<Fp16>();
+    }
+
+    /// At f64 the shader's rectangle is the reference bit for bit (one generic function), and
+    /// its disk differs only by the segment table.
+    #[test]
+    fn at_f64_the_shader_is_the_reference_but_for_the_table() {
+        let disk = Light {
+            center: Vec3::new(0.0, 2.0, 0.0),
+            shape: LightShape::Disk {
+                radius: 1.0,
+                normal: -Vec3::Y,
+            },
+        };
+        for k in 0..200 {
+            let p = Vec3::new(k as f32 / 50.0 - 2.0, 1.5 + k as f32 / 400.0, 0.3);
+            let n = Vec3::new(1.0, 0.2 - k as f32 / 500.0, 0.1).normalize();
+            let s: f64 = shader_fraction_in_front(&rect(), p.as_dvec3(), n.as_dvec3());
+            assert_eq!(s.to_bits(), fraction_in_front(&rect(), p, n).to_bits());
+            let d: f64 = shader_fraction_in_front(&disk, p.as_dvec3(), n.as_dvec3());
+            assert!((d - fraction_in_front(&disk, p, n)).abs() <= SEGMENT_TABLE_MAX_ERROR);
+        }
+    }
+
+    /// The precision bound of [`shader_fraction_in_front`]'s doc, at fp32, fp24 and fp16, on
+    /// 3000 pseudo-random receivers near each light shape (fixed LCG): the error against the
+    /// f64 reference is at most `K·ε·(m + D)/g` plus the table's error for a disk, with
+    /// `ε = 2^−(mantissa bits + 1)`, `m` the largest coordinate, `D` the point's distance to
+    /// the light's center and `g` the plane's gradient over the light's parameters (`|∇d|`
+    /// over `[−1, 1]²`; for a disk its reach `radius·|n⊥|`): the plane distance carries about
+    /// `4ε(m + D)` of rounding, the fraction moves by at most `(2√2/4)/g` per unit of distance
+    /// (the cut's length over the square's area; `(2/π)/g` for a disk), and `K = 4` covers
+    /// both with a factor of 2 for the clipping and area arithmetic.
+    #[test]
+    fn the_shader_fraction_is_within_its_precision_bound() {
+        fn worst<T: ShaderFloat>(eps: f64) -> f64 {
+            let lights = [
+                rect(),
+                Light {
+                    center: Vec3::new(0.3, 2.5, -0.2),
+                    shape: LightShape::Disk {
+                        radius: 0.7,
+                        normal: Vec3::new(0.2, -1.0, 0.1).normalize(),
+                    },
+                },
+                Light {
+                    center: Vec3::new(-0.4, 3.0, 0.5),
+                    shape: LightShape::Sphere { radius: 0.5 },
+                },
+            ];
+            let mut state = 12345u64;
+            let mut next = || {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+            };
+            let mut worst = 0.0f64;
+            for light in &lights {
+                for _ in 0..1000 {
+                    let p = Vec3::new(
+                        (2.0 * next()) as f32,
+                        (1.0 + next()) as f32,
+                        (2.0 * next()) as f32,
+                    );
+                    let n = crate::gpu::normal_buffer::quantize(
+                        Vec3::new(next() as f32, next() as f32, next() as f32).normalize(),
+                    );
+                    let reference = fraction_in_front(light, p, n.as_vec3());
+                    let shader: T = shader_fraction_in_front(light, p.as_dvec3(), n);
+                    let c = light.center.as_dvec3();
+                    let pd = p.as_dvec3();
+                    let m = c.abs().max_element().max(pd.abs().max_element());
+                    let dist = (c - pd).length();
+                    let (g, slope, table) = match light.shape {
+                        LightShape::Rect { u, v } => (
+                            libm::hypot(n.dot(u.as_dvec3()), n.dot(v.as_dvec3())),
+                            2f64.sqrt() / 2.0,
+                            0.0,
+                        ),
+                        LightShape::Disk { radius, normal } => {
+                            let dn = normal.as_dvec3();
+                            (
+                                f64::from(radius) * (n - dn * n.dot(dn)).length(),
+                                2.0 / std::f64::consts::PI,
+                                SEGMENT_TABLE_MAX_ERROR,
+                            )
+                        }
+                        LightShape::Sphere { radius } => {
+                            let dn = (pd - c).normalize();
+                            (
+                                f64::from(radius) * (n - dn * n.dot(dn)).length(),
+                                2.0 / std::f64::consts::PI,
+                                SEGMENT_TABLE_MAX_ERROR,
+                            )
+                        }
+                        _ => unreachable!(),
+                    };
+                    let bound = 4.0 * 4.0 * eps * (m + dist) * slope / g + table + 4.0 * eps;
+                    let err = (shader.to_f64() - reference).abs();
+                    worst = worst.max(err / bound);
+                }
+            }
+            worst
+        }
+        let eps =
+            |f: crate::gpu::shader_float::FloatFormat| libm::ldexp(1.0, -(f.mantissa_bits + 1));
+        for (name, w) in [
+            ("fp32", worst::<Fp32>(eps(FP32))),
+            ("fp24", worst::<Fp24>(eps(FP24))),
+            ("fp16", worst::<Fp16>(eps(FP16))),
+        ] {
+            assert!(w <= 1.0, "{name}: error / bound = {w}");
         }
     }
 

@@ -18,6 +18,7 @@ macro_rules! field_sum {
 pub mod dbuffer;
 pub mod dump;
 pub mod hard_sv;
+pub mod horizon_clip;
 pub mod light_average;
 pub mod nsample;
 pub mod output;

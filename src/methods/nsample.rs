@@ -20,14 +20,17 @@
 //! visibility is rounded from (`clamp(sum, 0, 1)` to f32) — with the stencil's overflow
 //! events summed over the sample passes. The per-sample stencils are not kept.
 //!
-//! Options: `n` (a perfect square, 1…4096, default 1024), and `mode`, `stencil`, `submission` as
-//! for `hard-sv`; `mode = auto` chooses z-fail when the near plane is in the shadow of the
+//! Options: `n` (a perfect square, 1…4096, default 1024), `horizon`
+//! ([`super::horizon_clip`]: with `clip` the averaged visibility is limited to the part of the
+//! light in front of the receiver's plane), and `mode`, `stencil`, `submission` as for
+//! `hard-sv`; `mode = auto` chooses z-fail when the near plane is in the shadow of the
 //! light center or of the shape's extreme points ([`crate::geometry::near_plane::representative_light_points`]).
 
 use super::dump::{row_major, BufferDump, DumpValues, ElementFormat, EventMap};
 use super::hard_sv::{
     stencil_event_kind, stencil_shadow, HardSvOptions, ShadowTest, StencilShadowSettings,
 };
+use super::horizon_clip::{clip_to_horizon, HorizonKeys};
 use super::output::MethodOutput;
 use crate::error::InputError;
 use crate::frame::{Frame, BACKGROUND};
@@ -67,6 +70,7 @@ option_table! {
     /// `[options.nsample]` (module doc): those of `hard-sv` and the sample count.
     pub struct NsampleOptions["nsample"] {
         ..shadow: HardSvOptions,
+        ..horizon: HorizonKeys,
         /// light samples: the centers of √n×√n strata (a perfect square)
         n: u32 [1..=4096] = DEFAULT_SAMPLES;
     }
@@ -290,6 +294,8 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
                 "the lit samples' weights, clamped to [0, 1], as f32"
             })
     });
+    let horizon = NsampleOptions::read(scene)?.horizon;
+    let (visibility, horizon) = clip_to_horizon(&mut rec, horizon, visibility);
     rec.dump(|| {
         let channels = if colored { 3 } else { 1 };
         let sums = rows.iter().flat_map(|p| p[..channels].to_vec()).collect();
@@ -310,6 +316,6 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     });
     Ok(rec.finish(
         visibility,
-        serde_json::json!({ "n": samples.len(), "pattern": "centered", "mode": mode.written(), "resolved": settings, "colored": colored, "gpu": frame.gpu }),
+        serde_json::json!({ "n": samples.len(), "pattern": "centered", "mode": mode.written(), "resolved": settings, "colored": colored, "horizon": horizon, "gpu": frame.gpu }),
     ))
 }

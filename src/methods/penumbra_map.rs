@@ -114,6 +114,7 @@
 use super::dump::{
     color_values, depth_values, row_major, BufferDump, ElementFormat, EventKind, EventMap,
 };
+use super::horizon_clip::{clip_to_horizon, HorizonKeys};
 use super::output::MethodOutput;
 use crate::error::InputError;
 use crate::frame::Frame;
@@ -235,6 +236,7 @@ option_table! {
     /// `[options.penumbra-map]` (module doc).
     pub struct PenumbraMapOptions["penumbra-map"] {
         ..maps: ShadowMapKeys,
+        ..horizon: HorizonKeys,
         /// where the bias applies: drawing the shadow map, or the screen pass's shadow test
         bias_stage: BiasStage = BiasStage::Render;
         /// triangles per cone at a silhouette vertex
@@ -811,6 +813,8 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let r = render(frame, &s)?;
     r.passes.iter().cloned().for_each(|p| rec.record_pass(p));
     rec.dump_all(|| map_dumps(&r, &s));
+    let horizon = PenumbraMapOptions::read(frame.scene)?.horizon;
+    let (visibility, horizon) = clip_to_horizon(&mut rec, horizon, r.visibility);
     let settings = serde_json::json!({
         "settings": s,
         "light_view": {
@@ -828,9 +832,10 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         "penumbra_triangles": r.geometry.triangles.len(),
         "program": r.program,
         "screen": r.screen,
+        "horizon": horizon,
         "gpu": frame.gpu,
     });
-    Ok(rec.finish(r.visibility, settings))
+    Ok(rec.finish(visibility, settings))
 }
 
 /// The dumps of the shadow map and the penumbra map (module doc).

@@ -157,6 +157,13 @@ impl<'f, 's> PassRecorder<'f, 's> {
         self.passes.push(stats);
     }
 
+    /// Add `c` to the frame's scene pass, the first pass recorded: the work of a render target
+    /// the scene pass writes only for this method (the receiver normals of `horizon = clip`,
+    /// [`crate::methods::horizon_clip`]), counted only in the runs that read it.
+    pub fn count_in_scene_pass(&mut self, c: Counters) {
+        self.passes[0].counters += c;
+    }
+
     /// Allocate a buffer with `alloc` and record `plan` for it, in allocation order.
     pub fn allocate<B>(&mut self, plan: BufferPlan, alloc: impl FnOnce() -> B) -> B {
         self.buffers.push(plan);

@@ -67,6 +67,7 @@ use super::dump::{row_major, BufferDump, ElementFormat, EventKind, EventMap, VBu
 use super::hard_sv::stencil_dump;
 use super::hard_sv::{shadow_test, stencil_row_major, stencil_shadow, ShadowTest, StencilOverflow};
 use super::hard_sv::{StencilShadowSettings, Submission};
+use super::horizon_clip::{clip_to_horizon, HorizonKeys};
 use super::output::MethodOutput;
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, Receiver, FULL_SCREEN};
@@ -160,6 +161,7 @@ option_names! {
 option_table! {
     /// `[options.ssv]` (module doc).
     pub struct SsvOptions["ssv"] {
+        ..horizon: HorizonKeys,
         /// count pass 1 z-pass or z-fail; auto: z-fail when the near plane is in the light center's shadow
         mode: CountMode = CountMode::Auto;
         /// coverage of an edge: exact clipping (Paper III §3.2.2) or the 4D coverage texture (§3.3; rectangle lights)
@@ -880,10 +882,13 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let mut rec = PassRecorder::new(frame, "ssv");
     let (settings, mode) = read_settings(frame)?;
     let r = render(&mut rec, &settings);
+    let horizon = SsvOptions::read(frame.scene)?.horizon;
+    let (visibility, horizon) = clip_to_horizon(&mut rec, horizon, r.visibility);
     Ok(rec.finish(
-        r.visibility,
+        visibility,
         serde_json::json!({
             "mode": mode.written(),
+            "horizon": horizon,
             "resolved": settings,
             "wedges": r.wedges.0,
             "wedges_full_screen": r.wedges.1,

@@ -99,6 +99,7 @@
 use super::dump::{
     receiver_pixels, row_major, BufferDump, DumpValues, ElementFormat, EventKind, EventMap,
 };
+use super::horizon_clip::{clip_to_horizon, HorizonKeys};
 use super::output::MethodOutput;
 use crate::error::InputError;
 use crate::frame::{Frame, BACKGROUND};
@@ -401,6 +402,7 @@ option_names! {
 option_table! {
     /// `[options.ssv-optimized]` (module doc).
     pub struct SsvOptimizedOptions["ssv-optimized"] {
+        ..horizon: HorizonKeys,
         /// coverage in the shaders: the paper's lookup tables (Paper IV §4.2) or exact arithmetic
         coverage: CoverageKind = CoverageKind::Tables;
         /// filter of the area table (coverage = tables)
@@ -1212,8 +1214,10 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         );
         Ok::<_, InputError>(vis)
     })?;
+    let horizon = SsvOptimizedOptions::read(frame.scene)?.horizon;
+    let (visibility, horizon) = clip_to_horizon(&mut rec, horizon, Visibility::Gray(vis));
     Ok(rec.finish(
-        Visibility::Gray(vis),
-        serde_json::json!({ "resolved": s, "gpu": frame.gpu }),
+        visibility,
+        serde_json::json!({ "resolved": s, "horizon": horizon, "gpu": frame.gpu }),
     ))
 }

@@ -29,6 +29,7 @@ mod golden;
 mod hard_case_catalog;
 mod hard_shadow_volumes;
 mod hiz;
+mod horizon_clip;
 mod multi_light;
 mod optimized_ssv;
 mod options;

@@ -1,0 +1,146 @@
+//! `horizon = off | clip` measured (`docs/horizon.md`): for each method that has the key, its
+//! mean |e| against `raycast` on the *horizon receivers* (whose tangent plane cuts the light,
+//! [`plane_cuts_light`]) and on the receivers that see the whole light, with `off`, with
+//! `clip` (`min(v, f)`, what the methods do) and with the product `v·f` (the candidate
+//! `clip` was chosen over, computed here from `off` and the same fragment program's `f`).
+//! The reference's own noise on each class is the mean |e| between two `raycast` seeds.
+//!
+//! `cargo run --release --example horizon_measure [SIZE] [SCENE…]` (default 256,
+//! `cube-of-spheres` and `scenes/real/*.toml`; a scene is a built-in name or a file).
+
+use penumbra::frame::Frame;
+use penumbra::gpu::shader_float::ShaderFloat;
+use penumbra::light::horizon::{fraction_in_front, plane_cuts_light, shader_fraction_in_front};
+use penumbra::methods;
+use penumbra::scene::file::load_scene_file;
+use penumbra::scene::{builtin, Scene};
+use penumbra::visibility::Visibility;
+use std::path::Path;
+
+/// The methods with the `horizon` key, and their options for this measurement.
+const METHODS: &[(&str, &[&str])] = &[
+    ("nsample", &["nsample.n=256"]),
+    ("ssv", &[]),
+    ("ssv-optimized", &[]),
+    ("penumbra-map", &[]),
+];
+
+/// Mean |a − b| over the pixels `mask` selects.
+fn mean_abs(a: &Visibility, b: &Visibility, mask: &[bool]) -> f64 {
+    let (sum, n) = mask
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| **m)
+        .fold((0.0, 0usize), |(s, n), (i, _)| {
+            (s + f64::from((a.gray(i) - b.gray(i)).abs()), n + 1)
+        });
+    sum / n.max(1) as f64
+}
+
+fn load(name: &str) -> Result<Scene, String> {
+    match builtin::load(name) {
+        Some(s) => Ok(s),
+        None => load_scene_file(Path::new(name)).map_err(|e| e.to_string()),
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let size: u32 = args.first().and_then(|a| a.parse().ok()).unwrap_or(256);
+    let mut scenes: Vec<String> = args.iter().skip(1).cloned().collect();
+    if scenes.is_empty() {
+        scenes.push("cube-of-spheres".into());
+        let mut real: Vec<String> = std::fs::read_dir("scenes/real")
+            .expect("scenes/real")
+            .filter_map(|e| e.ok().map(|e| e.path().display().to_string()))
+            .filter(|p| p.ends_with(".toml"))
+            .collect();
+        real.sort();
+        scenes.extend(real);
+    }
+    println!(
+        "| scene | light | method | horizon px | whole-light px | off: horizon | clip: horizon | v·f: horizon | off: whole | clip: whole | v·f: whole | raycast noise: horizon / whole |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for name in scenes {
+        let mut scene = match load(&name) {
+            Ok(s) => s,
+            Err(e) => {
+                eprintln!("{name}: skipped: {e}");
+                continue;
+            }
+        };
+        scene.resize(Some(size), Some(size));
+        let gpu = penumbra::render::gpu_settings(&scene).expect("gpu options");
+        let frame = Frame::render(&scene, gpu).expect("scene renders");
+        let light = scene.light().clone();
+        let receivers = frame.receivers();
+        let fraction: Vec<Option<f64>> = receivers
+            .iter()
+            .map(|r| r.map(|r| fraction_in_front(&light, r.point, r.normal)))
+            .collect();
+        let horizon: Vec<bool> = receivers
+            .iter()
+            .map(|r| r.is_some_and(|r| plane_cuts_light(&light, r.point, r.normal)))
+            .collect();
+        let whole: Vec<bool> = fraction.iter().map(|f| *f == Some(1.0)).collect();
+        let reference = methods::run("raycast", &frame).expect("raycast").visibility;
+        let mut reseeded = scene.clone();
+        reseeded.set_cli_option("raycast.seed=1").unwrap();
+        let noise = methods::run("raycast", &frame.lit_by(&reseeded))
+            .expect("raycast")
+            .visibility;
+        let normals = frame.receiver_normals();
+        for (method, opts) in METHODS {
+            if !methods::supports_scene(method, &scene) {
+                continue;
+            }
+            let with = |extra: Option<&str>| {
+                let mut s = scene.clone();
+                for o in opts.iter().copied().chain(extra) {
+                    s.set_cli_option(o).unwrap();
+                }
+                s
+            };
+            let (off_scene, clip_scene) =
+                (with(None), with(Some(&format!("{method}.horizon=clip"))));
+            let off = methods::run(method, &frame.lit_by(&off_scene))
+                .expect("off")
+                .visibility;
+            let clip = methods::run(method, &frame.lit_by(&clip_scene))
+                .expect("clip")
+                .visibility;
+            let product = Visibility::Gray(
+                (0..off.len())
+                    .map(|i| match receivers[i] {
+                        None => off.gray(i),
+                        Some(r) => {
+                            let f = shader_fraction_in_front::<f64>(
+                                &light,
+                                r.point.as_dvec3(),
+                                normals[i],
+                            );
+                            (f64::from(off.gray(i)) * f.to_f64()) as f32
+                        }
+                    })
+                    .collect(),
+            );
+            let e = |v: &Visibility, m: &[bool]| mean_abs(v, &reference, m);
+            println!(
+                "| {} | {} | {method} | {} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} / {:.4} |",
+                Path::new(&name).file_stem().unwrap().to_string_lossy(),
+                light.shape.type_name(),
+                horizon.iter().filter(|h| **h).count(),
+                whole.iter().filter(|h| **h).count(),
+                e(&off, &horizon),
+                e(&clip, &horizon),
+                e(&product, &horizon),
+                e(&off, &whole),
+                e(&clip, &whole),
+                e(&product, &whole),
+                mean_abs(&noise, &reference, &horizon),
+                mean_abs(&noise, &reference, &whole),
+            );
+        }
+    }
+}
