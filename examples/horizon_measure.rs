@@ -23,6 +23,10 @@ const METHODS: &[(&str, &[&str])] = &[
     ("ssv", &[]),
     ("ssv-optimized", &[]),
     ("penumbra-map", &[]),
+    ("pw2002", &[]),
+    ("pw-restructured", &[]),
+    ("wedge-blending", &[]),
+    ("dbuffer", &[]),
 ];
 
 /// Mean |a − b| over the pixels `mask` selects.

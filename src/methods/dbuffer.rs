@@ -158,6 +158,7 @@
 
 use super::dump::{color_values, row_major, BufferDump, DumpValues, ElementFormat};
 use super::dump::{EventKind, EventMap};
+use super::horizon_clip::{clip_to_horizon, HorizonKeys};
 use super::output::MethodOutput;
 use super::penumbra_map::ShadowMapKeys;
 use crate::error::InputError;
@@ -253,6 +254,7 @@ option_table! {
     /// and the method's own.
     pub struct DBufferOptions["dbuffer"] {
         ..maps: ShadowMapKeys,
+        ..horizon: HorizonKeys,
         /// storage of the four distance channels
         storage: ColorFormat [&[ColorFormat::F32, ColorFormat::F16]] = ColorFormat::F32;
         /// V(t): 3t² − 2t³ (CGI 2004 eq. 4) or √t (§6.2, for occluders smaller than the light)
@@ -1129,7 +1131,10 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         }
     }
     rec.dump_all(|| dbuffer_dumps(frame, &r, &s));
+    let keys = DBufferOptions::read(frame.scene)?.horizon;
+    let (visibility, horizon) = clip_to_horizon(&mut rec, keys, r.visibility.clone());
     let settings = serde_json::json!({
+        "horizon": horizon,
         "settings": s,
         "light_view": {
             "axis": r.view.axis.to_array(),
@@ -1147,7 +1152,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         "several_crossings": r.several_crossings,
         "gpu": frame.gpu,
     });
-    Ok(rec.finish(r.visibility, settings))
+    Ok(rec.finish(visibility, settings))
 }
 
 /// The warning for `n` receiver pixels whose texel's ray crosses a volume of the mesh `object`

@@ -100,7 +100,8 @@ fn limit<T: ShaderFloat>(v: f32, f: T) -> f32 {
 /// number of receivers it lowered.
 fn clip_with<T: ShaderFloat>(rec: &mut PassRecorder, visibility: Visibility) -> (Visibility, u64) {
     let frame: &Frame = rec.frame();
-    let light = frame.scene.light();
+    let lights = &frame.scene.lights;
+    let share = T::from_f64(1.0 / lights.len() as f64);
     let normals = frame.receiver_normals();
     rec.uses(BufferPlan {
         name: "receiver normals".into(),
@@ -126,7 +127,16 @@ fn clip_with<T: ShaderFloat>(rec: &mut PassRecorder, visibility: Visibility) -> 
                 };
                 count!(c.fragments_shaded += 1);
                 count!(c.color_read_bytes += u64::from(normal_buffer::BYTES_PER_PIXEL));
-                let f = shader_fraction_in_front::<T>(light, r.point.as_dvec3(), normals[i]);
+                // Several lights in one pass (Paper I §7's equal shares, `pw2002` and
+                // `pw-restructured`): the mean of their fractions, the part of all the light
+                // in front; one light: its fraction, bit for bit.
+                let fraction = |l| shader_fraction_in_front::<T>(l, r.point.as_dvec3(), normals[i]);
+                let f = match lights.as_slice() {
+                    [one] => fraction(one),
+                    many => {
+                        many.iter().fold(T::zero(), |sum, l| sum + fraction(l)) * share
+                    }
+                };
                 let out = v.map(|x| limit(x, f));
                 *limited += u64::from(out != v);
                 if let Some(tap) = tap {

@@ -46,6 +46,7 @@
 //! its wraps or saturations per pixel and the pixels the resolve clamps ([`li_dump`]).
 
 use super::dump::{li_values, row_major, BufferDump, ElementFormat, EventKind, EventMap};
+use super::horizon_clip::{clip_to_horizon, HorizonKeys};
 use super::output::MethodOutput;
 use super::Falloff;
 use crate::error::InputError;
@@ -183,6 +184,7 @@ option_table! {
     /// `[options.pw2002]` (module doc).
     pub struct Pw2002Options["pw2002"] {
         ..wedges: WedgeKeys,
+        ..horizon: HorizonKeys,
         /// values at a wedge's entry and exit points: computed (Paper I §4) or 255/0 with side planes cancelling (§5)
         side_planes: SidePlanes = SidePlanes::Compute;
         /// the hierarchical-Z unit's zmax rejection of wedge faces behind every receiver of a tile (needs [options.gpu] hiz = on; Paper I ran without it; the same image either way)
@@ -550,9 +552,12 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         rec.warn(w);
     }
     rec.dump(|| li_dump(frame, &s, &tiles, &li, clamped, "Paper I §4"));
+    let keys = Pw2002Options::read(frame.scene)?.horizon;
+    let (visibility, horizon) = clip_to_horizon(&mut rec, keys, visibility);
     Ok(rec.finish(
         visibility,
         serde_json::json!({
+            "horizon": horizon,
             "settings": s,
             "wedges": set.wedges.len(),
             "extra_corner_wedges": set.extra_wedges,

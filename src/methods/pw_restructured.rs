@@ -77,6 +77,7 @@
 //! algorithm never visits side planes, it is the `cancel` form by construction) plus `passes = single|three`, `culling = zmin-zmax|zmax|off`,
 //! `mode = auto|zpass|zfail`.
 
+use super::horizon_clip::{clip_to_horizon, HorizonKeys};
 use super::output::MethodOutput;
 use super::pw2002::{
     frame_wedges, li_buffer_plan, li_dump, li_row_major, resolve, wedge_primitive, MultiLight,
@@ -162,6 +163,7 @@ option_table! {
     /// `[options.pw-restructured]` (module doc).
     pub struct PwRestructuredOptions["pw-restructured"] {
         ..wedges: WedgeKeys,
+        ..horizon: HorizonKeys,
         /// umbra and penumbra in one pass (Paper II §6.2), or stencil, stencil, penumbra (§6.1)
         passes: Passes = Passes::Single;
         /// tile occlusion culling (Paper II §4): zmin and zmax with the box test, zmax only, or none
@@ -732,10 +734,13 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         rec.warn(w);
     }
     rec.dump(|| li_dump(frame, &s.wedge, &tiles, &li, clamped, "Paper II §3, §6"));
+    let keys = PwRestructuredOptions::read(frame.scene)?.horizon;
+    let (visibility, horizon) = clip_to_horizon(&mut rec, keys, visibility);
     Ok(rec.finish(
         visibility,
         serde_json::json!({
             "mode": mode.written(),
+            "horizon": horizon,
             "resolved": s,
             "wedges": set.wedges.len(),
             "open_wedges": set.open_wedges,

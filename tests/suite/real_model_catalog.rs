@@ -23,7 +23,10 @@
 //! 0.0007 at 64², hard-sv 0.011; the issue measured its failure on another placement and
 //! light), so it needs no pin. A
 //! scene or method without an entry fails the test with a message naming it and its measured
-//! error.
+//! error. And issue 28's rule is checked on every scene: a method whose whole-light error is
+//! above `hard-sv`'s there must carry a warning (`penumbra-map` aside: it darkens outward by
+//! design) — pw2002 and pw-restructured warn about the folds of the silhouette, dbuffer about
+//! receivers whose ray crosses its volumes more than once.
 //!
 //! **The reference** is `raycast` with its default [`REFERENCE_SAMPLES`] = 1024 jittered
 //! stratified samples. Its own noise — the same reference with the next seed — is measured on
@@ -326,6 +329,22 @@ fn every_real_model_renders_with_every_method_within_its_bound() {
             });
         }
         assert!(hard.is_finite(), "{name}: hard-sv runs on every light");
+        // Issue 28's rule: no method is silently worse than the hard shadow on receivers that
+        // see the whole light — where one is, it warns (penumbra-map aside: it darkens
+        // outward by design, Wyman & Hansen).
+        for row in rows.iter().filter(|r| {
+            r.scene == name
+                && !r.method.starts_with('(')
+                && r.method != "hard-sv"
+                && r.method != "penumbra-map"
+        }) {
+            if row.whole_light > hard && row.warnings == 0 {
+                failures.push(format!(
+                    "{name} {}: whole-light mean |e| {:.5} > hard-sv's {hard:.5} and no warning",
+                    row.method, row.whole_light
+                ));
+            }
+        }
         for row in rows
             .iter()
             .filter(|r| r.scene == name && !r.method.starts_with('('))

@@ -134,6 +134,7 @@ pub mod vbuffer;
 
 use super::dump::{row_major, BufferDump, DumpValues, ElementFormat, EventKind, EventMap};
 use super::hard_sv::{shadow_test, volume_stencil_state, ShadowTest, StencilOverflow};
+use super::horizon_clip::{clip_to_horizon, HorizonKeys};
 use super::output::MethodOutput;
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, FULL_SCREEN};
@@ -240,6 +241,7 @@ option_names! {
 option_table! {
     /// `[options.wedge-blending]` (module doc).
     pub struct WedgeBlendingOptions["wedge-blending"] {
+        ..horizon: HorizonKeys,
         /// vBuffer storage: PK4UB-packed 8-bit values in two RGBA32F targets (Forest et al. §4.3), or f32
         packing: Packing = Packing::Bit8;
         /// how the RGBA32F targets store packed patterns (packing = 8bit only)
@@ -1434,10 +1436,13 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         DumpValues::U8(r.penumbrae),
     ));
     r.dumps.into_iter().for_each(|d| rec.output(d));
+    let keys = WedgeBlendingOptions::read(frame.scene)?.horizon;
+    let (visibility, horizon) = clip_to_horizon(&mut rec, keys, Visibility::Gray(r.visibility));
     Ok(rec.finish(
-        Visibility::Gray(r.visibility),
+        visibility,
         serde_json::json!({
             "mode": mode.written(),
+            "horizon": horizon,
             "resolved": s,
             "gpu": frame.gpu,
             "buffer_bytes": footprint,
