@@ -423,7 +423,7 @@ impl std::ops::AddAssign for BlendingCounters {
     }
 }
 
-/// The passes of the method, in the order of [`BlendingRender::passes`].
+/// The passes of the method, in the order they first run and `stats.json` lists them.
 pub const PASS_NAMES: [&str; 5] = [
     "wb-shadow-volumes",
     "wb-init",
