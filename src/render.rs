@@ -11,7 +11,7 @@ use crate::metrics::horizon::{receiver_classes, HorizonSplit};
 use crate::metrics::ErrorStats;
 use crate::options::OptionTable;
 use crate::output::Comparison;
-use crate::scene::Scene;
+use crate::scene::{OptionValue, Scene};
 use crate::visibility::Visibility;
 use std::path::Path;
 
@@ -36,6 +36,10 @@ pub struct MethodRun {
     /// For the reference: its own sampling noise, the reference against itself with the next
     /// seed ([`methods::raycast::reference_noise_floor`]).
     pub noise_floor: Option<ErrorStats>,
+    /// For the scene's best method (lowest RMSE among those with a `horizon` key the scene
+    /// leaves at its default `off`): its error rerun with `horizon = clip` on the same frame
+    /// (issue 28: shown next to `off` under the table and in the report).
+    pub horizon_clip: Option<ErrorReport>,
 }
 
 /// The pipeline settings `[options.gpu]` of `scene` asks for ([`GpuOptions`]).
@@ -158,9 +162,54 @@ pub fn render_scene_dumping(
             shaded,
             error,
             noise_floor,
+            horizon_clip: None,
         });
     }
+    if let Some(best) = best_with_horizon_key(scene, &runs) {
+        let reference = runs
+            .iter()
+            .find(|r| r.method == methods::REFERENCE)
+            .map(|r| &r.output.visibility)
+            .expect("a run with an error has the reference");
+        let mut clipped = scene.clone();
+        clipped
+            .options
+            .entry(runs[best].method.clone())
+            .or_default()
+            .insert("horizon".into(), OptionValue::Str("clip".into()));
+        let out = methods::run(&runs[best].method, &frame.lit_by(&clipped))?;
+        runs[best].horizon_clip = Some(error_report(
+            &out.visibility,
+            reference,
+            methods::REFERENCE,
+            &classes,
+        ));
+    }
     Ok(runs)
+}
+
+/// The index of the run with the lowest whole-image RMSE against the reference among the
+/// methods whose option table has the `horizon` key and whose scene leaves it unset (the
+/// method [`MethodRun::horizon_clip`] is measured for), if any.
+fn best_with_horizon_key(scene: &Scene, runs: &[MethodRun]) -> Option<usize> {
+    let docs = methods::option_docs();
+    let has_key = |m: &str| {
+        docs.iter()
+            .any(|(t, keys)| *t == m && keys.iter().any(|k| k.key == "horizon"))
+    };
+    runs.iter()
+        .enumerate()
+        .filter(|(_, r)| has_key(&r.method))
+        .filter(|(_, r)| {
+            !scene
+                .options
+                .get(&r.method)
+                .is_some_and(|t| t.contains_key("horizon"))
+        })
+        .filter_map(|(i, r)| Some((i, r.error.as_ref()?.all.rmse)))
+        .filter(|(_, e)| e.is_finite())
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(i, _)| i)
 }
 
 /// Write every run's files under `dir/METHOD/`, all or nothing: the method folders appear
@@ -268,6 +317,23 @@ pub fn table_notes(scene: &Scene, runs: &[MethodRun]) -> Vec<String> {
     for r in runs {
         for w in &r.output.stats.warnings {
             notes.push(format!("warning: {}: {w}", r.method));
+        }
+    }
+    for r in runs {
+        if let (Some(off), Some(clip)) = (&r.error, &r.horizon_clip) {
+            let (a, b) = (&off.horizon_split, &clip.horizon_split);
+            notes.push(format!(
+                "horizon = clip on the best method here, {}: horizon receivers' mean |e| \
+                 {:.5} → {:.5}, whole-light {:.5} → {:.5}, RMSE {:.5} → {:.5} (default off, \
+                 the papers' arithmetic; docs/horizon.md)",
+                r.method,
+                a.horizon.mean_abs,
+                b.horizon.mean_abs,
+                a.whole_light.mean_abs,
+                b.whole_light.mean_abs,
+                off.all.rmse,
+                clip.all.rmse
+            ));
         }
     }
     let sphere = scene

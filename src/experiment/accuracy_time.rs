@@ -79,7 +79,10 @@ pub type Configuration = (&'static str, &'static [(&'static str, &'static str)])
 ///   inner-rectangle adjustment always / never, silhouettes grouped per mesh;
 /// - `penumbra-map`: its defaults (the 8-bit map, the p-buffer of its time) and an f32 map;
 /// - `dbuffer`: its defaults (smoothstep, f32 channels, interpolated distances, the corrected
-///   eq. 3), √t, f16 channels, exact distances and eq. 3 as printed.
+///   eq. 3), √t, f16 channels, exact distances and eq. 3 as printed;
+/// - every soft method once with `horizon = clip` (the receiver's own horizon, issue 28;
+///   `nsample` at n = 64, `pw2002` and `pw-restructured` with the 16-bit LI buffer, `ssv` with
+///   exact coverage and the f32 V-buffer, the others at their defaults).
 pub fn configurations() -> Vec<Configuration> {
     crate::methods::ALL
         .iter()

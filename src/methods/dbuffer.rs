@@ -1080,6 +1080,7 @@ const SWEEP: &[crate::methods::OptionPairs] = &[
     &[("storage", "f16")],
     &[("distances", "exact")],
     &[("eq3", "printed")],
+    &[("horizon", "clip")],
 ];
 
 /// `dbuffer` in the registry ([`crate::methods::ALL`]).

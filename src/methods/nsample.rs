@@ -114,6 +114,7 @@ const SWEEP: &[crate::methods::OptionPairs] = &[
     &[("n", "64")],
     &[("n", "256")],
     &[("n", "1024")],
+    &[("n", "64"), ("horizon", "clip")],
 ];
 
 /// `nsample` in the registry ([`crate::methods::ALL`]).

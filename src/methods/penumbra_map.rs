@@ -764,7 +764,7 @@ const GOLDENS: &[crate::methods::Golden] = &[
 ];
 
 /// `penumbra-map`'s configurations in the accuracy–time sweep ([`crate::methods::Method::sweep`]).
-const SWEEP: &[crate::methods::OptionPairs] = &[&[], &[("storage", "f32")]];
+const SWEEP: &[crate::methods::OptionPairs] = &[&[], &[("storage", "f32")], &[("horizon", "clip")]];
 
 /// `penumbra-map` in the registry ([`crate::methods::ALL`]).
 pub const METHOD: crate::methods::Method = crate::methods::Method {

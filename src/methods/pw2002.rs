@@ -501,7 +501,12 @@ const GOLDENS: &[crate::methods::Golden] = &[
 ];
 
 /// `pw2002`'s configurations in the accuracy–time sweep ([`crate::methods::Method::sweep`]).
-const SWEEP: &[crate::methods::OptionPairs] = &[&[("li", "16")], &[("li", "12")], &[("li", "8")]];
+const SWEEP: &[crate::methods::OptionPairs] = &[
+    &[("li", "16")],
+    &[("li", "12")],
+    &[("li", "8")],
+    &[("li", "16"), ("horizon", "clip")],
+];
 
 /// `pw2002` in the registry ([`crate::methods::ALL`]).
 pub const METHOD: crate::methods::Method = crate::methods::Method {

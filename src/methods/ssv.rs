@@ -853,6 +853,11 @@ const SWEEP: &[crate::methods::OptionPairs] = &[
         ("texture-n", "64"),
         ("filter", "quadrilinear"),
     ],
+    &[
+        ("coverage", "exact"),
+        ("vbuffer", "f32"),
+        ("horizon", "clip"),
+    ],
 ];
 
 /// `ssv` in the registry ([`crate::methods::ALL`]).

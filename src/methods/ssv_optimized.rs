@@ -1098,6 +1098,7 @@ const SWEEP: &[crate::methods::OptionPairs] = &[
     &[("light-split", "3")],
     &[("light-split", "4")],
     &[("overlap", "loops")],
+    &[("horizon", "clip")],
 ];
 
 /// `ssv-optimized` in the registry ([`crate::methods::ALL`]).

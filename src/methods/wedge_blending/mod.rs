@@ -1348,6 +1348,7 @@ const SWEEP: &[crate::methods::OptionPairs] = &[
     &[("adjust", "always")],
     &[("adjust", "never")],
     &[("silhouettes", "meshes")],
+    &[("horizon", "clip")],
 ];
 
 /// `wedge-blending` in the registry ([`crate::methods::ALL`]).
