@@ -17,6 +17,7 @@
 
 // Helpers shared by several modules.
 mod common;
+mod independent_coverage;
 mod sphere_hard_cases;
 
 mod accuracy_time;
