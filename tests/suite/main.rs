@@ -24,6 +24,7 @@ mod accuracy_time;
 mod buffer_dumps;
 mod cli_errors;
 mod dbuffer;
+mod doc_references;
 mod effects_plan;
 mod fuzz_corpus_replay;
 mod golden;
