@@ -1221,14 +1221,35 @@ mod tests {
     /// A projected edge whose line runs through the light's center to rounding, one end
     /// 2·10⁻¹⁴ from it (found by fuzzing: a receiver on the edge, so in the quad's plane): the
     /// ray through that end has a direction as short, and clipping the region beyond the
-    /// segment gave 1.7·10¹³ of the light. Whatever the region, it is part of the light.
+    /// segment gave 1.7·10¹³ of the light.
+    ///
+    /// The region, derived by hand: with `a = (−η, −1)`, `b = (−η, ε)` (`η ≈ 1.4·10⁻¹⁷`,
+    /// `ε ≈ 2.2·10⁻¹⁴`) the quad `a, b, b∞, a∞` is `{αa + βb : α, β ≥ 0, α + β ≥ 1}`: the
+    /// points left of `x = −η` inside the cone between the ray along `a` (straight down, to
+    /// `η`) and the ray along `b` (up, leaning left by `η/ε ≈ 6.6·10⁻⁴`). In the square that is
+    /// the left half (area 2) less the sliver between the ray along `b` and the `+y` axis
+    /// (`½·η/ε`) and strips of width `≤ η`: a fraction `(2 − ½ η/ε)/4 ± η` (exact rational
+    /// arithmetic on the same vertices gives 0.49991807479119554). Rounding: the clip of the
+    /// edge from `b` (W = 1) to `b∞` (W = 0) at the border T = W solves `1 − λ = ε`, a
+    /// difference of two numbers near 1, so the sliver's width is off by a relative `u/ε`
+    /// (`u = 2⁻⁵³`: 5·10⁻³) per rounding; two allowed. Measured 2.0·10⁻⁷ (0.25% of the
+    /// sliver). Checked on the region's own area — before [`square_fraction`]'s clamp — so a
+    /// value above the light, a wrong one below it, or NaN fails.
     #[test]
-    fn segment_through_the_center_covers_at_most_the_light() {
+    fn segment_through_the_center_covers_its_half_square_less_a_sliver() {
         let a = DVec2::new(-1.4153545364093077e-17, -1.0);
         let b = DVec2::new(-1.415354536409308e-17, 2.1595223208207936e-14);
+        let (eta, eps) = (-b.x, b.y);
+        let sliver = 0.5 * eta / eps / 4.0;
+        let expected = 0.5 - sliver;
+        let tolerance = 2.0 * (0.5 * f64::EPSILON / eps) * sliver + 1e-15;
         for (a, b) in [(a, b), (b, a)] {
-            let f = segment_coverage(a, b);
-            assert!((0.0..=1.0).contains(&f), "{f}");
+            let unclamped = polygon_area(&segment_region(a, b)) / 4.0;
+            assert!(
+                (unclamped - expected).abs() <= tolerance,
+                "{a} {b}: region {unclamped} vs {expected} (tolerance {tolerance})"
+            );
+            assert_eq!(segment_coverage(a, b), unclamped, "{a} {b}");
         }
     }
 
@@ -1311,10 +1332,17 @@ mod tests {
         assert!((segment_coverage(a, b) - exact.abs()).abs() < 1e-12);
     }
 
-    /// An edge through the light center from nearly opposite endpoints: the coverage is a
-    /// fraction of the light (≤ 1) whatever the rounding of `a × b`, and for an edge one
-    /// part in 10⁶ off the center it is the half-square beyond it. Before the rounding rule of
-    /// [`segment_region`], `a × b ≈ 10⁻¹⁷` gave a self-intersecting region of area 5.5.
+    /// An edge through the light center from nearly opposite endpoints: the region beyond it
+    /// is the half-square beyond its line — or empty when [`segment_region`]'s rounding rule
+    /// takes the line through the center — whatever the rounding of `a × b`. Before that rule,
+    /// `a × b ≈ 10⁻¹⁷` gave a self-intersecting region of area 5.5.
+    ///
+    /// Bound, derived: with `|a| = 0.7` and `b = −a + off·a⊥` the line passes `d ≤ 0.35·off`
+    /// from the center, so the region differs from a half-square by a strip of width `d` and
+    /// length ≤ 2√2 and by the cone's missing angle (`≤ off`) over a radius ≤ √2: at most
+    /// `(2√2·0.35 + 1)·off < 2·off` of area, `off/2` of the light; checked with `off`. The rule
+    /// empties the region only when `|a × b| = 0.49·off ≤ 16ε·0.49`, i.e. `off ≤ 16ε < 2⁻⁴⁵`.
+    /// The region's area is checked before [`square_fraction`]'s clamp, so NaN fails too.
     #[test]
     fn segments_through_the_center_never_cover_more_than_the_light() {
         let a = DVec2::new(-0.09999999999999998, 0.7666666666666666);
@@ -1327,12 +1355,13 @@ mod tests {
             for e in 1..20 {
                 let off = libm::ldexp(1.0, -3 * e);
                 let b = -a + a.perp() * off;
-                let c = segment_coverage(a, b);
-                assert!((0.0..=1.0).contains(&c), "{a} {b}: {c}");
-                if off > 1e-9 && off < 1e-5 {
-                    // The region beyond a line through (almost) the center: half the square.
-                    assert!((c - 0.5).abs() < 1e-5, "{a} {b}: {c}");
+                let unclamped = polygon_area(&segment_region(a, b)) / 4.0;
+                if unclamped == 0.0 {
+                    assert!(off < libm::ldexp(1.0, -45), "{a} {b}: empty at off {off}");
+                } else {
+                    assert!((unclamped - 0.5).abs() <= off, "{a} {b}: {unclamped}");
                 }
+                assert_eq!(segment_coverage(a, b), unclamped, "{a} {b}");
             }
         }
     }

@@ -512,7 +512,7 @@ impl BufferDump {
 }
 
 /// Row-major values of a tiled buffer: `field(tile)` is one tile's tile-major storage
-/// (`docs/architecture.md` "Tiles").
+/// (`docs/architecture.md` "Rasterization").
 pub fn row_major<T: Copy, U>(tiling: &Tiling, tiles: &[U], field: impl Fn(&U) -> &[T]) -> Vec<T> {
     tiling.gather_row_major(|t| field(&tiles[t]))
 }

@@ -376,8 +376,8 @@ fn volumes_bound_the_true_umbra_and_penumbra_of_an_l_shaped_slab() {
 /// The limit of trimming neighbours only (`umbra_penumbra` module doc, "Corners"): on the L
 /// 0.1 thick, the short vertical edges between its top and bottom edges let the quads of
 /// edges two apart cross; the farthest crossing (§4's depth test) then lies beyond the floor
-/// and inner-penumbra points come out as umbra. Pinned: every wrong point is of that kind
-/// (measured: 4 of 594 points).
+/// and inner-penumbra points come out as umbra. Pinned: every wrong point is of that kind,
+/// and there are exactly 4 of the 594 floor points (measured; a change in either count fails).
 #[test]
 fn thin_slabs_cross_quads_that_are_not_neighbours() {
     let mut l = l_slab();
@@ -389,7 +389,11 @@ fn thin_slabs_cross_quads_that_are_not_neighbours() {
     let (points, _) = volume_classes(&l, &l_light());
     let wrong: Vec<_> = points.iter().filter(|(_, t, v)| t != v).collect();
     eprintln!("{} of {} floor points wrong", wrong.len(), points.len());
-    assert!(!wrong.is_empty());
+    assert_eq!(
+        (wrong.len(), points.len()),
+        (4, 594),
+        "pin: wrong of all floor points"
+    );
     assert!(wrong
         .iter()
         .all(|(_, t, v)| *t == ShadowClass::Penumbra && *v == ShadowClass::Umbra));

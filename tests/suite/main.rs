@@ -17,12 +17,14 @@
 
 // Helpers shared by several modules.
 mod common;
+mod independent_coverage;
 mod sphere_hard_cases;
 
 mod accuracy_time;
 mod buffer_dumps;
 mod cli_errors;
 mod dbuffer;
+mod doc_references;
 mod effects_plan;
 mod fuzz_corpus_replay;
 mod golden;

@@ -45,19 +45,34 @@ fn hits(tris: &[[ClipVertex; 3]], tile: u32) -> Vec<u32> {
     tiling.to_row_major(&flat)
 }
 
-/// Whether the sample of pixel (i, j) is strictly inside the convex quad (in NDC, GL y up).
-fn strictly_inside(q: &[[f32; 2]; 4], i: u32, j: u32) -> Option<bool> {
-    let x = (i as f64 + 0.5) / W as f64 * 2.0 - 1.0;
-    let y = 1.0 - (j as f64 + 0.5) / H as f64 * 2.0;
+/// How close to an outer edge of the quad (in pixels) a sample may be classified either way:
+/// the rasterizer snaps vertices to 1/256 pixel (`gpu::fixed`), which moves each by at most
+/// 1/512 in x and y, so an edge by at most √2/512 ≈ 0.003 pixel where the sample lies
+/// between its ends, a few times that beside a vertex; the f32 viewport transform adds
+/// ~10⁻⁵ pixel. 1/64 pixel is five times the snapping and a sixty-fourth of a one-pixel shift:
+/// an edge moved by a pixel puts the samples of a strip of width 1 − 2/64 on the wrong side
+/// (`shifted_reference_fails`).
+const EDGE_BAND_PX: f64 = 1.0 / 64.0;
+
+/// Whether the sample of pixel (i, j) is strictly inside the convex quad `q` (in NDC, GL y
+/// up) moved by `shift` pixels (x right, y down), `None` within [`EDGE_BAND_PX`] of an edge.
+fn strictly_inside_shifted(q: &[[f32; 2]; 4], i: u32, j: u32, shift: [f64; 2]) -> Option<bool> {
+    // In pixels, rows down from the top: the sample of pixel (i, j) is at (i + ½, j + ½).
+    let px = |v: [f32; 2]| {
+        [
+            (v[0] as f64 + 1.0) / 2.0 * W as f64 + shift[0],
+            (1.0 - v[1] as f64) / 2.0 * H as f64 + shift[1],
+        ]
+    };
+    let (x, y) = (i as f64 + 0.5, j as f64 + 0.5);
     let mut sign = 0.0;
     let mut near_edge = false;
     for k in 0..4 {
-        let a = q[k];
-        let b = q[(k + 1) % 4];
-        let (ax, ay, bx, by) = (a[0] as f64, a[1] as f64, b[0] as f64, b[1] as f64);
+        let [ax, ay] = px(q[k]);
+        let [bx, by] = px(q[(k + 1) % 4]);
         let e = (bx - ax) * (y - ay) - (by - ay) * (x - ax);
         let len = libm::hypot(bx - ax, by - ay);
-        if (e / len).abs() < 4.0 / W as f64 {
+        if (e / len).abs() < EDGE_BAND_PX {
             near_edge = true; // within snapping distance of an outer edge: either answer is fine
         }
         if sign == 0.0 {
@@ -70,6 +85,56 @@ fn strictly_inside(q: &[[f32; 2]; 4], i: u32, j: u32) -> Option<bool> {
         None
     } else {
         Some(true)
+    }
+}
+
+/// [`strictly_inside_shifted`] with the quad where it is.
+fn strictly_inside(q: &[[f32; 2]; 4], i: u32, j: u32) -> Option<bool> {
+    strictly_inside_shifted(q, i, j, [0.0, 0.0])
+}
+
+/// The pixels of the split quad `q` (diagonal 0, tiles of 8) whose coverage contradicts
+/// [`strictly_inside_shifted`] by `shift`.
+fn contradicted_pixels(q: &[[f32; 2]; 4], shift: [f64; 2]) -> usize {
+    let v: Vec<ClipVertex> = q
+        .iter()
+        .map(|p| ClipVertex([p[0], p[1], 0.0, 1.0]))
+        .collect();
+    let counts = hits(&[[v[0], v[1], v[2]], [v[0], v[2], v[3]]], 8);
+    let mut wrong = 0;
+    for j in 0..H {
+        for i in 0..W {
+            let n = counts[(j * W + i) as usize];
+            if let Some(inside) = strictly_inside_shifted(q, i, j, shift) {
+                wrong += usize::from((n == 1) != inside);
+            }
+        }
+    }
+    wrong
+}
+
+/// The coverage property is sharp: the rasterizer's coverage of a quad agrees with the
+/// reference where it is and contradicts it on many pixels when the reference is moved by one
+/// pixel (a rasterizer with a systematic one-pixel offset would fail
+/// `split_quad_covers_each_pixel_once`) — and by a quarter pixel too. Each edge of the quad
+/// spans ≥ 10 rows or columns, so a shift across it misclassifies ≥ 10 samples per edge.
+#[test]
+fn shifted_reference_fails() {
+    let q = [[-0.5, -0.6], [0.55, -0.45], [0.4, 0.5], [-0.45, 0.62]];
+    assert_eq!(contradicted_pixels(&q, [0.0, 0.0]), 0);
+    for shift in [
+        [1.0, 0.0],
+        [-1.0, 0.0],
+        [0.0, 1.0],
+        [0.0, -1.0],
+        [0.25, 0.25],
+    ] {
+        let wrong = contradicted_pixels(&q, shift);
+        eprintln!("reference shifted by {shift:?} px: {wrong} pixels contradicted");
+        assert!(
+            wrong >= 10,
+            "shift {shift:?}: only {wrong} pixels contradicted"
+        );
     }
 }
 

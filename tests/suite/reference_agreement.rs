@@ -208,9 +208,18 @@ fn a_far_light_is_still_the_reference() {
 }
 
 /// `scenes/hard/far-sun-sphere.toml`, a sun-sized sphere light 10⁴ away (0.27°): the frame is
-/// drawn, the penumbra is thin, and every method but the penumbra map agrees with the
-/// reference within one sample's worth on all but a handful of pixels (measured: at most 3
-/// pixels over 4/255 for any of them). The penumbra map's own failure on this scene (the floor
+/// drawn, the penumbra is thin, and every method but the penumbra map differs from the
+/// reference by more than 4/255 on few pixels.
+///
+/// Derived bound: both evaluate the same receiver point per pixel, so a pixel where both
+/// values are hard (exactly 0 or 1) is one where the two classify the point as umbra or lit —
+/// no sampling or approximation error applies there, and they agree unless one of them is
+/// wrong about the geometry. So the pixels over 4/255 are at most the pixels where the
+/// reference or the method is strictly between 0 and 1 (each method's count is printed):
+/// asserted as "no hard pixel disagrees".
+/// PIN beside it (measured, not derived): at most 3 pixels over 4/255 for any method — the
+/// reference's stratified error (up to 2/k per crossing edge) exceeds 4/255, so the derived
+/// bound allows every penumbra pixel. The penumbra map's own failure on this scene (the floor
 /// slab's far edge darkened by the slab's own penumbra sheets, the same with the light at 10
 /// units) is pinned: 16 pixels.
 #[test]
@@ -233,10 +242,28 @@ fn a_sun_far_away_is_drawn_and_agreed_on() {
                 (r.output.visibility.gray(i) - reference.visibility.gray(i)).abs() > 4.0 / 255.0
             })
             .count();
+        let soft = |v: f32| v > 0.0 && v < 1.0;
+        let either_soft = (0..reference.visibility.len())
+            .filter(|&i| soft(r.output.visibility.gray(i)) || soft(reference.visibility.gray(i)))
+            .count();
+        let hard_disagreeing = (0..reference.visibility.len())
+            .filter(|&i| {
+                let (m, v) = (r.output.visibility.gray(i), reference.visibility.gray(i));
+                !soft(m) && !soft(v) && m != v
+            })
+            .count();
+        eprintln!(
+            "{}: {over} px over 4/255, derived bound {either_soft} (either soft), \
+             {hard_disagreeing} hard pixels disagreeing",
+            r.method
+        );
         if r.method == "penumbra-map" {
             assert_eq!(over, 16, "pin: penumbra-map");
         } else {
-            assert!(over <= 3, "{}: {over} px over 4/255", r.method);
+            // The derived bound, `over ≤ either_soft`, is exactly this: every pixel over
+            // 4/255 is a soft one.
+            assert_eq!(hard_disagreeing, 0, "{}: hard pixels disagree", r.method);
+            assert!(over <= 3, "pin: {}: {over} px over 4/255", r.method);
         }
     }
 }
