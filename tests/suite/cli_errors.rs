@@ -204,7 +204,7 @@ fn bad_options_and_methods() {
             "unknown option",
             &["--methods", "nsample", "--opt", "nsample.bogus=1"],
             "--opt nsample.bogus=1",
-            &["unknown option bogus for nsample; valid: mode, stencil, submission, n"],
+            &["unknown option bogus for nsample; valid: mode, stencil, submission, horizon, n"],
         ),
         (
             "not a perfect square",
