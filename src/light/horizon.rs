@@ -131,19 +131,24 @@ fn square_fraction_in_front<T: ShaderFloat>(d0: T, ds: T, dt: T) -> T {
     ];
     let zero = T::zero();
     let d = |q: SVec2<T>| d0 + q.x * ds + q.y * dt;
-    let mut clipped: Vec<SVec2<T>> = Vec::with_capacity(5);
+    // A half-plane cuts a quadrilateral into at most five corners: a fixed array, no
+    // allocation in the per-pixel program.
+    let mut clipped = [corners[0]; 5];
+    let mut n = 0;
     for (i, &a) in corners.iter().enumerate() {
         let b = corners[(i + 1) % 4];
         let (da, db) = (d(a), d(b));
         if da >= zero {
-            clipped.push(a);
+            clipped[n] = a;
+            n += 1;
         }
         if (da >= zero) != (db >= zero) {
-            clipped.push(a + (b - a) * (da / (da - db)));
+            clipped[n] = a + (b - a) * (da / (da - db));
+            n += 1;
         }
     }
-    let twice_area = (0..clipped.len())
-        .map(|i| clipped[i].perp_dot(clipped[(i + 1) % clipped.len()]))
+    let twice_area = (0..n)
+        .map(|i| clipped[i].perp_dot(clipped[(i + 1) % n]))
         .fold(zero, |sum, x| sum + x);
     (twice_area / T::from_f64(8.0)).clamp(zero, one)
 }

@@ -1133,7 +1133,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     }
     rec.dump_all(|| dbuffer_dumps(frame, &r, &s));
     let keys = DBufferOptions::read(frame.scene)?.horizon;
-    let (visibility, horizon) = clip_to_horizon(&mut rec, keys, r.visibility.clone());
+    let (visibility, horizon) = clip_to_horizon(&mut rec, keys, r.visibility);
     let settings = serde_json::json!({
         "horizon": horizon,
         "settings": s,

@@ -40,13 +40,15 @@ impl ReceiverClass {
     /// ([`fraction_in_front`] of each light: some strictly between 0 and 1 → horizon; all 1 →
     /// whole light; else facing away).
     pub fn of(lights: &[Light], point: glam::Vec3, normal: glam::Vec3) -> Self {
-        let fractions: Vec<f64> = lights
-            .iter()
-            .map(|l| fraction_in_front(l, point, normal))
-            .collect();
-        if fractions.iter().any(|&f| f > 0.0 && f < 1.0) {
+        let (mut cut, mut all_in_front) = (false, true);
+        for l in lights {
+            let f = fraction_in_front(l, point, normal);
+            cut |= f > 0.0 && f < 1.0;
+            all_in_front &= f == 1.0;
+        }
+        if cut {
             ReceiverClass::Horizon
-        } else if fractions.iter().all(|&f| f == 1.0) {
+        } else if all_in_front {
             ReceiverClass::WholeLight
         } else {
             ReceiverClass::FacingAway
