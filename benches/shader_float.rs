@@ -15,7 +15,7 @@ use std::sync::atomic::{AtomicU8, Ordering};
 static PRECISION: AtomicU8 = AtomicU8::new(0);
 
 /// A scalar whose format is chosen at run time.
-#[derive(Debug, Clone, Copy, PartialEq, PartialOrd)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, PartialOrd)]
 struct Dyn(f64);
 
 fn round(x: f64) -> f64 {

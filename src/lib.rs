@@ -98,6 +98,7 @@ mod module_graph;
 pub mod options;
 pub mod output;
 pub mod pass;
+pub mod primitives;
 pub mod probe;
 pub mod progress;
 pub mod render;

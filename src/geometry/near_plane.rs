@@ -3,6 +3,8 @@
 //! the exact f64 segment–mesh tests it is made of, which tests also use as hard-shadow ground
 //! truth.
 
+use crate::primitives::polygon_clip::clip_polygon;
+use crate::primitives::ray_triangle::segment_crosses_triangle;
 use crate::scene::{LightShape, Scene};
 use glam::{DVec3, Vec3};
 
@@ -90,8 +92,9 @@ pub fn eye_in_shadow(scene: &Scene, near: f64, lights: &[Vec3]) -> bool {
     let tris = casters_meeting_hull_box(scene, points.iter().chain(&rect).chain(&lights));
     points.iter().any(|p| {
         lights.iter().any(|l| {
-            tris.iter()
-                .any(|[a, b, c]| segment_hits_triangle(*p, *l - *p, *a, *b, *c))
+            tris.iter().any(|[a, b, c]| {
+                segment_crosses_triangle(*p, *l - *p, *a, *b - *a, *c - *a, 0.0, 1.0)
+            })
         })
     }) || rect_meets_shadow(&rect, &tris, &lights)
 }
@@ -171,7 +174,7 @@ fn rect_meets_shadow(rect: &[DVec3; 4], tris: &[[DVec3; 3]], lights: &[DVec3]) -
             }
             let mut poly = rect.to_vec();
             for (h, d) in planes {
-                poly = clip(&poly, h, d);
+                poly = clip_polygon(&poly, |p: DVec3| h.dot(p) + d);
                 if poly.len() < 3 {
                     return false;
                 }
@@ -179,22 +182,6 @@ fn rect_meets_shadow(rect: &[DVec3; 4], tris: &[[DVec3; 3]], lights: &[DVec3]) -
             area(&poly) > min_area
         })
     })
-}
-
-/// The part of the convex polygon `poly` where `h·p + d ≥ 0` (Sutherland–Hodgman).
-fn clip(poly: &[DVec3], h: DVec3, d: f64) -> Vec<DVec3> {
-    let mut out = Vec::with_capacity(poly.len() + 1);
-    for i in 0..poly.len() {
-        let (p, q) = (poly[i], poly[(i + 1) % poly.len()]);
-        let (fp, fq) = (h.dot(p) + d, h.dot(q) + d);
-        if fp >= 0.0 {
-            out.push(p);
-        }
-        if (fp >= 0.0) != (fq >= 0.0) {
-            out.push(p + (q - p) * (fp / (fp - fq)));
-        }
-    }
-    out
 }
 
 /// Whether the open segment p→q crosses a triangle of a mesh that casts shadows (not a
@@ -213,32 +200,8 @@ pub fn segment_hits_mesh(mesh: &crate::scene::Mesh, p: DVec3, q: DVec3) -> bool 
     let d = q - p;
     mesh.triangles.iter().any(|t| {
         let [a, b, c] = t.map(|i| mesh.positions[i as usize].as_dvec3());
-        segment_hits_triangle(p, d, a, b, c)
+        segment_crosses_triangle(p, d, a, b - a, c - a, 0.0, 1.0)
     })
-}
-
-/// Möller–Trumbore restricted to the open segment p + t·d, t ∈ (0, 1).
-fn segment_hits_triangle(p: DVec3, d: DVec3, a: DVec3, b: DVec3, c: DVec3) -> bool {
-    let e1 = b - a;
-    let e2 = c - a;
-    let h = d.cross(e2);
-    let det = e1.dot(h);
-    if det.abs() < 1e-300 {
-        return false;
-    }
-    let inv = 1.0 / det;
-    let s = p - a;
-    let u = s.dot(h) * inv;
-    if !(0.0..=1.0).contains(&u) {
-        return false;
-    }
-    let q = s.cross(e1);
-    let v = d.dot(q) * inv;
-    if v < 0.0 || u + v > 1.0 {
-        return false;
-    }
-    let t = e2.dot(q) * inv;
-    t > 0.0 && t < 1.0
 }
 
 #[cfg(test)]
@@ -269,28 +232,5 @@ mod tests {
         assert!(eye_in_shadow(&scene, near, &lights));
         assert!(!near_rect_meets_shadow(&scene, 0.1, &lights));
         assert!(!eye_in_shadow(&scene, 0.1, &lights));
-    }
-
-    #[test]
-    fn segment_triangle() {
-        let a = DVec3::new(-1.0, 0.0, -1.0);
-        let b = DVec3::new(1.0, 0.0, -1.0);
-        let c = DVec3::new(0.0, 0.0, 1.0);
-        let p = DVec3::new(0.0, -1.0, 0.0);
-        assert!(segment_hits_triangle(p, DVec3::new(0.0, 2.0, 0.0), a, b, c));
-        assert!(!segment_hits_triangle(
-            p,
-            DVec3::new(0.0, 0.5, 0.0),
-            a,
-            b,
-            c
-        ));
-        assert!(!segment_hits_triangle(
-            p,
-            DVec3::new(5.0, 2.0, 0.0),
-            a,
-            b,
-            c
-        ));
     }
 }

@@ -202,6 +202,7 @@ impl FloatFormat {
 /// [`ShaderFloat::from_f64`]; the f64 implementation is therefore plain f64 arithmetic.
 pub trait ShaderFloat:
     Copy
+    + Default
     + Debug
     + PartialEq
     + PartialOrd
@@ -338,7 +339,7 @@ impl ShaderFloat for f64 {
 macro_rules! rounded_float {
     ($(#[$meta:meta])* $name:ident, $format:expr, $precision:expr) => {
         $(#[$meta])*
-        #[derive(Debug, Clone, Copy, PartialEq, PartialOrd)]
+        #[derive(Debug, Clone, Copy, Default, PartialEq, PartialOrd)]
         pub struct $name(f64);
 
         impl ShaderFloat for $name {

@@ -72,6 +72,7 @@
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::shader_vec::{SVec2, SVec3, SVec4};
 use crate::light::lookup_tables::AreaShape;
+use crate::primitives::polygon_clip::{clip_polygon_into, clip_segment, clip_segment_marking};
 use crate::scene::{Light, LightShape};
 use arrayvec::ArrayVec;
 use glam::{DVec2, DVec3};
@@ -538,14 +539,6 @@ fn shader_polygon_area<T: ShaderFloat>(poly: &[SVec2<T>]) -> T {
     (T::from_f64(0.5) * twice_area).abs()
 }
 
-/// The part of a convex polygon inside the axis-aligned box `[lo, hi]` (Sutherland–Hodgman).
-pub fn clip_polygon_to_box(poly: &[DVec2], lo: DVec2, hi: DVec2) -> Vec<DVec2> {
-    let mut out = clip_polygon(poly, |p: DVec2| p.x - lo.x);
-    out = clip_polygon(&out, |p: DVec2| hi.x - p.x);
-    out = clip_polygon(&out, |p: DVec2| p.y - lo.y);
-    clip_polygon(&out, |p: DVec2| hi.y - p.y)
-}
-
 /// Signed exact coverage of the disk that the sphere light (`center`, `radius`) shows to `p` by
 /// the semi-infinite hard shadow quad of edge `e0 e1` (module doc, "Sphere lights"; Paper III
 /// §5.3): the covered area divided by the disk's area, in `[−1, 1]`, with the sign of
@@ -968,86 +961,10 @@ type Polygon<V> = ArrayVec<V, POLYGON_CAPACITY>;
 /// The most vertices a fragment program's clipped polygon can have ([`Polygon`]).
 const POLYGON_CAPACITY: usize = 42;
 
-/// One Sutherland–Hodgman step: keep the part of `poly` where `dist ≥ 0`.
-fn clip_polygon<V, T, F>(poly: &[V], dist: F) -> Vec<V>
-where
-    V: Copy + std::ops::Sub<Output = V> + std::ops::Add<Output = V> + std::ops::Mul<T, Output = V>,
-    T: ShaderFloat,
-    F: Fn(V) -> T,
-{
-    let mut out = Vec::with_capacity(poly.len() + 2);
-    clip_polygon_into(poly, dist, |x| x, |x| out.push(x));
-    out
-}
-
-/// [`clip_polygon`], handing the result's vertices in order to `emit`, and each vertex the
-/// clip creates through `cut` first.
-fn clip_polygon_into<V, T, F, M>(poly: &[V], dist: F, cut: M, mut emit: impl FnMut(V))
-where
-    V: Copy + std::ops::Sub<Output = V> + std::ops::Add<Output = V> + std::ops::Mul<T, Output = V>,
-    T: ShaderFloat,
-    F: Fn(V) -> T,
-    M: Fn(V) -> V,
-{
-    let zero = T::zero();
-    let Some(&first) = poly.first() else {
-        return;
-    };
-    // Each vertex's distance is evaluated once and carried to the next edge.
-    let d_first = dist(first);
-    let (mut a, mut da) = (first, d_first);
-    for i in 1..=poly.len() {
-        let (b, db) = match poly.get(i) {
-            Some(&b) => (b, dist(b)),
-            None => (first, d_first),
-        };
-        if da >= zero {
-            emit(a);
-        }
-        if (da >= zero) != (db >= zero) {
-            emit(cut(a + (b - a) * (da / (da - db))));
-        }
-        (a, da) = (b, db);
-    }
-}
-
-/// Clip the segment `a b` to `dist ≥ 0` in place; `None` when nothing is left.
-fn clip_segment<V, T, F>(a: &mut V, b: &mut V, dist: F) -> Option<()>
-where
-    V: Copy + std::ops::Sub<Output = V> + std::ops::Add<Output = V> + std::ops::Mul<T, Output = V>,
-    T: ShaderFloat,
-    F: Fn(V) -> T,
-{
-    clip_segment_marking(a, b, dist, |x| x)
-}
-
-/// [`clip_segment`], passing an end the clip moves through `cut`.
-fn clip_segment_marking<V, T, F, M>(a: &mut V, b: &mut V, dist: F, cut: M) -> Option<()>
-where
-    V: Copy + std::ops::Sub<Output = V> + std::ops::Add<Output = V> + std::ops::Mul<T, Output = V>,
-    T: ShaderFloat,
-    F: Fn(V) -> T,
-    M: Fn(V) -> V,
-{
-    let zero = T::zero();
-    let (da, db) = (dist(*a), dist(*b));
-    match (da >= zero, db >= zero) {
-        (true, true) => Some(()),
-        (false, false) => None,
-        (true, false) => {
-            *b = cut(*a + (*b - *a) * (da / (da - db)));
-            Some(())
-        }
-        (false, true) => {
-            *a = cut(*a + (*b - *a) * (da / (da - db)));
-            Some(())
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::primitives::polygon_clip::clip_polygon;
 
     /// [`Polygon`]'s capacity is the bound of its doc: a clip step that alternates sides at
     /// every vertex returns `⌊3n/2⌋` vertices, no clip of random polygons returns more, and six

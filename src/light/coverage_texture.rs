@@ -460,7 +460,7 @@ impl LightWeights {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::light::coverage::clip_polygon_to_box;
+    use crate::primitives::polygon_clip::clip_polygon_to_box;
 
     /// The colour-weighted area of `region` by clipping it against every light cell — the
     /// direct definition, against which the Green's-theorem sum is checked.

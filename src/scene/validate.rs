@@ -17,8 +17,10 @@
 use super::{Camera, Light, LightShape, Mesh, Scene};
 use crate::error::InputError;
 use crate::limits::{MAX_IMAGE_SIZE, MAX_LIGHTS, MIN_RECT_LIGHT_WIDTH, MIN_VFOV_DEG};
+use crate::primitives::polygon_clip::clip_polygon_to_box;
+use crate::primitives::ray_triangle::line_triangle;
 use crate::scene::adjacency;
-use glam::{DVec3, Vec3};
+use glam::{DVec2, DVec3, Vec3};
 
 /// Checks every invariant a [`Scene`] promises (see the module docs); the first violation is
 /// returned, in the order image size, camera, light, ambient, methods, meshes, light placement.
@@ -161,11 +163,11 @@ impl LightRegion {
                 let normal = u.cross(*v);
                 let (du, dv) = (v.cross(normal), normal.cross(*u));
                 let (su, tv) = (u.dot(du), v.dot(dv));
-                let st: Vec<[f64; 2]> = plane_section(c, normal, tri)
+                let st: Vec<DVec2> = plane_section(c, normal, tri)
                     .iter()
-                    .map(|q| [(*q - c).dot(du) / su, (*q - c).dot(dv) / tv])
+                    .map(|q| DVec2::new((*q - c).dot(du) / su, (*q - c).dot(dv) / tv))
                     .collect();
-                !clip_to_unit_square(st).is_empty()
+                !clip_polygon_to_box(&st, DVec2::splat(-1.0), DVec2::ONE).is_empty()
             }
         }
     }
@@ -199,28 +201,6 @@ fn closest_point_on_segment(p: DVec3, a: DVec3, b: DVec3) -> DVec3 {
     } else {
         a + d * ((p - a).dot(d) / l2).clamp(0.0, 1.0)
     }
-}
-
-/// The convex polygon `poly` (a point or a segment allowed) clipped to the square
-/// [−1, 1]² (Sutherland–Hodgman); empty when they do not meet.
-fn clip_to_unit_square(mut poly: Vec<[f64; 2]>) -> Vec<[f64; 2]> {
-    for (axis, side) in [(0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0)] {
-        let inside = |q: &[f64; 2]| q[axis] * side <= 1.0;
-        let n = poly.len();
-        let mut out = Vec::with_capacity(n + 2);
-        for i in 0..n {
-            let (p, q) = (poly[i], poly[(i + 1) % n]);
-            if inside(&p) {
-                out.push(p);
-            }
-            if n > 1 && inside(&p) != inside(&q) {
-                let t = (side - p[axis]) / (q[axis] - p[axis]);
-                out.push([p[0] + (q[0] - p[0]) * t, p[1] + (q[1] - p[1]) * t]);
-            }
-        }
-        poly = out;
-    }
-    poly
 }
 
 /// Largest f32 rounding of a stored coordinate that passes without a warning, as a fraction
@@ -547,31 +527,19 @@ enum Hit {
     Ambiguous,
 }
 
-/// Möller–Trumbore ray/triangle test in f64 (t > 0), flagging grazing hits near an edge.
+/// The ray `o + t·d`, `t > 0`, against triangle `abc` ([`line_triangle`], widened by 10⁻⁹ in
+/// barycentric coordinates), flagging grazing hits near an edge or a vertex as ambiguous; a
+/// ray within 10⁻¹² (relative) of the triangle's plane misses.
 fn ray_hits(o: DVec3, d: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Hit {
     const EPS: f64 = 1e-9;
-    let e1 = b - a;
-    let e2 = c - a;
-    let p = d.cross(e2);
-    let det = e1.dot(p);
-    let scale = e1.length() * e2.length();
-    if det.abs() <= 1e-12 * scale {
-        return Hit::No; // ray parallel to the plane (or degenerate triangle)
-    }
-    let inv = 1.0 / det;
-    let s = o - a;
-    let u = s.dot(p) * inv;
-    let q = s.cross(e1);
-    let v = d.dot(q) * inv;
-    let t = e2.dot(q) * inv;
-    if t <= 0.0 {
+    let (e1, e2) = (b - a, c - a);
+    let Some(h) = line_triangle(o, d, a, e1, e2, EPS) else {
         return Hit::No;
+    };
+    if h.det.abs() <= 1e-12 * e1.length() * e2.length() || h.t <= 0.0 {
+        return Hit::No; // parallel to the plane (or a degenerate triangle), or behind
     }
-    let w = 1.0 - u - v;
-    if u < -EPS || v < -EPS || w < -EPS {
-        return Hit::No;
-    }
-    if u <= EPS || v <= EPS || w <= EPS {
+    if h.u <= EPS || h.v <= EPS || 1.0 - h.u - h.v <= EPS {
         return Hit::Ambiguous;
     }
     Hit::Yes
@@ -955,17 +923,6 @@ mod tests {
             ),
             "{w}"
         );
-    }
-
-    #[test]
-    fn unit_square_clipping() {
-        assert!(clip_to_unit_square(vec![[2.0, 0.0], [3.0, 5.0]]).is_empty());
-        assert!(!clip_to_unit_square(vec![[2.0, 0.0], [0.0, 0.5]]).is_empty());
-        assert!(!clip_to_unit_square(vec![[0.5, 0.5]]).is_empty());
-        assert!(clip_to_unit_square(vec![[1.5, 0.5]]).is_empty());
-        // A big triangle around the square.
-        assert!(!clip_to_unit_square(vec![[-9.0, -9.0], [9.0, -9.0], [0.0, 9.0]]).is_empty());
-        assert!(clip_to_unit_square(vec![[2.0, 2.0], [3.0, 2.0], [2.0, 3.0]]).is_empty());
     }
 
     #[test]
