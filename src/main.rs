@@ -438,15 +438,8 @@ fn experiment(cmd: ExperimentCmd) -> Result<(), Box<dyn std::error::Error>> {
                     .map(|n| builtin::load(n).ok_or("missing built-in scene"))
                     .collect::<Result<_, _>>()?,
             };
-            if let Some(bad) = scenes.iter().find(|s| {
-                !penumbra::methods::supports_scene("wedge-blending", s) || s.is_multi_light()
-            }) {
-                return Err(InputError::at(
-                    &bad.source,
-                    "light",
-                    "the wedge-blending experiment needs one rect light",
-                )
-                .into());
+            for s in &scenes {
+                wedge_blending::check_scene(s)?;
             }
             print!("{}", wedge_blending::run(&scenes, size_range(size)?, &out)?);
             println!(

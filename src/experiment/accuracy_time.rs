@@ -92,7 +92,7 @@ pub fn configurations() -> Vec<Configuration> {
 
 /// The reference every configuration is measured against: `raycast` with 1024 jittered
 /// stratified samples per pixel (and the scene's other `raycast` options, e.g. its seed).
-pub const REFERENCE: Configuration = ("raycast", &[("samples", "1024")]);
+pub const REFERENCE: Configuration = (crate::methods::REFERENCE, &[("samples", "1024")]);
 
 /// Timed renders per configuration by default; the reported time is their median.
 pub const TIMING_RUNS: usize = 5;

@@ -9,14 +9,14 @@
 //!    The hard methods (`hard-sv`, `nsample`) and the reference run no fragment arithmetic
 //!    that the setting rounds and are not measured.
 //! 2. **Storage formats** at f64: each narrow buffer format against the widest format of the
-//!    same method ([`STORAGE`]: the 8-bit and f16 V-buffers of Paper III against f32, the 12-
+//!    same method ([`storage_variants`]: the 8-bit and f16 V-buffers of Paper III against f32, the 12-
 //!    and 8-bit LI buffers of Paper I against 16 bits, Paper IV's split V-buffer with fewer or
 //!    more carry bits against the paper's 5, Paper IV's 16-bit float position buffer against
 //!    positions from depth, wedge blending's packed 8-bit vBuffer against f32), and the depth formats D16 and D32F against D24 for every rasterized method, with
 //!    the pixels whose visibility *flips* (|Δ| > ½).
 //! 3. **Overflow**: the stacked-quad family [`overlap_stack`] (N = 1…512 two-sided quads 0.002
 //!    apart; a point light for the stencil, a sphere for the LI buffers, a rectangle for the
-//!    V-buffers; [`OVERFLOW_CONFIGS`], [`STACK_SIZES`]) rendered with buffer dumps, so that every
+//!    V-buffers; [`overflow_configs`], [`STACK_SIZES`]) rendered with buffer dumps, so that every
 //!    wrap, saturation and non-finite value is recorded where it happens
 //!    ([`crate::methods::dump::EventMap`]). A pixel is **corrupted** when its buffers recorded
 //!    an overflow event *and* its visibility is off `raycast` (256 samples) by more than ½.
@@ -45,13 +45,13 @@ use crate::gpu::depth::DepthFormat;
 use crate::gpu::shader_float::{ShaderPrecision, FP16, FP24, FP32};
 use crate::methods::dump::BufferDump;
 use crate::methods::output::MethodOutput;
+pub use crate::methods::precision_spec::StackLight;
 use crate::metrics::error_report::{in_penumbra, signed_error_map};
 use crate::metrics::{compare, compare_where, ErrorStats};
 use crate::options::OptionType;
 use crate::scene::builtin::overlap_stack;
-use crate::scene::{LightShape, Scene};
+use crate::scene::Scene;
 use crate::visibility::Visibility;
-use glam::Vec3;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::fmt::Write as _;
@@ -68,13 +68,14 @@ pub const DEFAULT_SIZE: u32 = 128;
 pub const STACK_IMAGE: u32 = 40;
 /// Light samples of the overflow study's reference.
 pub const STACK_REFERENCE_SAMPLES: &str = "256";
-/// The methods with no fragment arithmetic the shader precision rounds: the reference and
-/// the hard-shadow stencil methods. Every other method is measured in part 1.
-pub const NO_SHADER_ARITHMETIC: [&str; 3] = ["raycast", "nsample", "hard-sv"];
-
-/// The soft methods, whose fragment programs the shader precision rounds.
+/// The soft methods, whose fragment programs the shader precision rounds
+/// ([`PrecisionSpec::shader_arithmetic`](crate::methods::precision_spec::PrecisionSpec)); the
+/// reference and the stencil-only hard-shadow methods are not measured in part 1.
 pub fn shader_methods() -> impl Iterator<Item = &'static str> {
-    crate::methods::names().filter(|m| !NO_SHADER_ARITHMETIC.contains(m))
+    crate::methods::ALL
+        .iter()
+        .filter(|m| m.precision.shader_arithmetic)
+        .map(|m| m.name)
 }
 
 /// The rasterized methods whose depth formats are compared (every method but the ray tracer).
@@ -102,60 +103,21 @@ pub struct StorageVariant {
     pub wide: &'static str,
 }
 
-impl StorageVariant {
-    /// `method`'s `key = narrow` measured against `key = wide`.
-    pub const fn of(
-        method: &'static str,
-        key: &'static str,
-        narrow: &'static str,
-        wide: &'static str,
-    ) -> Self {
-        StorageVariant {
-            method,
-            key,
-            narrow,
-            wide,
-        }
-    }
-}
-
-/// Part 2's buffer formats (module doc).
-pub const STORAGE: &[StorageVariant] = &[
-    StorageVariant::of("ssv", "vbuffer", "f16", "f32"),
-    StorageVariant::of("ssv", "vbuffer", "8bit", "f32"),
-    StorageVariant::of("pw2002", "li", "12", "16"),
-    StorageVariant::of("pw2002", "li", "8", "16"),
-    StorageVariant::of("pw-restructured", "li", "12", "16"),
-    StorageVariant::of("pw-restructured", "li", "8", "16"),
-    StorageVariant::of("ssv-optimized", "reserved-bits", "3", "5"),
-    StorageVariant::of("ssv-optimized", "reserved-bits", "7", "5"),
-    StorageVariant::of("ssv-optimized", "position", "f16", "depth"),
-    StorageVariant::of("wedge-blending", "packing", "8bit", "f32"),
-];
-
-/// The light of an overflow configuration's stack.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-pub enum StackLight {
-    /// A point light (hard shadows: the stencil alone).
-    Point,
-    /// A sphere of radius 0.2 (Paper I's wedges and LI buffer).
-    Sphere,
-    /// A square of half extent 0.2 (the soft shadow volumes' V-buffers, wedge blending).
-    Rect,
-}
-
-impl StackLight {
-    /// The light's shape.
-    pub fn shape(self) -> LightShape {
-        match self {
-            StackLight::Point => LightShape::Point,
-            StackLight::Sphere => LightShape::Sphere { radius: 0.2 },
-            StackLight::Rect => LightShape::Rect {
-                u: Vec3::new(0.2, 0.0, 0.0),
-                v: Vec3::new(0.0, 0.0, 0.2),
-            },
-        }
-    }
+/// Part 2's buffer formats (module doc): every method's
+/// [`PrecisionSpec::storage`](crate::methods::precision_spec::PrecisionSpec), in the
+/// registry's order.
+pub fn storage_variants() -> Vec<StorageVariant> {
+    crate::methods::ALL
+        .iter()
+        .flat_map(|m| {
+            m.precision.storage.iter().map(|f| StorageVariant {
+                method: m.name,
+                key: f.key,
+                narrow: f.narrow,
+                wide: f.wide,
+            })
+        })
+        .collect()
 }
 
 /// A buffer format whose overflow the stack family measures.
@@ -170,19 +132,6 @@ pub struct OverflowConfig {
 }
 
 impl OverflowConfig {
-    /// `method` with `knobs` on the stack under `light`.
-    pub const fn of(
-        method: &'static str,
-        light: StackLight,
-        knobs: &'static [(&'static str, &'static str)],
-    ) -> Self {
-        OverflowConfig {
-            method,
-            light,
-            knobs,
-        }
-    }
-
     /// The name in the tables and the plot: the method and its options, e.g.
     /// `pw2002 li=16 overflow=wrap`.
     pub fn label(&self) -> String {
@@ -191,30 +140,23 @@ impl OverflowConfig {
     }
 }
 
-/// Part 3's formats (module doc): the 8-bit stencil wrapping and saturating (`hard-sv`; every
-/// stencil pass of the other methods is the same buffer), Paper I's LI buffers, Paper III's
-/// V-buffers, Paper IV's split V-buffer with 1…7 carry bits, wedge blending's packed vBuffer.
-pub const OVERFLOW_CONFIGS: &[OverflowConfig] = {
-    use StackLight::*;
-    &[
-        OverflowConfig::of("hard-sv", Point, &[("stencil", "wrap")]),
-        OverflowConfig::of("hard-sv", Point, &[("stencil", "saturate")]),
-        OverflowConfig::of("pw2002", Sphere, &[("li", "16"), ("overflow", "wrap")]),
-        OverflowConfig::of("pw2002", Sphere, &[("li", "16"), ("overflow", "saturate")]),
-        OverflowConfig::of("pw2002", Sphere, &[("li", "12"), ("overflow", "wrap")]),
-        OverflowConfig::of("pw2002", Sphere, &[("li", "12"), ("overflow", "saturate")]),
-        OverflowConfig::of("pw2002", Sphere, &[("li", "8"), ("overflow", "wrap")]),
-        OverflowConfig::of("pw2002", Sphere, &[("li", "8"), ("overflow", "saturate")]),
-        OverflowConfig::of("ssv", Rect, &[("vbuffer", "f32")]),
-        OverflowConfig::of("ssv", Rect, &[("vbuffer", "f16")]),
-        OverflowConfig::of("ssv", Rect, &[("vbuffer", "8bit")]),
-        OverflowConfig::of("ssv-optimized", Rect, &[("reserved-bits", "1")]),
-        OverflowConfig::of("ssv-optimized", Rect, &[("reserved-bits", "3")]),
-        OverflowConfig::of("ssv-optimized", Rect, &[("reserved-bits", "5")]),
-        OverflowConfig::of("ssv-optimized", Rect, &[("reserved-bits", "7")]),
-        OverflowConfig::of("wedge-blending", Rect, &[("packing", "8bit")]),
-    ]
-};
+/// Part 3's formats (module doc): every method's
+/// [`PrecisionSpec::overflow`](crate::methods::precision_spec::PrecisionSpec) in the registry's
+/// order — the 8-bit stencil wrapping and saturating (`hard-sv`; every stencil pass of the
+/// other methods is the same buffer), Paper I's LI buffers, Paper III's V-buffers, Paper IV's
+/// split V-buffer with 1…7 carry bits, wedge blending's packed vBuffer.
+pub fn overflow_configs() -> Vec<OverflowConfig> {
+    crate::methods::ALL
+        .iter()
+        .flat_map(|m| {
+            m.precision.overflow.iter().map(|o| OverflowConfig {
+                method: m.name,
+                light: o.light,
+                knobs: o.knobs,
+            })
+        })
+        .collect()
+}
 
 /// The stack sizes N of part 3: every N up to 8, then around each format's limit (Paper III's
 /// 8-bit V-buffer, Paper IV's carry bits, Paper I's LI buffers, the 8-bit stencil).
@@ -408,7 +350,7 @@ pub fn storage_row_of(scene: &Scene, s: &StorageVariant) -> Result<StorageRow, I
 pub fn storage_rows(scene: &Scene) -> Result<Vec<StorageRow>, InputError> {
     let base = crate::render::gpu_settings(scene)?;
     let mut rows = Vec::new();
-    for s in STORAGE {
+    for s in &storage_variants() {
         if crate::methods::supports_scene(s.method, scene) {
             rows.push(storage_row_of(scene, s)?);
         }
@@ -657,7 +599,7 @@ pub fn study(scenes: &[Scene], size: u32) -> Result<(Study, ErrorMaps), InputErr
         maps.extend(m);
         s.storage.extend(storage_rows(&scene)?);
     }
-    s.overflow = overflow_rows(OVERFLOW_CONFIGS, STACK_SIZES, STACK_IMAGE)?;
+    s.overflow = overflow_rows(&overflow_configs(), STACK_SIZES, STACK_IMAGE)?;
     Ok((s, maps))
 }
 
@@ -969,7 +911,7 @@ mod tests {
     /// overflow events from N = 256 on). Bounds from the format: 8 bits hold 0…255.
     #[test]
     fn stencil_wraps_at_256_and_saturation_does_not_corrupt() {
-        let configs = &OVERFLOW_CONFIGS[..2];
+        let configs = &overflow_configs()[..2];
         let rows = overflow_rows(configs, &[1, 255, 256], STACK_IMAGE).unwrap();
         let get = |c: &str, n: u32| rows.iter().find(|r| r.config == c && r.n == n).unwrap();
         for c in ["hard-sv stencil=wrap", "hard-sv stencil=saturate"] {
@@ -985,8 +927,8 @@ mod tests {
     }
 
     fn config(label: &str) -> OverflowConfig {
-        *OVERFLOW_CONFIGS
-            .iter()
+        overflow_configs()
+            .into_iter()
             .find(|c| c.label() == label)
             .unwrap()
     }
@@ -1040,8 +982,8 @@ mod tests {
     fn pin_the_f16_v_buffer_and_position_buffer() {
         let scene = sized(crate::scene::builtin::load("cube-of-spheres").unwrap(), 64);
         let find = |m: &str, k: &str| {
-            *STORAGE
-                .iter()
+            storage_variants()
+                .into_iter()
                 .find(|s| s.method == m && s.key == k && s.narrow == "f16")
                 .unwrap()
         };

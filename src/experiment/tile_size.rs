@@ -110,7 +110,8 @@ pub fn sweep(scene: &Scene) -> Result<Vec<Row>, InputError> {
         for round in 0..TIMING_RUNS {
             for (v, s) in settings.iter().enumerate() {
                 let start = Instant::now();
-                let mut rec = PassRecorder::new(&frame, "pw-restructured");
+                let mut rec =
+                    PassRecorder::new(&frame, crate::methods::pw_restructured::METHOD.name);
                 render_li(&mut rec, &set, s);
                 times[v].push(start.elapsed().as_secs_f64());
                 if round > 0 {

@@ -236,10 +236,25 @@ fn gray(v: &Visibility) -> Vec<f32> {
     (0..v.len()).map(|i| v.gray(i)).collect()
 }
 
+/// Whether the experiment can measure `scene`: one light that `wedge-blending` renders (a
+/// rectangle); the error names the scene.
+pub fn check_scene(scene: &Scene) -> Result<(), InputError> {
+    if crate::methods::supports_scene(wedge_blending::METHOD.name, scene) && !scene.is_multi_light()
+    {
+        Ok(())
+    } else {
+        Err(InputError::at(
+            &scene.source,
+            "light",
+            "the wedge-blending experiment needs one rect light",
+        ))
+    }
+}
+
 /// Parts 1–3 of the module doc on `scene`.
 pub fn measure_scene(scene: &Scene) -> Result<SceneReport, InputError> {
     let frame = Frame::render(scene, GpuSettings::default())?;
-    let reference = crate::methods::run("raycast", &frame)?.visibility;
+    let reference = crate::methods::run(crate::methods::REFERENCE, &frame)?.visibility;
     let f32_variant = variant("wedge-blending f32");
     let unpacked = wedge_blending::options(&frame.lit_by(&configured(
         scene,

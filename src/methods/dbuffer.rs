@@ -180,6 +180,7 @@ use crate::gpu::shader_vec::SVec3;
 use crate::gpu::texture::Filter;
 use crate::gpu::transform::ClipVertex;
 use crate::methods::output::BufferPlan;
+use crate::methods::precision_spec::PrecisionSpec;
 use crate::methods::recorder::PassRecorder;
 use crate::options::{option_names, option_table, OptionTable};
 use crate::pass::PassStats;
@@ -1083,6 +1084,13 @@ const SWEEP: &[crate::methods::OptionPairs] = &[
     &[("horizon", "clip")],
 ];
 
+/// What the precision experiment measures of it ([`crate::experiment::precision`]): its fragment programs only.
+const PRECISION: PrecisionSpec = PrecisionSpec {
+    shader_arithmetic: true,
+    storage: &[],
+    overflow: &[],
+};
+
 /// `dbuffer` in the registry ([`crate::methods::ALL`]).
 pub const METHOD: crate::methods::Method = crate::methods::Method {
     name: "dbuffer",
@@ -1099,6 +1107,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     run,
     goldens: GOLDENS,
     sweep: SWEEP,
+    precision: PRECISION,
 };
 
 /// Run `dbuffer` on a rendered frame (one light: [`super::run`] averages several).

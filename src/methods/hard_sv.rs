@@ -33,6 +33,7 @@ use crate::gpu::raster::{bin, draw};
 use crate::gpu::setup::CullMode;
 use crate::gpu::stencil::{StencilFace, StencilOp, StencilState};
 use crate::methods::output::BufferPlan;
+use crate::methods::precision_spec::{OverflowKnobs, PrecisionSpec, StackLight};
 use crate::methods::recorder::PassRecorder;
 use crate::options::{option_names, option_table, OptionTable, OptionType};
 use crate::visibility::Visibility;
@@ -335,6 +336,16 @@ const GOLDENS: &[crate::methods::Golden] = &[
 /// `hard-sv`'s configurations in the accuracy–time sweep ([`crate::methods::Method::sweep`]).
 const SWEEP: &[crate::methods::OptionPairs] = &[&[]];
 
+/// What the precision experiment measures of it ([`crate::experiment::precision`]): the 8-bit stencil wrapping and saturating (every stencil pass of the other methods is the same buffer).
+const PRECISION: PrecisionSpec = PrecisionSpec {
+    shader_arithmetic: false,
+    storage: &[],
+    overflow: &[
+        OverflowKnobs::of(StackLight::Point, &[("stencil", "wrap")]),
+        OverflowKnobs::of(StackLight::Point, &[("stencil", "saturate")]),
+    ],
+};
+
 /// `hard-sv` in the registry ([`crate::methods::ALL`]).
 pub const METHOD: crate::methods::Method = crate::methods::Method {
     name: "hard-sv",
@@ -350,6 +361,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     run,
     goldens: GOLDENS,
     sweep: SWEEP,
+    precision: PRECISION,
 };
 
 /// Run `hard-sv` on a rendered frame.

@@ -23,6 +23,7 @@ pub mod light_average;
 pub mod nsample;
 pub mod output;
 pub mod penumbra_map;
+pub mod precision_spec;
 pub mod pw2002;
 pub mod pw_restructured;
 pub mod raycast;
@@ -86,6 +87,8 @@ pub struct Method {
     /// Its configurations in the accuracy–time sweep
     /// ([`crate::experiment::accuracy_time::configurations`]).
     pub sweep: &'static [OptionPairs],
+    /// What the precision experiment measures of it ([`crate::experiment::precision`]).
+    pub precision: precision_spec::PrecisionSpec,
 }
 
 impl std::fmt::Debug for Method {

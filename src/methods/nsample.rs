@@ -135,6 +135,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     run,
     goldens: GOLDENS,
     sweep: SWEEP,
+    precision: crate::methods::precision_spec::PrecisionSpec::NO_SHADER_ARITHMETIC,
 };
 
 /// Run `nsample` on a rendered frame.

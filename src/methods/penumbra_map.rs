@@ -132,6 +132,7 @@ use crate::gpu::setup::{setup_all_barycentric, CullMode};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::texture::Filter;
 use crate::methods::output::BufferPlan;
+use crate::methods::precision_spec::PrecisionSpec;
 use crate::methods::recorder::PassRecorder;
 use crate::options::{option_names, option_table, OptionTable};
 use crate::pass::PassStats;
@@ -766,6 +767,13 @@ const GOLDENS: &[crate::methods::Golden] = &[
 /// `penumbra-map`'s configurations in the accuracy–time sweep ([`crate::methods::Method::sweep`]).
 const SWEEP: &[crate::methods::OptionPairs] = &[&[], &[("storage", "f32")], &[("horizon", "clip")]];
 
+/// What the precision experiment measures of it ([`crate::experiment::precision`]): its fragment programs only.
+const PRECISION: PrecisionSpec = PrecisionSpec {
+    shader_arithmetic: true,
+    storage: &[],
+    overflow: &[],
+};
+
 /// `penumbra-map` in the registry ([`crate::methods::ALL`]).
 pub const METHOD: crate::methods::Method = crate::methods::Method {
     name: "penumbra-map",
@@ -782,6 +790,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     run,
     goldens: GOLDENS,
     sweep: SWEEP,
+    precision: PRECISION,
 };
 
 /// Run `penumbra-map` on a rendered frame (one light: [`super::run`] averages several).

@@ -66,6 +66,7 @@ use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::shader_vec::SVec3;
 use crate::methods::output::BufferPlan;
+use crate::methods::precision_spec::{NarrowFormat, OverflowKnobs, PrecisionSpec, StackLight};
 use crate::methods::recorder::PassRecorder;
 use crate::options::{option_names, option_table, OptionTable, Switch};
 use crate::scene::{LightShape, Scene};
@@ -508,6 +509,29 @@ const SWEEP: &[crate::methods::OptionPairs] = &[
     &[("li", "16"), ("horizon", "clip")],
 ];
 
+/// What the precision experiment measures of it ([`crate::experiment::precision`]): Paper I's LI buffers.
+const PRECISION: PrecisionSpec = PrecisionSpec {
+    shader_arithmetic: true,
+    storage: &[
+        NarrowFormat::of("li", "12", "16"),
+        NarrowFormat::of("li", "8", "16"),
+    ],
+    overflow: &[
+        OverflowKnobs::of(StackLight::Sphere, &[("li", "16"), ("overflow", "wrap")]),
+        OverflowKnobs::of(
+            StackLight::Sphere,
+            &[("li", "16"), ("overflow", "saturate")],
+        ),
+        OverflowKnobs::of(StackLight::Sphere, &[("li", "12"), ("overflow", "wrap")]),
+        OverflowKnobs::of(
+            StackLight::Sphere,
+            &[("li", "12"), ("overflow", "saturate")],
+        ),
+        OverflowKnobs::of(StackLight::Sphere, &[("li", "8"), ("overflow", "wrap")]),
+        OverflowKnobs::of(StackLight::Sphere, &[("li", "8"), ("overflow", "saturate")]),
+    ],
+};
+
 /// `pw2002` in the registry ([`crate::methods::ALL`]).
 pub const METHOD: crate::methods::Method = crate::methods::Method {
     name: "pw2002",
@@ -523,6 +547,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     run,
     goldens: GOLDENS,
     sweep: SWEEP,
+    precision: PRECISION,
 };
 
 /// Run `pw2002` on a rendered frame.

@@ -102,6 +102,7 @@ use crate::gpu::shader_vec::SVec3;
 use crate::gpu::stencil::{StencilFace, StencilOp, StencilState};
 use crate::methods::hard_sv::CountMode;
 use crate::methods::output::BufferPlan;
+use crate::methods::precision_spec::{NarrowFormat, PrecisionSpec};
 use crate::methods::recorder::PassRecorder;
 use crate::options::{option_names, option_table, OptionTable, OptionType};
 use crate::scene::LightShape;
@@ -706,6 +707,16 @@ const SWEEP: &[crate::methods::OptionPairs] = &[
     &[("li", "16"), ("horizon", "clip")],
 ];
 
+/// What the precision experiment measures of it ([`crate::experiment::precision`]): Paper II's LI buffers.
+const PRECISION: PrecisionSpec = PrecisionSpec {
+    shader_arithmetic: true,
+    storage: &[
+        NarrowFormat::of("li", "12", "16"),
+        NarrowFormat::of("li", "8", "16"),
+    ],
+    overflow: &[],
+};
+
 /// `pw-restructured` in the registry ([`crate::methods::ALL`]).
 pub const METHOD: crate::methods::Method = crate::methods::Method {
     name: "pw-restructured",
@@ -721,6 +732,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     run,
     goldens: GOLDENS,
     sweep: SWEEP,
+    precision: PRECISION,
 };
 
 /// Run `pw-restructured` on a rendered frame.

@@ -105,6 +105,7 @@ use crate::frame::Frame;
 use crate::gpu::probe::{PassProbe, PrimitiveKind};
 use crate::light::sampling::{self, LightSample, Pattern};
 use crate::options::{option_names, option_table, OptionTable, OptionType};
+use crate::primitives::ray_triangle::segment_crosses_triangle;
 use crate::scene::{Light, LightShape, Scene};
 use crate::visibility::Visibility;
 use bvh::aabb::{Aabb, Bounded};
@@ -202,27 +203,19 @@ struct Triangle {
 
 impl Triangle {
     /// True when the segment `o + t·d` hits the triangle at `t ∈ (t_start, 1 − ε)`
-    /// (Möller & Trumbore 1997, f64, edges inclusive, both sides).
+    /// ([`segment_crosses_triangle`]: Möller & Trumbore 1997, f64, edges inclusive, both
+    /// sides).
     #[inline]
     fn blocks(&self, o: DVec3, d: DVec3, t_start: f64) -> bool {
-        let pvec = d.cross(self.e2);
-        let det = self.e1.dot(pvec);
-        if det == 0.0 {
-            return false;
-        }
-        let inv = 1.0 / det;
-        let tvec = o - self.v0;
-        let u = tvec.dot(pvec) * inv;
-        if !(0.0..=1.0).contains(&u) {
-            return false;
-        }
-        let qvec = tvec.cross(self.e1);
-        let v = d.dot(qvec) * inv;
-        if v < 0.0 || u + v > 1.0 {
-            return false;
-        }
-        let t = self.e2.dot(qvec) * inv;
-        t > t_start && t < 1.0 - SEGMENT_EPSILON
+        segment_crosses_triangle(
+            o,
+            d,
+            self.v0,
+            self.e1,
+            self.e2,
+            t_start,
+            1.0 - SEGMENT_EPSILON,
+        )
     }
 }
 
@@ -1021,6 +1014,7 @@ pub const METHOD: super::Method = super::Method {
     run,
     goldens: GOLDENS,
     sweep: SWEEP,
+    precision: crate::methods::precision_spec::PrecisionSpec::NO_SHADER_ARITHMETIC,
 };
 
 /// `raycast` (the ground truth by definition): per pixel, the fraction of the light visible

@@ -97,6 +97,7 @@ use crate::light::coverage_texture::{
 };
 use crate::methods::hard_sv::CountMode;
 use crate::methods::output::BufferPlan;
+use crate::methods::precision_spec::{NarrowFormat, OverflowKnobs, PrecisionSpec, StackLight};
 use crate::methods::recorder::PassRecorder;
 use crate::options::{option_names, option_table, OptionTable, OptionType};
 use crate::scene::LightShape;
@@ -860,6 +861,20 @@ const SWEEP: &[crate::methods::OptionPairs] = &[
     ],
 ];
 
+/// What the precision experiment measures of it ([`crate::experiment::precision`]): Paper III's V-buffers.
+const PRECISION: PrecisionSpec = PrecisionSpec {
+    shader_arithmetic: true,
+    storage: &[
+        NarrowFormat::of("vbuffer", "f16", "f32"),
+        NarrowFormat::of("vbuffer", "8bit", "f32"),
+    ],
+    overflow: &[
+        OverflowKnobs::of(StackLight::Rect, &[("vbuffer", "f32")]),
+        OverflowKnobs::of(StackLight::Rect, &[("vbuffer", "f16")]),
+        OverflowKnobs::of(StackLight::Rect, &[("vbuffer", "8bit")]),
+    ],
+};
+
 /// `ssv` in the registry ([`crate::methods::ALL`]).
 pub const METHOD: crate::methods::Method = crate::methods::Method {
     name: "ssv",
@@ -880,6 +895,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     run,
     goldens: GOLDENS,
     sweep: SWEEP,
+    precision: PRECISION,
 };
 
 /// Run `ssv` on a rendered frame.

@@ -126,6 +126,7 @@ use crate::light::coverage::{self, RectLight};
 use crate::light::lookup_tables::{AreaShape, AreaTable, Atan2CubeMap, SplitTable, TableFilter};
 use crate::methods::hard_sv::CountMode;
 use crate::methods::output::BufferPlan;
+use crate::methods::precision_spec::{NarrowFormat, OverflowKnobs, PrecisionSpec, StackLight};
 use crate::methods::recorder::PassRecorder;
 use crate::options::{option_names, option_table, OptionTable};
 use crate::scene::LightShape;
@@ -1101,6 +1102,22 @@ const SWEEP: &[crate::methods::OptionPairs] = &[
     &[("horizon", "clip")],
 ];
 
+/// What the precision experiment measures of it ([`crate::experiment::precision`]): Paper IV's split V-buffer with 1…7 carry bits and its f16 position buffer.
+const PRECISION: PrecisionSpec = PrecisionSpec {
+    shader_arithmetic: true,
+    storage: &[
+        NarrowFormat::of("reserved-bits", "3", "5"),
+        NarrowFormat::of("reserved-bits", "7", "5"),
+        NarrowFormat::of("position", "f16", "depth"),
+    ],
+    overflow: &[
+        OverflowKnobs::of(StackLight::Rect, &[("reserved-bits", "1")]),
+        OverflowKnobs::of(StackLight::Rect, &[("reserved-bits", "3")]),
+        OverflowKnobs::of(StackLight::Rect, &[("reserved-bits", "5")]),
+        OverflowKnobs::of(StackLight::Rect, &[("reserved-bits", "7")]),
+    ],
+};
+
 /// `ssv-optimized` in the registry ([`crate::methods::ALL`]).
 pub const METHOD: crate::methods::Method = crate::methods::Method {
     name: "ssv-optimized",
@@ -1116,6 +1133,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     run,
     goldens: GOLDENS,
     sweep: SWEEP,
+    precision: PRECISION,
 };
 
 /// Run `ssv-optimized` on a rendered frame.

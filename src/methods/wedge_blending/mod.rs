@@ -158,6 +158,7 @@ use crate::light::coverage::{quad_side, RectLight};
 use crate::light::radial_parts::{edge_in_parts, read, stored, PART_COUNT};
 use crate::methods::hard_sv::CountMode;
 use crate::methods::output::BufferPlan;
+use crate::methods::precision_spec::{NarrowFormat, OverflowKnobs, PrecisionSpec, StackLight};
 use crate::methods::recorder::PassRecorder;
 use crate::options::{option_names, option_table, OptionTable, OptionType, Switch};
 
@@ -1351,6 +1352,13 @@ const SWEEP: &[crate::methods::OptionPairs] = &[
     &[("horizon", "clip")],
 ];
 
+/// What the precision experiment measures of it ([`crate::experiment::precision`]): Paper V's packed vBuffer.
+const PRECISION: PrecisionSpec = PrecisionSpec {
+    shader_arithmetic: true,
+    storage: &[NarrowFormat::of("packing", "8bit", "f32")],
+    overflow: &[OverflowKnobs::of(StackLight::Rect, &[("packing", "8bit")])],
+};
+
 /// `wedge-blending` in the registry ([`crate::methods::ALL`]).
 pub const METHOD: crate::methods::Method = crate::methods::Method {
     name: "wedge-blending",
@@ -1367,6 +1375,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     run,
     goldens: GOLDENS,
     sweep: SWEEP,
+    precision: PRECISION,
 };
 
 /// The warning for a mesh whose hole loops the 8-bit packing cannot hold (module doc,
