@@ -188,7 +188,6 @@ use crate::scene::LightShape;
 use crate::visibility::Visibility;
 use glam::DVec3;
 use serde::Serialize;
-use std::time::Instant;
 
 /// The default number of corner-fan triangles per full circle (`fan-segments`).
 pub const DEFAULT_FAN_SEGMENTS: u32 = 32;
@@ -765,8 +764,21 @@ fn volume_input(
     input
 }
 
-/// Render `dbuffer` with `s` on `frame` (one disk light).
+/// Render `dbuffer` with `s` on `frame` (one disk light), its passes recorded by a recorder
+/// of its own ([`DBufferRender::passes`]).
 pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, InputError> {
+    let mut rec = PassRecorder::new(frame, METHOD.name);
+    let mut r = render_with(&mut rec, s)?;
+    r.passes = rec.passes_after_the_scene_pass().to_vec();
+    Ok(r)
+}
+
+/// [`render`], its passes run through `rec` (`passes` left empty).
+pub fn render_with(
+    rec: &mut PassRecorder,
+    s: &DBufferSettings,
+) -> Result<DBufferRender, InputError> {
+    let frame = rec.frame();
     let scene = frame.scene;
     let light = scene.light();
     let LightShape::Disk { radius, normal } = light.shape else {
@@ -789,15 +801,14 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
     let range = bound * (1.0 + BOUND_MARGIN);
 
     // Pass 1: the volumes (CPU).
-    let t = Instant::now();
     let meshes = frame.caster_meshes();
     let ex = Extrusion {
         bound,
         fan_segments: s.fan_segments,
     };
-    let volumes = build_volumes(&meshes, &disk, &ex)
+    let volumes = rec
+        .pass("volumes", |_| build_volumes(&meshes, &disk, &ex))
         .map_err(|(i, e)| InputError::at(&scene.source, frame.caster_object(i), e))?;
-    let pass_volumes = PassStats::since("volumes", t, Counters::default());
 
     // Pass 2: the D-buffer, three draws; a probe watches the texel the screen pass reads for
     // its pixel.
@@ -829,61 +840,61 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
                 .clear("depth", Raw::Depth(tiles[0].depth.values[0]))
         });
     }
-    let t = Instant::now();
-    let mut scene_input = DrawInput::default();
-    for (m, _) in &meshes {
-        let world: Vec<DVec3> = m.positions.iter().map(|p| p.as_dvec3()).collect();
-        let clip: Vec<ClipVertex> = world
-            .iter()
-            .map(|p| view.distance_clip_point(*p, range))
-            .collect();
-        for tri in &m.triangles {
-            let k = tri.map(|i| i as usize);
-            let w = k.map(|i| world[i]);
-            scene_input.push(w, k.map(|i| clip[i]), w.map(|p| [(p - c).length(), 0.0]));
+    rec.pass("dbuffer-scene", |pass| {
+        let mut scene_input = DrawInput::default();
+        for (m, _) in &meshes {
+            let world: Vec<DVec3> = m.positions.iter().map(|p| p.as_dvec3()).collect();
+            let clip: Vec<ClipVertex> = world
+                .iter()
+                .map(|p| view.distance_clip_point(*p, range))
+                .collect();
+            for tri in &m.triangles {
+                let k = tri.map(|i| i as usize);
+                let w = k.map(|i| world[i]);
+                scene_input.push(w, k.map(|i| clip[i]), w.map(|p| [(p - c).length(), 0.0]));
+            }
         }
-    }
-    let c1 = draw_dbuffer(
-        &view,
-        range,
-        s.distances,
-        &mut tiles,
-        &scene_input,
-        DrawKind::Scene {
-            offset: s.offset,
-            early_z: early_z.is_some(),
-        },
-        map_probe("dbuffer-scene").as_ref(),
-    );
-    let pass_scene = PassStats::since("dbuffer-scene", t, c1);
-    let mut not_finite = 0;
-    let mut volume_pass = |name: &str, tris: &[[VolumeVertex; 3]], mask: [bool; 4]| {
-        let t = Instant::now();
-        for tile in tiles.iter_mut() {
-            tile.depth = DepthTile::cleared_to(view.depth, 0.0, tile.depth.values.len());
-        }
-        let probe = map_probe(name);
-        if let Some(p) = &probe {
-            p.record_each(|tap| {
-                tap.event()
-                    .clear("depth", Raw::Depth(tiles[0].depth.values[0]))
-            });
-        }
-        let input = volume_input(&view, range, &disk, tris, &mut not_finite);
-        let kind = DrawKind::Volume(ColorMask(mask));
-        let counters = draw_dbuffer(
+        pass.count(draw_dbuffer(
             &view,
             range,
             s.distances,
             &mut tiles,
-            &input,
-            kind,
-            probe.as_ref(),
-        );
-        PassStats::since(name, t, counters)
+            &scene_input,
+            DrawKind::Scene {
+                offset: s.offset,
+                early_z: early_z.is_some(),
+            },
+            map_probe("dbuffer-scene").as_ref(),
+        ));
+    });
+    let mut not_finite = 0;
+    let mut volume_pass = |name: &str, tris: &[[VolumeVertex; 3]], mask: [bool; 4]| {
+        rec.pass(name, |pass| {
+            for tile in tiles.iter_mut() {
+                tile.depth = DepthTile::cleared_to(view.depth, 0.0, tile.depth.values.len());
+            }
+            let probe = map_probe(name);
+            if let Some(p) = &probe {
+                p.record_each(|tap| {
+                    tap.event()
+                        .clear("depth", Raw::Depth(tiles[0].depth.values[0]))
+                });
+            }
+            let input = volume_input(&view, range, &disk, tris, &mut not_finite);
+            let kind = DrawKind::Volume(ColorMask(mask));
+            pass.count(draw_dbuffer(
+                &view,
+                range,
+                s.distances,
+                &mut tiles,
+                &input,
+                kind,
+                probe.as_ref(),
+            ));
+        })
     };
-    let pass_umbra = volume_pass("dbuffer-umbra", &volumes.umbra, [false, true, false, true]);
-    let pass_penumbra = volume_pass(
+    volume_pass("dbuffer-umbra", &volumes.umbra, [false, true, false, true]);
+    volume_pass(
         "dbuffer-penumbra",
         &volumes.penumbra,
         [false, false, true, true],
@@ -907,11 +918,13 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
     }
 
     // Pass 3: the screen.
-    let t = Instant::now();
-    let (visibility, shades, screen, c3) = crate::with_shader_float!(frame.gpu.shader, T => {
-        screen_pass::<T>(frame, &view, &dbuffer, c, s)
+    let (visibility, shades, screen) = rec.pass("screen", |pass| {
+        let (visibility, shades, screen, c) = crate::with_shader_float!(frame.gpu.shader, T => {
+            screen_pass::<T>(frame, &view, &dbuffer, c, s)
+        });
+        pass.count(c);
+        (visibility, shades, screen)
     });
-    let pass_screen = PassStats::since("screen", t, c3);
     let several_crossings = several_crossings(frame, &view, &crossings, &shades, &volumes);
 
     Ok(DBufferRender {
@@ -924,13 +937,7 @@ pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, Input
         screen,
         shades,
         several_crossings,
-        passes: vec![
-            pass_volumes,
-            pass_scene,
-            pass_umbra,
-            pass_penumbra,
-            pass_screen,
-        ],
+        passes: Vec::new(),
     })
 }
 
@@ -1112,7 +1119,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
 
 /// Run `dbuffer` on a rendered frame (one light: [`super::run`] averages several).
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
-    let mut rec = PassRecorder::new(frame, "dbuffer");
+    let mut rec = PassRecorder::new(frame, METHOD.name);
     let s = read_settings(frame)?;
     let n = s.map_size;
     rec.uses(BufferPlan::color_target(
@@ -1131,9 +1138,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             hiz_tile,
         ));
     }
-    // The passes time and count themselves ([`render`]), as the tests read them.
-    let r = render(frame, &s)?;
-    r.passes.iter().cloned().for_each(|p| rec.record_pass(p));
+    let r = render_with(&mut rec, &s)?;
     rec.clamped(r.screen.t_out_of_range);
     for (k, n) in r.several_crossings.iter().enumerate() {
         if *n > 0 {

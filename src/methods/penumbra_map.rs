@@ -139,7 +139,6 @@ use crate::pass::PassStats;
 use crate::scene::{LightShape, Scene};
 use crate::visibility::Visibility;
 use serde::Serialize;
-use std::time::Instant;
 
 /// The default polygon-offset units of the shadow map (`bias`): resolvable-difference steps.
 pub const DEFAULT_BIAS_UNITS: f64 = 4.0;
@@ -344,8 +343,21 @@ pub struct PenumbraMapRender {
     pub passes: Vec<PassStats>,
 }
 
-/// Render `penumbra-map` with `s` on `frame` (one sphere light).
+/// Render `penumbra-map` with `s` on `frame` (one sphere light), its passes recorded by a
+/// recorder of its own ([`PenumbraMapRender::passes`]).
 pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRender, InputError> {
+    let mut rec = PassRecorder::new(frame, METHOD.name);
+    let mut r = render_with(&mut rec, s)?;
+    r.passes = rec.passes_after_the_scene_pass().to_vec();
+    Ok(r)
+}
+
+/// [`render`], its passes run through `rec` (`passes` left empty).
+pub fn render_with(
+    rec: &mut PassRecorder,
+    s: &PenumbraMapSettings,
+) -> Result<PenumbraMapRender, InputError> {
+    let frame = rec.frame();
     let scene = frame.scene;
     let light = scene.light();
     let LightShape::Sphere { radius } = light.shape else {
@@ -371,51 +383,56 @@ pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRende
     };
 
     // Pass 1: the shadow map.
-    let t = Instant::now();
     let render_offset = match s.bias_stage {
         BiasStage::Render => s.offset,
         BiasStage::Lookup => PolygonOffset::NONE,
     };
-    let probe = map_probe("shadow-map");
-    let hiz_tile = frame.gpu.hiz_tile();
-    let (shadow_map, c1) = view.render_depth(scene, render_offset, hiz_tile, probe.as_ref());
-    let pass1 = PassStats::since("shadow-map", t, c1);
+    let shadow_map = rec.pass("shadow-map", |pass| {
+        let probe = map_probe("shadow-map");
+        let hiz_tile = frame.gpu.hiz_tile();
+        let (map, c) = view.render_depth(scene, render_offset, hiz_tile, probe.as_ref());
+        pass.count(c);
+        map
+    });
 
     // The silhouette from the light center (CPU; the paper's 30 %).
-    let t = Instant::now();
     let meshes = frame.caster_meshes();
-    let sils = silhouettes(&meshes, light.center)
+    let sils = rec
+        .pass("silhouettes", |_| silhouettes(&meshes, light.center))
         .map_err(|(i, e)| InputError::at(&scene.source, frame.caster_object(i), e))?;
-    let pass_sil = PassStats::since("silhouettes", t, Counters::default());
 
     // Pass 2: cones and sheets into the penumbra map.
-    let t = Instant::now();
-    let mesh_refs: Vec<_> = meshes.iter().map(|(m, _)| *m).collect();
-    let geometry = cones_and_sheets(
-        &mesh_refs,
-        &sils,
-        &cone_light(&view, radius),
-        s.cone_segments,
-    );
-    let probe = map_probe("penumbra-map");
-    let (color, program, c2) = crate::with_shader_float!(frame.gpu.shader, T => {
-        render_penumbra_map::<T>(
-            &view,
-            &shadow_map,
-            &geometry,
-            s,
-            frame.dump_buffers,
-            probe.as_ref(),
-        )
+    let (geometry, color, program) = rec.pass("penumbra-map", |pass| {
+        let mesh_refs: Vec<_> = meshes.iter().map(|(m, _)| *m).collect();
+        let geometry = cones_and_sheets(
+            &mesh_refs,
+            &sils,
+            &cone_light(&view, radius),
+            s.cone_segments,
+        );
+        let probe = map_probe("penumbra-map");
+        let (color, program, c) = crate::with_shader_float!(frame.gpu.shader, T => {
+            render_penumbra_map::<T>(
+                &view,
+                &shadow_map,
+                &geometry,
+                s,
+                frame.dump_buffers,
+                probe.as_ref(),
+            )
+        });
+        pass.count(c);
+        (geometry, color, program)
     });
-    let pass2 = PassStats::since("penumbra-map", t, c2);
 
     // Pass 3: the screen.
-    let t = Instant::now();
-    let (visibility, screen, c3) = crate::with_shader_float!(frame.gpu.shader, T => {
-        screen_pass::<T>(frame, &view, &shadow_map, &color, s)
+    let (visibility, screen) = rec.pass("screen", |pass| {
+        let (visibility, screen, c) = crate::with_shader_float!(frame.gpu.shader, T => {
+            screen_pass::<T>(frame, &view, &shadow_map, &color, s)
+        });
+        pass.count(c);
+        (visibility, screen)
     });
-    let pass3 = PassStats::since("screen", t, c3);
 
     let silhouette = (
         sils.iter().map(|m| m.edges.len()).sum(),
@@ -431,7 +448,7 @@ pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRende
         silhouette,
         program,
         screen,
-        passes: vec![pass1, pass_sil, pass2, pass3],
+        passes: Vec::new(),
     })
 }
 
@@ -795,7 +812,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
 
 /// Run `penumbra-map` on a rendered frame (one light: [`super::run`] averages several).
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
-    let mut rec = PassRecorder::new(frame, "penumbra-map");
+    let mut rec = PassRecorder::new(frame, METHOD.name);
     let s = read_settings(frame)?;
     let n = s.map_size;
     rec.uses(BufferPlan::depth_target(
@@ -818,9 +835,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             hiz_tile,
         ));
     }
-    // The passes time and count themselves ([`render`]), as the tests read them.
-    let r = render(frame, &s)?;
-    r.passes.iter().cloned().for_each(|p| rec.record_pass(p));
+    let r = render_with(&mut rec, &s)?;
     rec.dump_all(|| map_dumps(&r, &s));
     let horizon = PenumbraMapOptions::read(frame.scene)?.horizon;
     let (visibility, horizon) = clip_to_horizon(&mut rec, horizon, r.visibility);

@@ -151,6 +151,11 @@ impl<'f, 's> PassRecorder<'f, 's> {
         out
     }
 
+    /// The passes recorded so far after the frame's scene pass, in execution order.
+    pub fn passes_after_the_scene_pass(&self) -> &[PassStats] {
+        &self.passes[1..]
+    }
+
     /// Record a pass that was run elsewhere and handed back its stats (a building block shared
     /// by methods, or a method run inside another one), after the passes before it.
     pub fn record_pass(&mut self, stats: PassStats) {
