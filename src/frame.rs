@@ -19,6 +19,7 @@ use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::shader_float::ShaderPrecision;
 use crate::gpu::tiling::Tiling;
 use crate::gpu::transform::{ClipVertex, Projection};
+use crate::gpu_model::GpuModel;
 use crate::options::{option_names, option_table, OptionTable, PowerOfTwo, Switch};
 use crate::pass::PassStats;
 use crate::scene::adjacency::{self, Adjacency};
@@ -70,6 +71,8 @@ pub struct GpuSettings {
     /// raster tiles, because the tiles are drawn in parallel and each keeps its own bounds
     /// as it writes depth (`docs/architecture.md`, "Hierarchical Z").
     pub hiz_tile_size: u32,
+    /// The GPU profile of the cost model ([`crate::gpu_model`]); no pass reads it.
+    pub model: GpuModel,
 }
 
 impl GpuSettings {
@@ -112,6 +115,8 @@ option_table! {
         hiz: Switch = Switch::On;
         /// edge of a hierarchical-Z tile in pixels, whose zmin/zmax the unit keeps (at most the raster tile: a larger value is taken as the raster tile's edge)
         hiz_tile_size: PowerOfTwo [2..=256] = PowerOfTwo(crate::limits::DEFAULT_HIZ_TILE_SIZE);
+        /// the GPU profile whose modeled time stats.json (gpu_model), the tables and the report show (docs/gpu-model.md; penumbra list --gpus): it changes no computed bit
+        model: GpuModel = GpuModel::default();
     }
 }
 
@@ -124,6 +129,7 @@ impl GpuOptions {
             shader: self.shader,
             hiz: self.hiz == Switch::On,
             hiz_tile_size: self.hiz_tile_size.0.min(self.tile_size.0),
+            model: self.model,
         }
     }
 }
@@ -496,10 +502,15 @@ impl<'s> Frame<'s> {
     /// The unit normal and a vertex of primitive `prim`'s triangle, in f64: computed for every
     /// primitive at once on first use, where each pixel computed its primitive's, twice
     /// (`Frame::receivers` of `cube-of-spheres` 512², one thread: 9.1 → 6.7 ms).
+    ///
+    /// The initialization is sequential on purpose: it runs inside the callers' parallel
+    /// loops, and a parallel initializer lets the initializing worker steal another pixel's
+    /// job, which then waits on the same `OnceLock` the worker is still initializing — a
+    /// deadlock (seen in `goldens_do_not_depend_on_thread_count` with 3 threads).
     fn plane_of(&self, prim: u32) -> (DVec3, DVec3) {
         let planes = self.prim_planes.get_or_init(|| {
             self.prim_owner
-                .par_iter()
+                .iter()
                 .map(|&(mi, ti)| {
                     let m = &self.scene.meshes[mi as usize];
                     let [a, b, c] =
