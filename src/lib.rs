@@ -88,6 +88,7 @@ pub mod frame;
 pub mod geometry;
 pub mod golden;
 pub mod gpu;
+pub mod gpu_model;
 pub mod light;
 pub mod limits;
 pub mod memory;

@@ -52,6 +52,10 @@ enum Cmd {
         /// With --options: print the listing as Markdown, the page docs/options.md.
         #[arg(long, requires = "options")]
         markdown: bool,
+        /// Print instead the GPU profiles of the cost model, every figure with its source or
+        /// assumption (docs/gpu-model.md); choose one with --opt gpu.model=NAME.
+        #[arg(long, conflicts_with = "options")]
+        gpus: bool,
     },
     /// Run an experiment, or merge the shards of an accuracy–time sweep.
     #[command(subcommand)]
@@ -148,6 +152,10 @@ struct SceneOverrides {
     /// `penumbra list --options` lists every key with its values and default.
     #[arg(long = "opt")]
     opts: Vec<String>,
+    /// The GPU profile whose modeled time the table and stats.json show (`gpu_model`); the
+    /// same as --opt gpu.model=NAME. `penumbra list --gpus` lists them.
+    #[arg(long)]
+    gpu: Option<String>,
     /// Refuse a render whose estimated memory exceeds this many bytes (suffix K, M, G, T:
     /// powers of 1024). Default: half of the machine's memory.
     #[arg(long)]
@@ -206,6 +214,9 @@ fn apply_overrides(scene: &mut Scene, a: &SceneOverrides) -> Result<(), InputErr
     scene.resize(a.width, a.height);
     for o in &a.opts {
         scene.set_cli_option(o)?;
+    }
+    if let Some(g) = &a.gpu {
+        scene.set_cli_option(&format!("gpu.model={g}"))?;
     }
     validate::validate(scene)?;
     penumbra::methods::check_option_tables(scene)
@@ -604,9 +615,14 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
         Some(Cmd::Render(a)) => render(&a, dumps).map(|_| ()),
         Some(Cmd::Report(a)) => report(&a, dumps),
         Some(Cmd::Probe(a)) => probe(a),
+        Some(Cmd::List { gpus: true, .. }) => {
+            print!("{}", penumbra::gpu_model::profile::listing());
+            Ok(())
+        }
         Some(Cmd::List {
             options: true,
             markdown,
+            ..
         }) => {
             let tables = penumbra::methods::option_docs();
             if markdown {

@@ -274,6 +274,13 @@ impl TableRow<'_> {
         self.run.output.stats.wall_seconds
     }
 
+    /// The modeled GPU time of the method's passes, low–high in ms (`stats.json`'s
+    /// `gpu_model`; a model, not a measurement: [`crate::gpu_model`]).
+    pub fn gpu_model_ms(&self) -> String {
+        let g = &self.run.output.stats.gpu_model.seconds;
+        format!("{:.3}–{:.3}", g.low * 1e3, g.high * 1e3)
+    }
+
     /// Whether this is the reference's row (its error columns hold its noise floor).
     pub fn is_reference(&self) -> bool {
         self.run.method == methods::REFERENCE
@@ -297,6 +304,14 @@ pub fn table_rows(runs: &[MethodRun]) -> Vec<TableRow<'_>> {
 /// row holds, every method's warnings, and how a sphere light is sampled.
 pub fn table_notes(scene: &Scene, runs: &[MethodRun]) -> Vec<String> {
     let mut notes = Vec::new();
+    if let Some(r) = runs.first() {
+        let gpu = &r.output.stats.gpu_model.gpu;
+        notes.push(format!(
+            "note: \"GPU model\" is a model, not a measurement: the passes' counted work priced \
+             on the {gpu} profile, low–high (docs/gpu-model.md; other GPUs: penumbra list \
+             --gpus, --opt gpu.model=NAME)"
+        ));
+    }
     if !runs.iter().any(|r| r.method == methods::REFERENCE) {
         notes.push(format!(
             "no reference in this run, so no error columns: add {} to the methods",
@@ -372,9 +387,10 @@ pub fn scene_title(scene: &Scene) -> String {
 pub fn table(scene: &Scene, runs: &[MethodRun]) -> String {
     let mut s = format!("scene {}\n", scene_title(scene));
     s += &format!(
-        "{:<18} {:>10} {:>10} {:>10} {:>10} {:>12} {:>12} {:>12} {:>12} {:>10} {:>10}\n",
+        "{:<18} {:>10} {:>15} {:>10} {:>10} {:>10} {:>12} {:>12} {:>12} {:>12} {:>10} {:>10}\n",
         "method",
         "time [s]",
+        "GPU model [ms]",
         "RMSE",
         "mean |e|",
         "max |e|",
@@ -387,17 +403,18 @@ pub fn table(scene: &Scene, runs: &[MethodRun]) -> String {
     );
     for row in table_rows(runs) {
         let (m, t, mb) = (&row.run.method, row.seconds(), row.traffic_mb);
+        let gpu = row.gpu_model_ms();
         match row.error {
             Some(e) => {
                 s += &format!(
-                    "{:<18} {:>10.3} {:>10.5} {:>10.5} {:>10.5} {:>12.3} {:>12.2}",
-                    m, t, e.rmse, e.mean_abs, e.max_abs, e.pct_over_1_255, mb
+                    "{:<18} {:>10.3} {:>15} {:>10.5} {:>10.5} {:>10.5} {:>12.3} {:>12.2}",
+                    m, t, gpu, e.rmse, e.mean_abs, e.max_abs, e.pct_over_1_255, mb
                 )
             }
             None => {
                 s += &format!(
-                    "{:<18} {:>10.3} {:>10} {:>10} {:>10} {:>12} {:>12.2}",
-                    m, t, "—", "—", "—", "—", mb
+                    "{:<18} {:>10.3} {:>15} {:>10} {:>10} {:>10} {:>12} {:>12.2}",
+                    m, t, gpu, "—", "—", "—", "—", mb
                 )
             }
         }

@@ -35,6 +35,9 @@ pub struct MethodStats {
     /// Each mesh of the scene: its name, triangle count and what repair changed
     /// ([`crate::scene::repair::MeshReport`]), so that a result names the geometry it saw.
     pub meshes: Vec<crate::scene::repair::MeshReport>,
+    /// The passes' modeled time on the GPU profile `[options.gpu] model` ([`crate::gpu_model`]):
+    /// a model, not a measurement.
+    pub gpu_model: crate::gpu_model::FrameEstimate,
 }
 
 /// The result of running one method on one scene.

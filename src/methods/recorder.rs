@@ -253,7 +253,9 @@ impl<'f, 's> PassRecorder<'f, 's> {
         for p in &self.passes {
             totals += p.counters;
         }
+        let gpu_model = crate::gpu_model::estimate(self.frame.gpu.model.profile(), &self.passes);
         let stats = MethodStats {
+            gpu_model,
             method: self.method.into(),
             width: self.frame.scene.width,
             height: self.frame.scene.height,

@@ -716,6 +716,10 @@ mod tests {
                 warnings: vec![],
                 clamped_pixels: 0,
                 meshes: vec![],
+                gpu_model: crate::gpu_model::estimate(
+                    crate::gpu_model::GpuModel::default().profile(),
+                    &[],
+                ),
             },
         }
     }

@@ -1,6 +1,6 @@
 //! A scene's table: the rows and notes of the text table ([`crate::render::table_rows`],
 //! [`crate::render::table_notes`]) plus what only the page has room for — the error over the
-//! reference's penumbra, the split by the receiver's horizon (mean |e| over whole-light and
+//! reference's penumbra, the modeled GPU time ([`crate::gpu_model`]), the split by the receiver's horizon (mean |e| over whole-light and
 //! horizon receivers, their share of the image and of the error; [`crate::metrics::horizon`]),
 //! the clamp and overflow counters, and the plan's resolved settings
 //! (z-pass or z-fail, formats; [`super::plan::settings_summary`]). One row per method that
@@ -14,9 +14,10 @@ use crate::metrics::ErrorStats;
 use crate::render::{table_notes, table_rows};
 
 /// The column heads, in order.
-const HEADS: [&str; 14] = [
+const HEADS: [&str; 15] = [
     "method",
     "time [s]",
+    "GPU model [ms] (a model)",
     "RMSE",
     "penumbra RMSE",
     "max |e|",
@@ -59,6 +60,7 @@ pub fn table(h: &mut Html, s: &SceneRuns) {
         h.element("td", &[("class", "name")], &name);
         let cells = [
             format!("{:.3}", row.seconds()),
+            row.gpu_model_ms(),
             stat(row.error, |e| format!("{:.5}", e.rmse)),
             stat(row.penumbra_error, |e| format!("{:.5}", e.rmse)),
             stat(row.error, |e| format!("{:.4}", e.max_abs)),

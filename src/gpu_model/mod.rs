@@ -1,0 +1,417 @@
+//! What a frame would cost on the GPUs the methods were designed for (issue 29 item 2;
+//! `docs/gpu-model.md` has the equations, the profiles with their sources and the
+//! assumptions): a roofline per pass over the work the emulator counted.
+//!
+//! Per pass, from its [`Counters`] ([`PassWork::from_counters`]) and a [`GpuProfile`] at clock
+//! `f`:
+//!
+//! ```text
+//! t = overhead + max( setup   = triangles submitted / setup rate,
+//!                     raster  = fragments rasterized / (z/stencil-only rate · f),
+//!                     shade   = fragment-program operations / (pipes · ALU ops per pipe · f),
+//!                     rop     = fragments passing the depth test / (ROP rate · f),
+//!                               ROP rate = colour ROPs if the pass writes colour, else the
+//!                               z/stencil-only rate,
+//!                     hiz     = hierarchical-Z tile tests / (tests per clock · f),
+//!                     memory  = (depth+stencil bytes / z compression + other bytes)
+//!                               / (bandwidth · efficiency) )
+//! ```
+//!
+//! and the frame is the sum over its passes. Each figure is a range (a published value is a
+//! range of one point), so each pass gets a **low** estimate (every figure at its fast end) and
+//! a **high** one (every figure at its slow end), and the **bound**: the term that is largest
+//! with every figure at the geometric middle of its range. A pass with no GPU work (no
+//! triangle, fragment or byte: the CPU stages, e.g. silhouette extraction and the ray tracer's
+//! rays) costs nothing here and is bound by `cpu`: the model prices the GPU only.
+//!
+//! What it leaves out, on purpose (`docs/gpu-model.md` "Limits"): the CPU and driver, the
+//! bus transfer of vertices built on the CPU each frame, caches (every counted byte goes to
+//! DRAM), and the overlap of consecutive passes.
+
+pub mod profile;
+
+pub use profile::{profiles, GpuModel, GpuProfile, DEFAULT_PROFILE};
+
+use crate::gpu::counters::Counters;
+use crate::pass::PassStats;
+use profile::Assumptions;
+
+/// The work of one pass the model prices, from its counters.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PassWork {
+    /// Triangles handed to setup.
+    pub triangles: u64,
+    /// Fragments the rasterizer produced.
+    pub fragments_rasterized: u64,
+    /// Fragment-program arithmetic operations executed.
+    pub shader_ops: u64,
+    /// Fragments that reached the ROPs (passed the depth test).
+    pub rop_fragments: u64,
+    /// Whether the pass writes colour (else its ROPs run at the z/stencil-only rate).
+    pub writes_color: bool,
+    /// Depth and stencil bytes read and written.
+    pub depth_stencil_bytes: u64,
+    /// Colour, texture and hierarchical-Z bytes read and written.
+    pub other_bytes: u64,
+    /// Hierarchical-Z tile tests.
+    pub hiz_tests: u64,
+}
+
+impl PassWork {
+    /// The work `c` counted.
+    pub fn from_counters(c: &Counters) -> Self {
+        PassWork {
+            triangles: c.triangles_submitted,
+            fragments_rasterized: c.fragments_rasterized,
+            // Not counted yet (issue 29 item 1): the shade term is 0 until the emulated
+            // fragment programs count their operations.
+            shader_ops: 0,
+            rop_fragments: c.depth_passed,
+            writes_color: c.color_write_bytes > 0,
+            depth_stencil_bytes: c.depth_read_bytes
+                + c.depth_write_bytes
+                + c.stencil_read_bytes
+                + c.stencil_write_bytes,
+            other_bytes: c.color_read_bytes + c.color_write_bytes + c.hiz_read_bytes,
+            hiz_tests: c.tiles_visited,
+        }
+    }
+
+    fn is_gpu_work(&self) -> bool {
+        self.triangles + self.fragments_rasterized + self.depth_stencil_bytes + self.other_bytes > 0
+    }
+}
+
+/// A term of the per-pass maximum (module doc).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Term {
+    /// Triangle setup.
+    Setup,
+    /// Rasterization.
+    Raster,
+    /// Fragment-program arithmetic.
+    Shade,
+    /// Raster operations (depth, stencil and colour writes).
+    Rop,
+    /// Hierarchical-Z tile tests.
+    Hiz,
+    /// DRAM traffic.
+    Memory,
+    /// No GPU work: a CPU stage the model does not price.
+    Cpu,
+}
+
+const TERMS: [Term; 6] = [
+    Term::Setup,
+    Term::Raster,
+    Term::Shade,
+    Term::Rop,
+    Term::Hiz,
+    Term::Memory,
+];
+
+/// Which end of every figure's range an evaluation takes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum End {
+    /// The fast end: the highest rate, the lowest overhead.
+    Fast,
+    /// The slow end.
+    Slow,
+    /// The geometric middle.
+    Middle,
+}
+
+/// A rate figure (higher is faster) at `end`.
+fn rate(f: &profile::Figure, end: End) -> f64 {
+    let (low, high) = f.range();
+    match end {
+        End::Fast => high,
+        End::Slow => low,
+        End::Middle => (low * high).sqrt(),
+    }
+}
+
+/// A cost figure (higher is slower) at `end`.
+fn cost(f: &profile::Figure, end: End) -> f64 {
+    let (low, high) = f.range();
+    match end {
+        End::Fast => low,
+        End::Slow => high,
+        End::Middle => (low * high).sqrt(),
+    }
+}
+
+/// The six terms of `w` in seconds, in [`TERMS`] order, and the overhead.
+fn terms(g: &GpuProfile, a: &Assumptions, w: &PassWork, end: End) -> ([f64; 6], f64) {
+    let clock = rate(&g.core_clock_mhz, end) * 1e6;
+    let per_clock = |count: u64, per: f64| count as f64 / (per * clock);
+    let rop_rate = if w.writes_color {
+        rate(&g.rops, end)
+    } else {
+        rate(&g.zstencil_per_clock, end)
+    };
+    let bytes = w.depth_stencil_bytes as f64 / rate(&a.z_compression, end) + w.other_bytes as f64;
+    let t = [
+        w.triangles as f64 / (rate(&g.triangle_setup_mtris, end) * 1e6),
+        per_clock(w.fragments_rasterized, rate(&g.zstencil_per_clock, end)),
+        per_clock(
+            w.shader_ops,
+            rate(&g.pixel_pipes, end) * rate(&g.alu_ops_per_pipe_per_clock, end),
+        ),
+        per_clock(w.rop_fragments, rop_rate),
+        per_clock(w.hiz_tests, rate(&a.hiz_tests_per_clock, end)),
+        bytes / (rate(&g.memory_bandwidth_gbs, end) * 1e9 * rate(&a.memory_efficiency, end)),
+    ];
+    (t, cost(&a.pass_overhead_us, end) * 1e-6)
+}
+
+fn seconds(g: &GpuProfile, a: &Assumptions, w: &PassWork, end: End) -> f64 {
+    let (t, overhead) = terms(g, a, w, end);
+    overhead + t.iter().copied().fold(0.0, f64::max)
+}
+
+/// A low and a high estimate, seconds.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Seconds {
+    /// Every figure at its fast end.
+    pub low: f64,
+    /// Every figure at its slow end.
+    pub high: f64,
+}
+
+/// The modeled time of one pass.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct PassEstimate {
+    /// The pass name.
+    pub name: String,
+    /// Every figure at its fast end, seconds.
+    pub low: f64,
+    /// Every figure at its slow end, seconds.
+    pub high: f64,
+    /// The term that bounds it with every figure at the middle of its range.
+    pub bound: Term,
+}
+
+/// The modeled time of a frame (a method's passes): `stats.json`'s `gpu_model`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct FrameEstimate {
+    /// The profile's id.
+    pub gpu: String,
+    /// The sum over the passes.
+    pub seconds: Seconds,
+    /// Per pass, in execution order.
+    pub passes: Vec<PassEstimate>,
+}
+
+/// The modeled time of `w` on `g` with the shared assumptions `a`.
+pub fn estimate_pass(g: &GpuProfile, a: &Assumptions, name: &str, w: &PassWork) -> PassEstimate {
+    if !w.is_gpu_work() {
+        return PassEstimate {
+            name: name.into(),
+            low: 0.0,
+            high: 0.0,
+            bound: Term::Cpu,
+        };
+    }
+    let (mid, _) = terms(g, a, w, End::Middle);
+    let k = (0..TERMS.len())
+        .max_by(|&i, &j| mid[i].total_cmp(&mid[j]))
+        .unwrap_or(0);
+    PassEstimate {
+        name: name.into(),
+        low: seconds(g, a, w, End::Fast),
+        high: seconds(g, a, w, End::Slow),
+        bound: TERMS[k],
+    }
+}
+
+/// The modeled time of the passes `passes` (a method's, in execution order; a pass that ran
+/// N times counts its summed work, as N runs of it would) on the profile `gpu` with the
+/// built-in assumptions.
+pub fn estimate(gpu: &GpuProfile, passes: &[PassStats]) -> FrameEstimate {
+    let a = &profiles().assumptions;
+    let passes: Vec<PassEstimate> = passes
+        .iter()
+        .map(|p| {
+            let mut e = estimate_pass(gpu, a, &p.name, &PassWork::from_counters(&p.counters));
+            // A pass that ran N times pays its fixed overhead N times.
+            if e.bound != Term::Cpu && p.runs > 1 {
+                let extra = (p.runs - 1) as f64 * 1e-6;
+                e.low += extra * cost(&a.pass_overhead_us, End::Fast);
+                e.high += extra * cost(&a.pass_overhead_us, End::Slow);
+            }
+            e
+        })
+        .collect();
+    FrameEstimate {
+        gpu: gpu.id.clone(),
+        seconds: Seconds {
+            low: passes.iter().map(|p| p.low).sum(),
+            high: passes.iter().map(|p| p.high).sum(),
+        },
+        passes,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gpu() -> &'static GpuProfile {
+        profiles().get("geforce-6800-ultra").unwrap()
+    }
+
+    fn a() -> &'static Assumptions {
+        &profiles().assumptions
+    }
+
+    fn work() -> PassWork {
+        PassWork {
+            triangles: 10_000,
+            fragments_rasterized: 200_000,
+            shader_ops: 2_000_000,
+            rop_fragments: 150_000,
+            writes_color: true,
+            depth_stencil_bytes: 1_600_000,
+            other_bytes: 600_000,
+            hiz_tests: 20_000,
+        }
+    }
+
+    /// Every counter, raised, never lowers either estimate (each term is increasing in its
+    /// count and the maximum and the sum keep that).
+    #[test]
+    fn the_model_is_monotonic_in_every_counter() {
+        type Bump = fn(&mut PassWork);
+        let bumps: [(&str, Bump); 8] = [
+            ("triangles", |w| w.triangles *= 50),
+            ("fragments", |w| w.fragments_rasterized *= 50),
+            ("shader ops", |w| w.shader_ops *= 50),
+            ("rop fragments", |w| w.rop_fragments *= 50),
+            ("depth bytes", |w| w.depth_stencil_bytes *= 50),
+            ("other bytes", |w| w.other_bytes *= 50),
+            ("hiz tests", |w| w.hiz_tests *= 50),
+            ("colour writes", |w| w.writes_color = true),
+        ];
+        for g in &profiles().gpu {
+            for base in [
+                work(),
+                PassWork {
+                    writes_color: false,
+                    ..work()
+                },
+            ] {
+                let e0 = estimate_pass(g, a(), "p", &base);
+                for (what, bump) in bumps {
+                    let mut w = base;
+                    bump(&mut w);
+                    let e = estimate_pass(g, a(), "p", &w);
+                    assert!(e.low >= e0.low && e.high >= e0.high, "{}: {what}", g.id);
+                }
+            }
+            let e = estimate_pass(g, a(), "p", &work());
+            assert!(0.0 < e.low && e.low <= e.high, "{}: {e:?}", g.id);
+        }
+    }
+
+    /// A pass built to stress one unit is bound by that unit, for each term in turn, and its
+    /// time is then that term plus the overhead (the arithmetic of the module doc).
+    #[test]
+    fn a_constructed_pass_is_bound_by_each_term_in_turn() {
+        let g = gpu();
+        let small = PassWork {
+            triangles: 1,
+            fragments_rasterized: 1,
+            shader_ops: 1,
+            rop_fragments: 1,
+            writes_color: true,
+            depth_stencil_bytes: 1,
+            other_bytes: 1,
+            hiz_tests: 1,
+        };
+        let big = 1_000_000_000;
+        let cases: [(Term, PassWork); 6] = [
+            (
+                Term::Setup,
+                PassWork {
+                    triangles: big,
+                    ..small
+                },
+            ),
+            (
+                Term::Raster,
+                PassWork {
+                    fragments_rasterized: big,
+                    ..small
+                },
+            ),
+            (
+                Term::Shade,
+                PassWork {
+                    shader_ops: 100 * big,
+                    ..small
+                },
+            ),
+            (
+                Term::Rop,
+                PassWork {
+                    rop_fragments: big,
+                    ..small
+                },
+            ),
+            (
+                Term::Hiz,
+                PassWork {
+                    hiz_tests: big,
+                    ..small
+                },
+            ),
+            (
+                Term::Memory,
+                PassWork {
+                    other_bytes: 100 * big,
+                    ..small
+                },
+            ),
+        ];
+        for (term, w) in cases {
+            let e = estimate_pass(g, a(), "p", &w);
+            assert_eq!(e.bound, term, "{w:?}");
+        }
+        // Setup-bound at the slow end: 10⁹ triangles at 200 M/s is 5 s, plus 50 µs.
+        let e = estimate_pass(g, a(), "p", &cases[0].1);
+        assert!((e.high - (5.0 + 50e-6)).abs() < 1e-9, "{e:?}");
+        // Memory-bound at the fast end: 10¹¹ bytes at 35.2 GB/s × 0.85.
+        let e = estimate_pass(g, a(), "p", &cases[5].1);
+        let want = 1e11 / (35.2e9 * 0.85) + 5e-6;
+        assert!((e.low - want).abs() < 1e-9 * want, "{e:?}");
+    }
+
+    /// A pass with no GPU work is a CPU stage: no time, bound `cpu`.
+    #[test]
+    fn a_pass_without_gpu_work_costs_nothing_and_says_cpu() {
+        let e = estimate_pass(gpu(), a(), "silhouettes", &PassWork::default());
+        assert_eq!((e.low, e.high, e.bound), (0.0, 0.0, Term::Cpu));
+    }
+
+    /// Z/stencil-only fragments run at twice the colour rate on NV40 and at the same rate on
+    /// R300 (the profiles' published figures).
+    #[test]
+    fn stencil_only_passes_fill_twice_as_fast_on_nv40_not_on_r300() {
+        let fill = |id: &str, writes_color: bool| {
+            let g = profiles().get(id).unwrap();
+            let w = PassWork {
+                rop_fragments: 1_000_000_000,
+                writes_color,
+                ..PassWork::default()
+            };
+            let (t, _) = terms(g, a(), &w, End::Middle);
+            t[3]
+        };
+        let nv40 = fill("geforce-6800-ultra", true) / fill("geforce-6800-ultra", false);
+        assert!((nv40 - 2.0).abs() < 1e-12, "{nv40}");
+        let r300 = fill("radeon-9700-pro", true) / fill("radeon-9700-pro", false);
+        assert!((r300 - 1.0).abs() < 1e-12, "{r300}");
+    }
+}
