@@ -767,10 +767,8 @@ fn volume_input(
 /// Render `dbuffer` with `s` on `frame` (one disk light), its passes recorded by a recorder
 /// of its own ([`DBufferRender::passes`]).
 pub fn render(frame: &Frame, s: &DBufferSettings) -> Result<DBufferRender, InputError> {
-    let mut rec = PassRecorder::new(frame, METHOD.name);
-    let mut r = render_with(&mut rec, s)?;
-    r.passes = rec.passes_after_the_scene_pass().to_vec();
-    Ok(r)
+    let (r, passes) = PassRecorder::record_alone(frame, METHOD.name, |rec| render_with(rec, s))?;
+    Ok(DBufferRender { passes, ..r })
 }
 
 /// [`render`], its passes run through `rec` (`passes` left empty).

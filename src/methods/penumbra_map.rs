@@ -346,10 +346,8 @@ pub struct PenumbraMapRender {
 /// Render `penumbra-map` with `s` on `frame` (one sphere light), its passes recorded by a
 /// recorder of its own ([`PenumbraMapRender::passes`]).
 pub fn render(frame: &Frame, s: &PenumbraMapSettings) -> Result<PenumbraMapRender, InputError> {
-    let mut rec = PassRecorder::new(frame, METHOD.name);
-    let mut r = render_with(&mut rec, s)?;
-    r.passes = rec.passes_after_the_scene_pass().to_vec();
-    Ok(r)
+    let (r, passes) = PassRecorder::record_alone(frame, METHOD.name, |rec| render_with(rec, s))?;
+    Ok(PenumbraMapRender { passes, ..r })
 }
 
 /// [`render`], its passes run through `rec` (`passes` left empty).

@@ -151,9 +151,17 @@ impl<'f, 's> PassRecorder<'f, 's> {
         out
     }
 
-    /// The passes recorded so far after the frame's scene pass, in execution order.
-    pub fn passes_after_the_scene_pass(&self) -> &[PassStats] {
-        &self.passes[1..]
+    /// Run `body` with a recorder of its own for `method` on `frame`, and hand back its result
+    /// with the passes it recorded after the frame's scene pass (a method's typed `render`,
+    /// which the tests read, over its `render_with`).
+    pub fn record_alone<R, E>(
+        frame: &'f Frame<'s>,
+        method: &'static str,
+        body: impl FnOnce(&mut Self) -> Result<R, E>,
+    ) -> Result<(R, Vec<PassStats>), E> {
+        let mut rec = Self::new(frame, method);
+        let r = body(&mut rec)?;
+        Ok((r, rec.passes.split_off(1)))
     }
 
     /// Record a pass that was run elsewhere and handed back its stats (a building block shared
