@@ -84,6 +84,7 @@ pub fn method_names() -> impl Iterator<Item = &'static str> {
 pub mod drawing;
 pub mod error;
 pub mod experiment;
+pub mod export;
 pub mod frame;
 pub mod geometry;
 pub mod golden;

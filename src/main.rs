@@ -44,6 +44,9 @@ enum Cmd {
     Report(ReportArgs),
     /// Explain one pixel: every pass's contribution to it with one method, then the reference.
     Probe(ProbeArgs),
+    /// Write a scene's meshes, camera, light, raycast's light samples and hard-sv's shadow
+    /// volume as JSON, for renderers outside the crate (docs/cli.md).
+    ExportScene(ExportArgs),
     /// Print the built-in scenes and the methods, one per line.
     List {
         /// Print instead every option table's keys: values, default and meaning.
@@ -184,6 +187,17 @@ struct ReportArgs {
     overrides: SceneOverrides,
     /// Output directory: DIR/index.html and DIR/SCENE/METHOD/….
     #[arg(long, default_value = penumbra::render::DEFAULT_OUT)]
+    out: PathBuf,
+}
+
+#[derive(clap::Args, Debug)]
+struct ExportArgs {
+    /// Scene file (.toml/.json) or built-in scene name.
+    scene: String,
+    #[command(flatten)]
+    overrides: SceneOverrides,
+    /// The JSON file to write.
+    #[arg(long)]
     out: PathBuf,
 }
 
@@ -408,6 +422,17 @@ fn probe(a: ProbeArgs) -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
+/// `export-scene`: the scene's export document ([`penumbra::export`]) written to `--out`.
+fn export_scene(a: &ExportArgs) -> Result<(), Box<dyn std::error::Error>> {
+    let mut scene = file::resolve(&a.scene)?;
+    apply_overrides(&mut scene, &a.overrides)?;
+    let doc = penumbra::export::export_scene(&scene)?;
+    std::fs::write(&a.out, serde_json::to_vec(&doc)?)
+        .map_err(|e| format!("{}: cannot write: {e}", a.out.display()))?;
+    println!("export: {}", a.out.display());
+    Ok(())
+}
+
 /// A scene argument, loaded and validated, its option tables checked.
 fn load_scene(arg: &str) -> Result<Scene, InputError> {
     let scene = file::resolve(arg)?;
@@ -560,7 +585,13 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
     if dumps
         && matches!(
             cli.cmd,
-            Some(Cmd::List { .. } | Cmd::Probe(_) | Cmd::Experiment(_) | Cmd::Golden { .. })
+            Some(
+                Cmd::List { .. }
+                    | Cmd::Probe(_)
+                    | Cmd::ExportScene(_)
+                    | Cmd::Experiment(_)
+                    | Cmd::Golden { .. }
+            )
         )
     {
         return Err(InputError::new(
@@ -615,6 +646,7 @@ fn run(cli: Cli) -> Result<(), Box<dyn std::error::Error>> {
         Some(Cmd::Render(a)) => render(&a, dumps).map(|_| ()),
         Some(Cmd::Report(a)) => report(&a, dumps),
         Some(Cmd::Probe(a)) => probe(a),
+        Some(Cmd::ExportScene(a)) => export_scene(&a),
         Some(Cmd::List { gpus: true, .. }) => {
             print!("{}", penumbra::gpu_model::profile::listing());
             Ok(())
