@@ -4,7 +4,7 @@
 //!
 //! Everything is what the methods themselves use, not a re-derivation: the meshes in world
 //! space as loaded (transforms applied, f32), their clip coordinates as the scene pass rounds
-//! them ([`Projection::clip_point`]), the camera's `P·V` with the near plane actually used
+//! them ([`crate::gpu::transform::Projection::clip_point`]), the camera's `P·V` with the near plane actually used
 //! (infinite far plane), the light, `raycast`'s stratified jittered samples
 //! ([`sampling::stratified`] with the scene's `[options.raycast]` `samples` and `seed`), and
 //! the clip-space shadow-volume triangles `hard-sv` draws from the light center, in its
