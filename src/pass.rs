@@ -17,15 +17,3 @@ pub struct PassStats {
     /// Counters summed over all tiles and runs.
     pub counters: Counters,
 }
-
-impl PassStats {
-    /// The stats of one run of pass `name` that started at `start` with `counters`.
-    pub fn since(name: &str, start: std::time::Instant, counters: Counters) -> Self {
-        Self {
-            name: name.into(),
-            wall_seconds: start.elapsed().as_secs_f64(),
-            runs: 1,
-            counters,
-        }
-    }
-}
