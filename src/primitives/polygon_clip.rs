@@ -9,7 +9,7 @@
 //! A point or a segment passed as a polygon clips as one (an empty result: nothing is inside).
 
 use glam::DVec2;
-use std::ops::{Div, Sub};
+use std::ops::{Add, Div, Mul, Sub};
 
 /// A scalar the clip computes with: comparable, with subtraction and division, and `0` as
 /// its default (f64 and every shader precision).
@@ -20,10 +20,26 @@ pub trait ClipScalar:
 
 impl<T: Copy + PartialOrd + Sub<Output = T> + Div<Output = T> + Default> ClipScalar for T {}
 
+/// A vertex the clip interpolates: copied, subtracted, added and scaled by its scalar `T`
+/// (a point or a point with attributes, in f64 or a shader precision).
+pub trait ClipVertex<T>:
+    Copy + Sub<Output = Self> + Add<Output = Self> + Mul<T, Output = Self>
+{
+}
+
+impl<T, V: Copy + Sub<Output = V> + Add<Output = V> + Mul<T, Output = V>> ClipVertex<T> for V {}
+
+/// Where the edge `a b`, at signed distances `da` and `db` of opposite signs, crosses
+/// `dist = 0`: the module's one interpolation rule.
+#[inline]
+fn crossing<V: ClipVertex<T>, T: ClipScalar>(a: V, b: V, da: T, db: T) -> V {
+    a + (b - a) * (da / (da - db))
+}
+
 /// One Sutherland–Hodgman step: keep the part of `poly` where `dist ≥ 0`.
 pub fn clip_polygon<V, T, F>(poly: &[V], dist: F) -> Vec<V>
 where
-    V: Copy + std::ops::Sub<Output = V> + std::ops::Add<Output = V> + std::ops::Mul<T, Output = V>,
+    V: ClipVertex<T>,
     T: ClipScalar,
     F: Fn(V) -> T,
 {
@@ -36,7 +52,7 @@ where
 /// clip creates through `cut` first.
 pub fn clip_polygon_into<V, T, F, M>(poly: &[V], dist: F, cut: M, mut emit: impl FnMut(V))
 where
-    V: Copy + std::ops::Sub<Output = V> + std::ops::Add<Output = V> + std::ops::Mul<T, Output = V>,
+    V: ClipVertex<T>,
     T: ClipScalar,
     F: Fn(V) -> T,
     M: Fn(V) -> V,
@@ -57,7 +73,7 @@ where
             emit(a);
         }
         if (da >= zero) != (db >= zero) {
-            emit(cut(a + (b - a) * (da / (da - db))));
+            emit(cut(crossing(a, b, da, db)));
         }
         (a, da) = (b, db);
     }
@@ -66,7 +82,7 @@ where
 /// Clip the segment `a b` to `dist ≥ 0` in place; `None` when nothing is left.
 pub fn clip_segment<V, T, F>(a: &mut V, b: &mut V, dist: F) -> Option<()>
 where
-    V: Copy + std::ops::Sub<Output = V> + std::ops::Add<Output = V> + std::ops::Mul<T, Output = V>,
+    V: ClipVertex<T>,
     T: ClipScalar,
     F: Fn(V) -> T,
 {
@@ -76,7 +92,7 @@ where
 /// [`clip_segment`], passing an end the clip moves through `cut`.
 pub fn clip_segment_marking<V, T, F, M>(a: &mut V, b: &mut V, dist: F, cut: M) -> Option<()>
 where
-    V: Copy + std::ops::Sub<Output = V> + std::ops::Add<Output = V> + std::ops::Mul<T, Output = V>,
+    V: ClipVertex<T>,
     T: ClipScalar,
     F: Fn(V) -> T,
     M: Fn(V) -> V,
@@ -87,11 +103,11 @@ where
         (true, true) => Some(()),
         (false, false) => None,
         (true, false) => {
-            *b = cut(*a + (*b - *a) * (da / (da - db)));
+            *b = cut(crossing(*a, *b, da, db));
             Some(())
         }
         (false, true) => {
-            *a = cut(*a + (*b - *a) * (da / (da - db)));
+            *a = cut(crossing(*a, *b, da, db));
             Some(())
         }
     }
