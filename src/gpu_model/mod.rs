@@ -55,11 +55,14 @@ pub struct PassWork {
     pub other_bytes: u64,
     /// Hierarchical-Z tile tests.
     pub hiz_tests: u64,
+    /// How many times the pass ran (its counters are the runs' sum; each run pays the fixed
+    /// overhead).
+    pub runs: u64,
 }
 
 impl PassWork {
-    /// The work `c` counted.
-    pub fn from_counters(c: &Counters) -> Self {
+    /// The work `c` counted over `runs` runs of a pass.
+    pub fn from_counters(c: &Counters, runs: u64) -> Self {
         PassWork {
             triangles: c.triangles_submitted,
             fragments_rasterized: c.fragments_rasterized,
@@ -74,6 +77,7 @@ impl PassWork {
                 + c.stencil_write_bytes,
             other_bytes: c.color_read_bytes + c.color_write_bytes + c.hiz_read_bytes,
             hiz_tests: c.tiles_visited,
+            runs,
         }
     }
 
@@ -163,7 +167,7 @@ fn terms(g: &GpuProfile, a: &Assumptions, w: &PassWork, end: End) -> ([f64; 6], 
         per_clock(w.hiz_tests, rate(&a.hiz_tests_per_clock, end)),
         bytes / (rate(&g.memory_bandwidth_gbs, end) * 1e9 * rate(&a.memory_efficiency, end)),
     ];
-    (t, cost(&a.pass_overhead_us, end) * 1e-6)
+    (t, w.runs as f64 * cost(&a.pass_overhead_us, end) * 1e-6)
 }
 
 fn seconds(g: &GpuProfile, a: &Assumptions, w: &PassWork, end: End) -> f64 {
@@ -227,21 +231,19 @@ pub fn estimate_pass(g: &GpuProfile, a: &Assumptions, name: &str, w: &PassWork) 
 }
 
 /// The modeled time of the passes `passes` (a method's, in execution order; a pass that ran
-/// N times counts its summed work, as N runs of it would) on the profile `gpu` with the
-/// built-in assumptions.
+/// N times counts its summed work and N overheads, as N runs of it would) on the profile `gpu`
+/// with the built-in assumptions.
 pub fn estimate(gpu: &GpuProfile, passes: &[PassStats]) -> FrameEstimate {
     let a = &profiles().assumptions;
     let passes: Vec<PassEstimate> = passes
         .iter()
         .map(|p| {
-            let mut e = estimate_pass(gpu, a, &p.name, &PassWork::from_counters(&p.counters));
-            // A pass that ran N times pays its fixed overhead N times.
-            if e.bound != Term::Cpu && p.runs > 1 {
-                let extra = (p.runs - 1) as f64 * 1e-6;
-                e.low += extra * cost(&a.pass_overhead_us, End::Fast);
-                e.high += extra * cost(&a.pass_overhead_us, End::Slow);
-            }
-            e
+            estimate_pass(
+                gpu,
+                a,
+                &p.name,
+                &PassWork::from_counters(&p.counters, p.runs),
+            )
         })
         .collect();
     FrameEstimate {
@@ -276,6 +278,7 @@ mod tests {
             depth_stencil_bytes: 1_600_000,
             other_bytes: 600_000,
             hiz_tests: 20_000,
+            runs: 1,
         }
     }
 
@@ -329,6 +332,7 @@ mod tests {
             depth_stencil_bytes: 1,
             other_bytes: 1,
             hiz_tests: 1,
+            runs: 1,
         };
         let big = 1_000_000_000;
         let cases: [(Term, PassWork); 6] = [
@@ -386,6 +390,28 @@ mod tests {
         let e = estimate_pass(g, a(), "p", &cases[5].1);
         let want = 1e11 / (35.2e9 * 0.85) + 5e-6;
         assert!((e.low - want).abs() < 1e-9 * want, "{e:?}");
+    }
+
+    /// A pass that ran N times pays N overheads (5–50 µs each) on top of its summed work.
+    #[test]
+    fn each_run_of_a_pass_pays_the_overhead() {
+        let one = PassWork { runs: 1, ..work() };
+        let many = PassWork {
+            runs: 1024,
+            ..work()
+        };
+        let (e1, en) = (
+            estimate_pass(gpu(), a(), "p", &one),
+            estimate_pass(gpu(), a(), "p", &many),
+        );
+        assert!(
+            (en.low - e1.low - 1023.0 * 5e-6).abs() < 1e-12,
+            "{e1:?} {en:?}"
+        );
+        assert!(
+            (en.high - e1.high - 1023.0 * 50e-6).abs() < 1e-12,
+            "{e1:?} {en:?}"
+        );
     }
 
     /// A pass with no GPU work is a CPU stage: no time, bound `cpu`.
