@@ -65,6 +65,18 @@ pub struct Counters {
     pub hiz_read_bytes: u64,
     /// Writes whose value over- or underflowed the storage format (wrapped or saturated).
     pub overflow_events: u64,
+    /// Fragment-program ALU instruction slots executed ([`super::shader_ops`], its table).
+    pub shader_alu_ops: u64,
+    /// Fragment-program transcendental functions executed (`atan2`, `acos`, `tan`: no
+    /// instruction of the papers' GPUs; the cost model prices each as an assumption).
+    pub shader_transcendentals: u64,
+    /// Fragment-program texture samples.
+    pub shader_fetches: u64,
+    /// Fragments a fragment program killed (discarded) before they wrote.
+    pub shader_discards: u64,
+    /// The most instruction slots (ALU + fetches) one fragment-program invocation executed:
+    /// a maximum, not a sum, when counters are added.
+    pub shader_max_slots: u64,
 }
 
 impl Counters {
@@ -104,5 +116,10 @@ impl AddAssign for Counters {
         self.color_write_bytes += o.color_write_bytes;
         self.hiz_read_bytes += o.hiz_read_bytes;
         self.overflow_events += o.overflow_events;
+        self.shader_alu_ops += o.shader_alu_ops;
+        self.shader_transcendentals += o.shader_transcendentals;
+        self.shader_fetches += o.shader_fetches;
+        self.shader_discards += o.shader_discards;
+        self.shader_max_slots = self.shader_max_slots.max(o.shader_max_slots);
     }
 }

@@ -268,6 +268,18 @@ impl LightView {
         filter: Filter,
         texel: impl Fn(usize, usize) -> f64,
     ) -> f64 {
+        super::shader_ops::fetch();
+        self.sample_texels(x, y, filter, texel)
+    }
+
+    /// [`LightView::sample`] without counting a fetch (what a probe replays).
+    fn sample_texels(
+        &self,
+        x: f32,
+        y: f32,
+        filter: Filter,
+        texel: impl Fn(usize, usize) -> f64,
+    ) -> f64 {
         let n = self.size();
         sample_2d(
             x as f64,
@@ -287,7 +299,7 @@ impl LightView {
     /// ([`super::probe`]).
     pub fn texels_read(&self, x: f32, y: f32, filter: Filter) -> Vec<[u32; 2]> {
         let read = std::cell::RefCell::new(Vec::new());
-        self.sample(x, y, filter, |t, l| {
+        self.sample_texels(x, y, filter, |t, l| {
             read.borrow_mut().push(self.tiling.position(t, l));
             0.0
         });

@@ -28,6 +28,7 @@ pub mod probe;
 pub mod raster;
 pub mod setup;
 pub mod shader_float;
+pub mod shader_ops;
 pub mod shader_vec;
 pub mod split_blend;
 pub mod stencil;

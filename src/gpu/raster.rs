@@ -333,7 +333,8 @@ pub fn rasterize_in_tile(
 /// `fragment` gets a [`Tap`] for the fragments of the samples `probe` watches
 /// ([`super::probe`]) and `None` for every other one: the tile index is compared with the
 /// watched tiles once per tile; only in a watched tile is each fragment's sample compared.
-/// Returns the counters summed over tiles.
+/// Every fragment handed to `fragment` is one fragment-program invocation whose operations
+/// are counted ([`super::shader_ops::measure`]). Returns the counters summed over tiles.
 pub fn draw<T, S, D, F>(
     tiling: &Tiling,
     tiles: &mut [T],
@@ -371,7 +372,7 @@ where
                 };
                 let (visited, n) = rasterize_in_tile(tiling, tri, &within, |f| {
                     let tap = watched.and_then(|p| p.tap(t, f.local));
-                    fragment(t, storage, tri, f, &mut c, tap)
+                    super::shader_ops::measure(&mut c, |c| fragment(t, storage, tri, f, c, tap))
                 });
                 count!(c.tiles_visited += visited as u64);
                 count!(c.fragments_rasterized += n);

@@ -22,9 +22,11 @@
 //! | `fp24` | 1 / 7 / 16 | 63 | −62…63 | flushed to ±0 | ±∞ | (2 − 2⁻¹⁶)·2⁶³ ≈ 1.84·10¹⁹ |
 //! | `fp16` | 1 / 5 / 10 | 15 | −14…15 | kept | ±∞ | 65504 |
 //!
-//! * **`f64`** is the identity: the [`ShaderFloat`] implementation of `f64` is plain f64
-//!   arithmetic, so the default leaves every output bit-identical to the code before shader
-//!   precision existed.
+//! * **`f64`** is the identity: the default precision's scalar [`ShaderF64`] (and `f64`'s own
+//!   [`ShaderFloat`] implementation, the uncounted reference arithmetic of tests and CPU stages)
+//!   is plain f64 arithmetic, so the default leaves every output bit-identical to the code
+//!   before shader precision existed. Every fragment-program scalar counts its operations
+//!   ([`super::shader_ops`]); `f64` does not.
 //! * **`fp32`**: IEEE 754 binary32, as NV3x's (GeForce FX) and G70's (GeForce 7800) `float`
 //!   (Paper III's Cg shaders; Forest et al. 2006). Denormals are kept, so the arithmetic equals
 //!   Rust's `f32` bit for bit (a property test checks it).
@@ -62,6 +64,7 @@
 //! read per operation) — 2.6× slower at the default precision. The cost of the generic choice
 //! is compile time and code size, paid only in the converted passes.
 
+use super::shader_ops;
 use std::fmt::Debug;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
@@ -218,6 +221,10 @@ pub trait ShaderFloat:
     /// The precision this type computes in.
     const PRECISION: ShaderPrecision;
 
+    /// Whether its operations are counted ([`shader_ops`]): the fragment programs' scalars
+    /// are, `f64` (the uncounted reference arithmetic) is not.
+    const COUNTED: bool = true;
+
     /// This format, or fp32 where this one is wider (f64): the scalar of a fragment program
     /// whose arithmetic was fp32 before shader precision existed — `wedge-blending`'s vBuffer
     /// arithmetic ([`crate::methods::wedge_blending::blend`]), whose values are the f32 the
@@ -244,26 +251,41 @@ pub trait ShaderFloat:
 
     /// Square root, rounded.
     fn sqrt(self) -> Self {
+        if Self::COUNTED {
+            shader_ops::alu(2);
+        }
         Self::from_f64(libm::sqrt(self.to_f64()))
     }
 
     /// `atan2(self, x)` (`libm`), rounded.
     fn atan2(self, x: Self) -> Self {
+        if Self::COUNTED {
+            shader_ops::transcendental();
+        }
         Self::from_f64(libm::atan2(self.to_f64(), x.to_f64()))
     }
 
     /// `acos` (`libm`), rounded.
     fn acos(self) -> Self {
+        if Self::COUNTED {
+            shader_ops::transcendental();
+        }
         Self::from_f64(libm::acos(self.to_f64()))
     }
 
     /// `tan` (`libm`), rounded.
     fn tan(self) -> Self {
+        if Self::COUNTED {
+            shader_ops::transcendental();
+        }
         Self::from_f64(libm::tan(self.to_f64()))
     }
 
     /// The nearest integer, halves away from zero (f64 `round`; exact).
     fn round(self) -> Self {
+        if Self::COUNTED {
+            shader_ops::alu(2);
+        }
         Self::from_f64(self.to_f64().round())
     }
 
@@ -271,6 +293,9 @@ pub trait ShaderFloat:
     /// `self mod rhs` is exact in every format, and the one addition of `|rhs|` to a negative
     /// remainder is rounded once (module doc: double rounding is innocuous for `+`).
     fn rem_euclid(self, rhs: Self) -> Self {
+        if Self::COUNTED {
+            shader_ops::alu(3);
+        }
         Self::from_f64(self.to_f64().rem_euclid(rhs.to_f64()))
     }
 
@@ -283,6 +308,9 @@ pub trait ShaderFloat:
     /// operand, which would turn a NaN coverage into a valid-looking 0 or 1 — a NaN must stay
     /// visible; the GL specs leave `min` of a NaN undefined, so this is the choice).
     fn min(self, other: Self) -> Self {
+        if Self::COUNTED {
+            shader_ops::alu(1);
+        }
         let (a, b) = (self.to_f64(), other.to_f64());
         Self::from_f64(if a.is_nan() || b.is_nan() {
             f64::NAN
@@ -293,6 +321,9 @@ pub trait ShaderFloat:
 
     /// The larger of the two; NaN when either is NaN (as [`ShaderFloat::min`]).
     fn max(self, other: Self) -> Self {
+        if Self::COUNTED {
+            shader_ops::alu(1);
+        }
         let (a, b) = (self.to_f64(), other.to_f64());
         Self::from_f64(if a.is_nan() || b.is_nan() {
             f64::NAN
@@ -303,27 +334,40 @@ pub trait ShaderFloat:
 
     /// `self` clamped to `[lo, hi]` (f64 `clamp`: NaN stays NaN).
     fn clamp(self, lo: Self, hi: Self) -> Self {
+        if Self::COUNTED {
+            shader_ops::alu(2);
+        }
         Self::from_f64(self.to_f64().clamp(lo.to_f64(), hi.to_f64()))
     }
 
     /// Largest integer not above `self` (exact).
     fn floor(self) -> Self {
+        if Self::COUNTED {
+            shader_ops::alu(1);
+        }
         Self::from_f64(libm::floor(self.to_f64()))
     }
 
     /// `1`, `−1` (by the sign bit, as f64 `signum`), or NaN.
     fn signum(self) -> Self {
+        if Self::COUNTED {
+            shader_ops::alu(2);
+        }
         Self::from_f64(self.to_f64().signum())
     }
 
     /// Whether the value is neither infinite nor NaN.
     fn is_finite(self) -> bool {
+        if Self::COUNTED {
+            shader_ops::alu(1);
+        }
         self.to_f64().is_finite()
     }
 }
 
 impl ShaderFloat for f64 {
     const PRECISION: ShaderPrecision = ShaderPrecision::F64;
+    const COUNTED: bool = false;
     type AtMostFp32 = Fp32;
 
     fn from_f64(x: f64) -> Self {
@@ -337,17 +381,19 @@ impl ShaderFloat for f64 {
 
 /// A scalar type whose every operation rounds to `$format` (module doc).
 macro_rules! rounded_float {
-    ($(#[$meta:meta])* $name:ident, $format:expr, $precision:expr) => {
+    ($(#[$meta:meta])* $name:ident, $round:expr, $precision:expr, $at_most_fp32:ty) => {
         $(#[$meta])*
-        #[derive(Debug, Clone, Copy, Default, PartialEq, PartialOrd)]
+        #[derive(Debug, Clone, Copy, Default)]
         pub struct $name(f64);
 
         impl ShaderFloat for $name {
             const PRECISION: ShaderPrecision = $precision;
-            type AtMostFp32 = Self;
+            type AtMostFp32 = $at_most_fp32;
 
+            #[inline]
             fn from_f64(x: f64) -> Self {
-                $name($format.round(x))
+                let round: fn(f64) -> f64 = $round;
+                $name(round(x))
             }
 
             fn to_f64(self) -> f64 {
@@ -358,6 +404,7 @@ macro_rules! rounded_float {
         impl Add for $name {
             type Output = Self;
             fn add(self, rhs: Self) -> Self {
+                shader_ops::alu(1);
                 Self::from_f64(self.0 + rhs.0)
             }
         }
@@ -365,6 +412,7 @@ macro_rules! rounded_float {
         impl Sub for $name {
             type Output = Self;
             fn sub(self, rhs: Self) -> Self {
+                shader_ops::alu(1);
                 Self::from_f64(self.0 - rhs.0)
             }
         }
@@ -372,6 +420,7 @@ macro_rules! rounded_float {
         impl Mul for $name {
             type Output = Self;
             fn mul(self, rhs: Self) -> Self {
+                shader_ops::alu(1);
                 Self::from_f64(self.0 * rhs.0)
             }
         }
@@ -379,6 +428,7 @@ macro_rules! rounded_float {
         impl Div for $name {
             type Output = Self;
             fn div(self, rhs: Self) -> Self {
+                shader_ops::alu(2);
                 Self::from_f64(self.0 / rhs.0)
             }
         }
@@ -389,26 +439,53 @@ macro_rules! rounded_float {
                 $name(-self.0)
             }
         }
+
+        /// A comparison is one instruction (`SLT`, `SGE`, `CMP`; [`shader_ops`]).
+        impl PartialEq for $name {
+            fn eq(&self, other: &Self) -> bool {
+                shader_ops::alu(1);
+                self.0 == other.0
+            }
+        }
+
+        impl PartialOrd for $name {
+            fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+                shader_ops::alu(1);
+                self.0.partial_cmp(&other.0)
+            }
+        }
     };
 }
 
 rounded_float!(
+    /// The default precision's scalar in a fragment program: plain f64 arithmetic (the same
+    /// bits as `f64`'s [`ShaderFloat`]), every operation counted ([`shader_ops`]). `f64`
+    /// itself stays the uncounted reference arithmetic of the tests and the CPU stages.
+    ShaderF64,
+    |x| x,
+    ShaderPrecision::F64,
+    Fp32
+);
+rounded_float!(
     /// IEEE binary32 arithmetic ([`FP32`]).
     Fp32,
-    FP32,
-    ShaderPrecision::Fp32
+    |x| FP32.round(x),
+    ShaderPrecision::Fp32,
+    Self
 );
 rounded_float!(
     /// ATI R300 24-bit float arithmetic ([`FP24`]).
     Fp24,
-    FP24,
-    ShaderPrecision::Fp24
+    |x| FP24.round(x),
+    ShaderPrecision::Fp24,
+    Self
 );
 rounded_float!(
     /// IEEE binary16 arithmetic ([`FP16`]).
     Fp16,
-    FP16,
-    ShaderPrecision::Fp16
+    |x| FP16.round(x),
+    ShaderPrecision::Fp16,
+    Self
 );
 
 /// Evaluate `$body` with the type name `$t` bound to the [`ShaderFloat`] of `$precision` (a
@@ -418,7 +495,7 @@ macro_rules! with_shader_float {
     ($precision:expr, $t:ident => $body:expr) => {
         match $precision {
             $crate::gpu::shader_float::ShaderPrecision::F64 => {
-                type $t = f64;
+                type $t = $crate::gpu::shader_float::ShaderF64;
                 $body
             }
             $crate::gpu::shader_float::ShaderPrecision::Fp32 => {

@@ -7,6 +7,7 @@
 //! `DVec4`.
 
 use super::shader_float::ShaderFloat;
+use super::shader_ops::vector;
 use glam::{DVec2, DVec3};
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
@@ -61,12 +62,16 @@ impl<T: ShaderFloat> SVec2<T> {
 
     /// `x·o.x + y·o.y`, each operation rounded.
     pub fn dot(self, o: Self) -> T {
-        self.x * o.x + self.y * o.y
+        let d = self.x * o.x + self.y * o.y;
+        vector::<T>(3, 1); // DP3 with z = 0
+        d
     }
 
     /// `x·y′ − y·x′`.
     pub fn perp_dot(self, o: Self) -> T {
-        self.x * o.y - self.y * o.x
+        let d = self.x * o.y - self.y * o.x;
+        vector::<T>(3, 2); // MUL, MAD
+        d
     }
 
     /// Both components finite.
@@ -93,16 +98,20 @@ impl<T: ShaderFloat> SVec3<T> {
 
     /// `(x·x′ + y·y′) + z·z′`.
     pub fn dot(self, o: Self) -> T {
-        self.x * o.x + self.y * o.y + self.z * o.z
+        let d = self.x * o.x + self.y * o.y + self.z * o.z;
+        vector::<T>(5, 1); // DP3
+        d
     }
 
     /// The cross product, glam's order.
     pub fn cross(self, o: Self) -> Self {
-        SVec3::new(
+        let c = SVec3::new(
             self.y * o.z - o.y * self.z,
             self.z * o.x - o.z * self.x,
             self.x * o.y - o.x * self.y,
-        )
+        );
+        vector::<T>(9, 2); // MUL, MAD with swizzles (XPD)
+        c
     }
 
     /// `sqrt(dot(self, self))`.
@@ -148,35 +157,47 @@ impl<T: ShaderFloat> SVec4<T> {
 
     /// `((x·x′ + y·y′) + z·z′) + w·w′`.
     pub fn dot(self, o: Self) -> T {
-        self.x * o.x + self.y * o.y + self.z * o.z + self.w * o.w
+        let d = self.x * o.x + self.y * o.y + self.z * o.z + self.w * o.w;
+        vector::<T>(7, 1); // DP4
+        d
     }
 }
 
 /// Component-wise `+ −`, scaling by a scalar `* /`, negation.
+/// Each is one vector instruction ([`vector`]): `ADD`, `ADD`, `MUL`, and `RCP` + `MUL` for
+/// the division (the scalar operations counted `n`, `n`, `n` and `2n` slots).
 macro_rules! vector_ops {
-    ($v:ident { $($c:ident),+ }) => {
+    ($v:ident { $($c:ident),+ }, $n:expr) => {
         impl<T: ShaderFloat> Add for $v<T> {
             type Output = Self;
             fn add(self, o: Self) -> Self {
-                $v { $($c: self.$c + o.$c),+ }
+                let r = $v { $($c: self.$c + o.$c),+ };
+                vector::<T>($n, 1);
+                r
             }
         }
         impl<T: ShaderFloat> Sub for $v<T> {
             type Output = Self;
             fn sub(self, o: Self) -> Self {
-                $v { $($c: self.$c - o.$c),+ }
+                let r = $v { $($c: self.$c - o.$c),+ };
+                vector::<T>($n, 1);
+                r
             }
         }
         impl<T: ShaderFloat> Mul<T> for $v<T> {
             type Output = Self;
             fn mul(self, s: T) -> Self {
-                $v { $($c: self.$c * s),+ }
+                let r = $v { $($c: self.$c * s),+ };
+                vector::<T>($n, 1);
+                r
             }
         }
         impl<T: ShaderFloat> Div<T> for $v<T> {
             type Output = Self;
             fn div(self, s: T) -> Self {
-                $v { $($c: self.$c / s),+ }
+                let r = $v { $($c: self.$c / s),+ };
+                vector::<T>(2 * $n, 2);
+                r
             }
         }
         impl<T: ShaderFloat> Neg for $v<T> {
@@ -188,9 +209,9 @@ macro_rules! vector_ops {
     };
 }
 
-vector_ops!(SVec2 { x, y });
-vector_ops!(SVec3 { x, y, z });
-vector_ops!(SVec4 { x, y, z, w });
+vector_ops!(SVec2 { x, y }, 2);
+vector_ops!(SVec3 { x, y, z }, 3);
+vector_ops!(SVec4 { x, y, z, w }, 4);
 
 #[cfg(test)]
 mod tests {

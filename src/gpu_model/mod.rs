@@ -8,7 +8,8 @@
 //! ```text
 //! t = overhead + max( setup   = triangles submitted / setup rate,
 //!                     raster  = fragments rasterized / (z/stencil-only rate · f),
-//!                     shade   = fragment-program operations / (pipes · ALU ops per pipe · f),
+//!                     shade   = (fragment-program slots + transcendentals · their slots)
+//!                               / (pipes · ALU ops per pipe · f),
 //!                     rop     = fragments passing the depth test / (ROP rate · f),
 //!                               ROP rate = colour ROPs if the pass writes colour, else the
 //!                               z/stencil-only rate,
@@ -43,8 +44,12 @@ pub struct PassWork {
     pub triangles: u64,
     /// Fragments the rasterizer produced.
     pub fragments_rasterized: u64,
-    /// Fragment-program arithmetic operations executed.
-    pub shader_ops: u64,
+    /// Fragment-program instruction slots executed: ALU slots and texture fetches
+    /// ([`crate::gpu::shader_ops`]).
+    pub shader_slots: u64,
+    /// Fragment-program transcendental functions, each priced at the assumed
+    /// `transcendental_slots`.
+    pub shader_transcendentals: u64,
     /// Fragments that reached the ROPs (passed the depth test).
     pub rop_fragments: u64,
     /// Whether the pass writes colour (else its ROPs run at the z/stencil-only rate).
@@ -66,9 +71,8 @@ impl PassWork {
         PassWork {
             triangles: c.triangles_submitted,
             fragments_rasterized: c.fragments_rasterized,
-            // Not counted yet (issue 29 item 1): the shade term is 0 until the emulated
-            // fragment programs count their operations.
-            shader_ops: 0,
+            shader_slots: c.shader_alu_ops + c.shader_fetches,
+            shader_transcendentals: c.shader_transcendentals,
             rop_fragments: c.depth_passed,
             writes_color: c.color_write_bytes > 0,
             depth_stencil_bytes: c.depth_read_bytes
@@ -160,8 +164,12 @@ fn terms(g: &GpuProfile, a: &Assumptions, w: &PassWork, end: End) -> ([f64; 6], 
         w.triangles as f64 / (rate(&g.triangle_setup_mtris, end) * 1e6),
         per_clock(w.fragments_rasterized, rate(&g.zstencil_per_clock, end)),
         per_clock(
-            w.shader_ops,
+            w.shader_slots,
             rate(&g.pixel_pipes, end) * rate(&g.alu_ops_per_pipe_per_clock, end),
+        ) + per_clock(
+            w.shader_transcendentals,
+            rate(&g.pixel_pipes, end) * rate(&g.alu_ops_per_pipe_per_clock, end)
+                / cost(&a.transcendental_slots, end),
         ),
         per_clock(w.rop_fragments, rop_rate),
         per_clock(w.hiz_tests, rate(&a.hiz_tests_per_clock, end)),
@@ -195,6 +203,41 @@ pub struct PassEstimate {
     pub high: f64,
     /// The term that bounds it with every figure at the middle of its range.
     pub bound: Term,
+    /// What its fragment program executed per fragment shaded (`None` for a pass that ran
+    /// none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub program: Option<ProgramWork>,
+}
+
+/// A pass's fragment-program work per fragment shaded ([`crate::gpu::shader_ops`]): what
+/// `docs/gpu-model.md` compares with the papers' instruction counts.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct ProgramWork {
+    /// Instruction slots (ALU + fetches) over fragments shaded.
+    pub mean_slots: f64,
+    /// The most slots one invocation executed.
+    pub max_slots: u64,
+    /// Texture fetches over fragments shaded.
+    pub mean_fetches: f64,
+    /// Transcendental functions over fragments shaded.
+    pub mean_transcendentals: f64,
+}
+
+impl ProgramWork {
+    /// The per-fragment work of a pass that counted `c`; `None` if no program ran.
+    pub fn from_counters(c: &Counters) -> Option<Self> {
+        let slots = c.shader_alu_ops + c.shader_fetches;
+        if c.fragments_shaded == 0 || slots + c.shader_transcendentals == 0 {
+            return None;
+        }
+        let per = |n: u64| n as f64 / c.fragments_shaded as f64;
+        Some(ProgramWork {
+            mean_slots: per(slots),
+            max_slots: c.shader_max_slots,
+            mean_fetches: per(c.shader_fetches),
+            mean_transcendentals: per(c.shader_transcendentals),
+        })
+    }
 }
 
 /// The modeled time of a frame (a method's passes): `stats.json`'s `gpu_model`.
@@ -216,6 +259,7 @@ pub fn estimate_pass(g: &GpuProfile, a: &Assumptions, name: &str, w: &PassWork) 
             low: 0.0,
             high: 0.0,
             bound: Term::Cpu,
+            program: None,
         };
     }
     let (mid, _) = terms(g, a, w, End::Middle);
@@ -227,6 +271,7 @@ pub fn estimate_pass(g: &GpuProfile, a: &Assumptions, name: &str, w: &PassWork) 
         low: seconds(g, a, w, End::Fast),
         high: seconds(g, a, w, End::Slow),
         bound: TERMS[k],
+        program: None,
     }
 }
 
@@ -237,8 +282,9 @@ pub fn estimate(gpu: &GpuProfile, passes: &[PassStats]) -> FrameEstimate {
     let a = &profiles().assumptions;
     let passes: Vec<PassEstimate> = passes
         .iter()
-        .map(|p| {
-            estimate_pass(
+        .map(|p| PassEstimate {
+            program: ProgramWork::from_counters(&p.counters),
+            ..estimate_pass(
                 gpu,
                 a,
                 &p.name,
@@ -272,7 +318,8 @@ mod tests {
         PassWork {
             triangles: 10_000,
             fragments_rasterized: 200_000,
-            shader_ops: 2_000_000,
+            shader_slots: 2_000_000,
+            shader_transcendentals: 20_000,
             rop_fragments: 150_000,
             writes_color: true,
             depth_stencil_bytes: 1_600_000,
@@ -287,10 +334,11 @@ mod tests {
     #[test]
     fn the_model_is_monotonic_in_every_counter() {
         type Bump = fn(&mut PassWork);
-        let bumps: [(&str, Bump); 8] = [
+        let bumps: [(&str, Bump); 9] = [
             ("triangles", |w| w.triangles *= 50),
             ("fragments", |w| w.fragments_rasterized *= 50),
-            ("shader ops", |w| w.shader_ops *= 50),
+            ("shader slots", |w| w.shader_slots *= 50),
+            ("transcendentals", |w| w.shader_transcendentals *= 50),
             ("rop fragments", |w| w.rop_fragments *= 50),
             ("depth bytes", |w| w.depth_stencil_bytes *= 50),
             ("other bytes", |w| w.other_bytes *= 50),
@@ -326,7 +374,8 @@ mod tests {
         let small = PassWork {
             triangles: 1,
             fragments_rasterized: 1,
-            shader_ops: 1,
+            shader_slots: 1,
+            shader_transcendentals: 0,
             rop_fragments: 1,
             writes_color: true,
             depth_stencil_bytes: 1,
@@ -335,7 +384,7 @@ mod tests {
             runs: 1,
         };
         let big = 1_000_000_000;
-        let cases: [(Term, PassWork); 6] = [
+        let cases: [(Term, PassWork); 7] = [
             (
                 Term::Setup,
                 PassWork {
@@ -353,7 +402,14 @@ mod tests {
             (
                 Term::Shade,
                 PassWork {
-                    shader_ops: 100 * big,
+                    shader_slots: 100 * big,
+                    ..small
+                },
+            ),
+            (
+                Term::Shade,
+                PassWork {
+                    shader_transcendentals: 10 * big,
                     ..small
                 },
             ),
@@ -387,7 +443,7 @@ mod tests {
         let e = estimate_pass(g, a(), "p", &cases[0].1);
         assert!((e.high - (5.0 + 50e-6)).abs() < 1e-9, "{e:?}");
         // Memory-bound at the fast end: 10¹¹ bytes at 35.2 GB/s × 0.85.
-        let e = estimate_pass(g, a(), "p", &cases[5].1);
+        let e = estimate_pass(g, a(), "p", &cases[6].1);
         let want = 1e11 / (35.2e9 * 0.85) + 5e-6;
         assert!((e.low - want).abs() < 1e-9 * want, "{e:?}");
     }

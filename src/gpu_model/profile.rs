@@ -135,15 +135,18 @@ pub struct Assumptions {
     pub z_compression: Figure,
     /// Coarse tiles the hierarchical Z tests per clock.
     pub hiz_tests_per_clock: Figure,
+    /// Instruction slots of one transcendental function (`atan2`, `acos`, `tan`).
+    pub transcendental_slots: Figure,
 }
 
 impl Assumptions {
-    fn figures(&self) -> [(&'static str, &Figure); 4] {
+    fn figures(&self) -> [(&'static str, &Figure); 5] {
         [
             ("memory_efficiency", &self.memory_efficiency),
             ("pass_overhead_us", &self.pass_overhead_us),
             ("z_compression", &self.z_compression),
             ("hiz_tests_per_clock", &self.hiz_tests_per_clock),
+            ("transcendental_slots", &self.transcendental_slots),
         ]
     }
 }

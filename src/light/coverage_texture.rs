@@ -172,6 +172,16 @@ impl CoverageTexture {
     pub fn lookup(&self, p1: DVec2, p2: DVec2, filter: CoverageFilter) -> [f64; 3] {
         let g1 = self.grid(p1);
         let g2 = self.grid(p2);
+        // What the fragment program executes (crate::gpu::shader_ops): one fetch for the
+        // nearest and bilinear filters; the quadrilinear filter is four bilinear fetches
+        // blended by the program (a MUL and three MADs).
+        match filter {
+            CoverageFilter::Nearest | CoverageFilter::Bilinear => crate::gpu::shader_ops::fetch(),
+            CoverageFilter::Quadrilinear => {
+                (0..4).for_each(|_| crate::gpu::shader_ops::fetch());
+                crate::gpu::shader_ops::alu(4);
+            }
+        }
         match filter {
             CoverageFilter::Nearest => self.texel(nearest(g1), nearest(g2)),
             CoverageFilter::Bilinear => self.bilinear_second(nearest(g1), g2),

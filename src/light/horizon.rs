@@ -237,6 +237,7 @@ impl SegmentTable {
         let half_span = T::from_f64((SEGMENT_TABLE_SIZE - 1) as f64 / 2.0);
         let x = (t + T::one()) * half_span + T::from_f64(0.5);
         let ([i, j], f) = linear_taps(x.to_f64(), SEGMENT_TABLE_SIZE as u32, Wrap::ClampToEdge);
+        crate::gpu::shader_ops::fetch();
         let texel = |k: u32| f64::from(self.texels[k as usize]) / 65535.0;
         T::from_f64(texel(i) * (1.0 - f) + texel(j) * f)
     }

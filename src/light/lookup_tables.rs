@@ -84,6 +84,7 @@ impl UnormTexture2D {
     pub fn sample(&self, s: f64, t: f64, filter: TableFilter) -> f64 {
         let size = [self.width as u32, self.height as u32];
         let (x, y) = (s * self.width as f64, t * self.height as f64);
+        crate::gpu::shader_ops::fetch();
         sample_2d(x, y, size, Wrap::Repeat, filter, |i, j| self.texel(i, j))
     }
 }
@@ -370,6 +371,7 @@ impl SplitTable {
 
     /// [`SplitTable::lookup`] in the shader precision `T` ([`SplitTable::shader_index`]).
     pub fn shader_lookup<T: ShaderFloat>(&self, c: T) -> [u8; 4] {
+        crate::gpu::shader_ops::fetch();
         self.entries[Self::shader_index(c)]
     }
 }

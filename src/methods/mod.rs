@@ -495,7 +495,9 @@ where
                 .enumerate()
                 .map(|(k, r)| {
                     let tap = watched.and_then(|p| p.tap_at(k as u32, row as u32));
-                    program(row * width + k, r.as_ref(), &mut st, &mut c, tap)
+                    crate::gpu::shader_ops::measure(&mut c, |c| {
+                        program(row * width + k, r.as_ref(), &mut st, c, tap)
+                    })
                 })
                 .collect();
             (out, st, c)

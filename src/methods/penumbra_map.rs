@@ -570,6 +570,7 @@ pub fn render_penumbra_map<T: ShaderFloat>(
             let i = match penumbra_intensity::<T>(f.z, format.to_window(z_p), z_v, &view.proj) {
                 Ok(i) => i,
                 Err(why) => {
+                    count!(c.shader_discards += 1);
                     match why {
                         Discard::BehindSurface => st.discarded_behind_surface += 1,
                         Discard::SurfaceNotBeyondSilhouette => {

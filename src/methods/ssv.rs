@@ -540,6 +540,7 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(
                     .as_ref()
                     .is_some_and(|w| !w.shader_contains::<T>(p))
                 {
+                    count!(c.shader_discards += 1);
                     return stop("receiver outside the wedge: discarded");
                 }
                 count!(c.fragments_shaded += 1);

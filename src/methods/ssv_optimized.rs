@@ -838,6 +838,7 @@ fn render_group<T: ShaderFloat>(
                         return record(&|e| seen_depth(e).note("background"));
                     };
                     if tested && !job.shape.shader_contains::<T>(p, 0.0) {
+                        count!(cnt.shader_discards += 1);
                         return record(&|e| {
                             seen_depth(e).note("receiver outside the half (shader test)")
                         });

@@ -28,6 +28,7 @@ mod doc_references;
 mod effects_plan;
 mod fuzz_corpus_replay;
 mod golden;
+mod gpu_model;
 mod hard_case_catalog;
 mod hard_shadow_volumes;
 mod hiz;

@@ -1046,6 +1046,7 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
                         .any(|pl| pl.footprint_outside(f.x, f.y, z_w))
                     {
                         tile.counters.rejected_outside_planes += 1;
+                        count!(cnt.shader_discards += 1);
                         return record(&|e| seen(e).note("outside a bounding plane (Fig. 7)"));
                     }
                     let [a, b] = sil.edges[job.edge];
@@ -1053,6 +1054,7 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
                         quads[job.edge].side(f.x, f.y, stored, rcv.point.as_dvec3(), frame);
                     if side == 0.0 || (side > 0.0) != job.inner {
                         tile.counters.rejected_quad_side += 1;
+                        count!(cnt.shader_discards += 1);
                         return record(&|e| {
                             seen(e).note("the other side of the hard quad (Fig. 8)")
                         });
