@@ -3,6 +3,7 @@
 llvmpipe, on one scene, in one run.
 
     scripts/peers/.venv/bin/python scripts/peers/run.py SCENE [--out DIR] [--runs N] [--size W]
+                                                     [--opt METHOD.KEY=VALUE]...
 
 SCENE is a penumbra scene file (TOML or JSON) or a built-in scene name. The script
 
@@ -542,7 +543,8 @@ def write_report(out: Path, doc: dict) -> None:
     out.mkdir(parents=True, exist_ok=True)
     (out / "peers.json").write_text(json.dumps(doc, indent=2) + "\n")
     lines = [
-        f"# Peers: `{doc['scene']}` at {doc['width']}×{doc['height']}",
+        f"# Peers: `{doc['scene']}` at {doc['width']}×{doc['height']}"
+        + "".join(f", `{o}`" for o in doc["options"]),
         "",
         f"{doc['machine']}; medians of {doc['runs']} runs in one run of `scripts/peers/run.py`. "
         "Seconds per pass; *ratio* is penumbra's median over the peer's for the rows of "
@@ -609,6 +611,13 @@ def main() -> int:
     ap.add_argument("--runs", type=int, default=5, help="timed runs per pass (default 5)")
     ap.add_argument("--size", type=int, help="image width (height follows the aspect ratio)")
     ap.add_argument("--penumbra", help="the penumbra binary (default target/release/penumbra)")
+    ap.add_argument(
+        "--opt",
+        action="append",
+        default=[],
+        metavar="METHOD.KEY=VALUE",
+        help="a penumbra option for export-scene and every render (e.g. hard-sv.mode=zfail)",
+    )
     ap.add_argument("--check", action="store_true", help="only check that both peers start")
     a = ap.parse_args()
     if a.check:
@@ -621,8 +630,11 @@ def main() -> int:
         ap.error("SCENE is required and --runs must be at least 1")
     exe = penumbra_binary(a.penumbra)
     size = ["--width", str(a.size)] if a.size else []
+    for o in a.opt:
+        size += ["--opt", o]
     out = a.out or REPO / "out" / "peers" / scene_name(a.scene)
     mi, dr = mitsuba()
+    load_before = os.getloadavg()[0]
     with tempfile.TemporaryDirectory(prefix="penumbra-peers-") as tmpdir:
         tmp = Path(tmpdir)
         docs = {n: export(exe, a.scene, size, n, tmp) for n in SAMPLES}
@@ -637,6 +649,7 @@ def main() -> int:
             for n in SAMPLES:
                 mits[n].run()
             gl_peer.run()
+    load_after = os.getloadavg()[0]
     shadow, gl_receivers = gl_peer.finish()
     gl_times, renderer = gl_peer.times, gl_peer.renderer
 
@@ -684,11 +697,13 @@ def main() -> int:
 
     report = {
         "scene": a.scene,
+        "options": a.opt,
         "width": w,
         "height": h,
         "runs": a.runs,
         "machine": f"{platform.machine()}, {os.cpu_count()} cores, mitsuba {mi.__version__} "
-        f"(drjit {drjit.__version__}, {mi.variant()}), {renderer}",
+        f"(drjit {drjit.__version__}, {mi.variant()}), {renderer}; load average "
+        f"{load_before:.1f} before, {load_after:.1f} after",
         "triangles": sum(len(m["triangles"]) // 3 for m in doc16["meshes"]),
         "volume_triangles": doc16["hard_sv"]["volume_triangles"],
         "hard_sv_mode": doc16["hard_sv"]["mode"],
