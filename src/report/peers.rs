@@ -77,6 +77,9 @@ pub struct Row {
 pub struct Peers {
     /// The scene as given to the script.
     pub scene: String,
+    /// The penumbra options given to the script (`--opt`), applied to every render.
+    #[serde(default)]
+    pub options: Vec<String>,
     /// Image width.
     pub width: u32,
     /// Image height.
@@ -136,7 +139,16 @@ pub fn section(h: &mut Html, root: &Path, rel: &Path, p: &Peers, id: &str) {
     h.element(
         "h2",
         &[],
-        &format!("Peers: {} at {}×{}", p.scene, p.width, p.height),
+        &format!(
+            "Peers: {} at {}×{}{}",
+            p.scene,
+            p.width,
+            p.height,
+            p.options
+                .iter()
+                .map(|o| format!(", {o}"))
+                .collect::<String>()
+        ),
     );
     h.open("p", &[]);
     h.text(&format!(
@@ -252,7 +264,7 @@ mod tests {
         section(&mut h, &dir, &found[0].0, p, "peers-1");
         let page = h.finish();
         for want in [
-            "Peers: cube-of-spheres at 256×256",
+            "Peers: cube-of-spheres at 256×256, hard-sv.mode=zfail",
             "mitsuba-embree",
             "llvmpipe",
             "shadow rays, 16 samples",
