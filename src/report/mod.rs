@@ -2,7 +2,8 @@
 //! runs of one or more scenes — per scene the reference and every method's image in a
 //! labelled grid (each linking to its error map and raw buffers), the error/time/traffic
 //! table, the frame plans, and the accuracy–time Pareto plot and the tile-size experiment
-//! where their outputs lie next to the page.
+//! where their outputs lie next to the page, and the peers' side-by-side timings
+//! (`scripts/peers/run.py`, issue 32) where its `peers.json` does.
 //!
 //! The page is built from the runs in memory ([`crate::render::MethodRun`]) and the names of
 //! the files [`crate::render::write_runs`] wrote; nothing is read back but the experiments'
@@ -18,11 +19,13 @@
 //! | [`table`] | the table and the notes under it |
 //! | [`plan`] | the frame plans in a collapsible `<details>` |
 //! | [`experiments`] | the accuracy–time and tile-size results found next to the page |
+//! | [`peers`] | the peers' results (Mitsuba 3, llvmpipe) found next to the page |
 //! | [`html`] | escaping, links, the element builder |
 
 pub mod experiments;
 pub mod gallery;
 pub mod html;
+pub mod peers;
 pub mod plan;
 pub mod table;
 
@@ -88,6 +91,7 @@ details { margin: .6em 0; } summary { cursor: pointer; font-weight: bold; }
 /// looked for, [`experiments::Found`]).
 pub fn page(dir: &Path, scenes: &[SceneRuns]) -> String {
     let found = experiments::Found::look(dir);
+    let (peer_results, peer_problems) = peers::look(dir);
     let mut h = Html::new();
     h.raw("<!DOCTYPE html>\n");
     h.open(
@@ -130,8 +134,14 @@ pub fn page(dir: &Path, scenes: &[SceneRuns]) -> String {
         h.element("a", &[("href", "#precision")], "precision experiment");
         h.close();
     }
+    for (i, (rel, _)) in peer_results.iter().enumerate() {
+        h.open("li", &[]);
+        let text = format!("peers ({})", rel.join(peers::JSON_FILE).display());
+        h.element("a", &[("href", &format!("#peers-{}", i + 1))], &text);
+        h.close();
+    }
     h.close();
-    for note in &found.problems {
+    for note in found.problems.iter().chain(&peer_problems) {
         h.element("p", &[("class", "notes")], note);
     }
     for (i, s) in scenes.iter().enumerate() {
@@ -145,6 +155,9 @@ pub fn page(dir: &Path, scenes: &[SceneRuns]) -> String {
     }
     found.tile_size(&mut h);
     found.precision(&mut h);
+    for (i, (rel, p)) in peer_results.iter().enumerate() {
+        peers::section(&mut h, dir, rel, p, &format!("peers-{}", i + 1));
+    }
     h.close().close();
     h.finish()
 }
