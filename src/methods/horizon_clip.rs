@@ -1,5 +1,8 @@
-//! `horizon = off | clip`, a key of every soft method's option table (issue 28, item 4): the
-//! receiver's own horizon, which none of the papers models.
+//! `horizon = off | clip | integrate`, a key of every soft method's option table (issue 28,
+//! item 4): the receiver's own horizon, which none of the papers models. `integrate` exists
+//! only in the tables of `nsample` and `ssv` ([`IntegrableHorizonKeys`]), which integrate
+//! over the light clipped by the receiver's plane themselves (`docs/horizon.md`,
+//! "`integrate`"); [`clip_to_horizon`] then leaves their visibility as it is.
 //!
 //! A receiver whose tangent plane cuts an area light sees only the part of the light in front
 //! of that plane; the papers' methods count only the occluders' silhouette volumes, so on these

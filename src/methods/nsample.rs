@@ -22,7 +22,11 @@
 //!
 //! Options: `n` (a perfect square, 1…4096, default 1024), `horizon`
 //! ([`super::horizon_clip`]: with `clip` the averaged visibility is limited to the part of the
-//! light in front of the receiver's plane), and `mode`, `stencil`, `submission` as for
+//! light in front of the receiver's plane; with `integrate` each sample is tested against
+//! that plane, `n·(s − p) ≥ 0` in f64, a sample behind lights nothing and its weight goes to
+//! a behind accumulator, and a pixel with samples behind is `f·lit/front`, the lit share of
+//! the samples in front times the fraction `f` in front ([`in_front_share`];
+//! `docs/horizon.md`, "`integrate`")), and `mode`, `stencil`, `submission` as for
 //! `hard-sv`; `mode = auto` chooses z-fail when the near plane is in the shadow of the
 //! light center or of the shape's extreme points ([`crate::geometry::near_plane::representative_light_points`]).
 

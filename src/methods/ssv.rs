@@ -36,6 +36,15 @@
 //!   and filtering stay as they are. The hard quads of pass 1 and the wedges (§3.1) are
 //!   geometry built on the CPU and submitted as vertices, and stay f64.
 //!
+//! * **The receiver's horizon** (`horizon`, [`super::horizon_clip`]): `clip` limits the
+//!   visibility to the fraction `f` of the light in front of the receiver's plane; `integrate`
+//!   (rectangle lights, exact coverage, f32 or f16 V-buffer) integrates over the clipped light:
+//!   a scale pass between pass 1 and pass 2 ([`HORIZON_SCALE`]) multiplies the V-buffer's
+//!   `1 − count` by `f` and keeps `f` in a fraction buffer, each wedge fragment's coverage is
+//!   clipped by the receiver's half-plane
+//!   ([`EdgeCoverageProgram::at_in_front`](crate::light::coverage::EdgeCoverageProgram::at_in_front)),
+//!   and the resolve clamps to `[0, f]` (`docs/horizon.md`, "`integrate`").
+//!
 //! Choices where the paper is silent:
 //! * The receiver point of a pixel is the depth-buffer point ([`Frame::receivers`]), the same
 //!   one `raycast` uses by default, so the error against the reference is the method's own.
