@@ -1056,7 +1056,7 @@ mod tests {
                 .collect();
             let in_light = clip_polygon_to_box(&projected, DVec2::splat(-1.0), DVec2::splat(1.0));
             let in_front = clip_polygon(&in_light, |q: DVec2| plane.at(SVec2::new(q.x, q.y)));
-            let edges = || (0..4).map(|j| (corners[(j + 1) % 4], corners[j]));
+            let edges = || (0..4).map(|j| (corners[j], corners[(j + 1) % 4]));
             let whole: f64 = edges()
                 .map(|(a, b)| EdgeCoverageProgram::<f64>::new(&l, a, b).at(p))
                 .sum();
