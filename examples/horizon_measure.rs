@@ -1,8 +1,9 @@
 //! `horizon = off | clip` measured (`docs/horizon.md`): for each method that has the key, its
 //! mean |e| against `raycast` on the *horizon receivers* (whose tangent plane cuts the light,
 //! [`plane_cuts_light`]) and on the receivers that see the whole light, with `off`, with
-//! `clip` (`min(v, f)`, what the methods do) and with the product `v·f` (the candidate
-//! `clip` was chosen over, computed here from `off` and the same fragment program's `f`).
+//! `clip` (`min(v, f)`, what the methods do), with the product `v·f` (the candidate
+//! `clip` was chosen over, computed here from `off` and the same fragment program's `f`), and
+//! with `integrate` where the method has it (`nsample`, `ssv` under a rectangle).
 //! The reference's own noise on each class is the mean |e| between two `raycast` seeds.
 //!
 //! `cargo run --release --example horizon_measure [SIZE] [SCENE…]` (default 256,
@@ -17,16 +18,17 @@ use penumbra::scene::{builtin, Scene};
 use penumbra::visibility::Visibility;
 use std::path::Path;
 
-/// The methods with the `horizon` key, and their options for this measurement.
-const METHODS: &[(&str, &[&str])] = &[
-    ("nsample", &["nsample.n=256"]),
-    ("ssv", &[]),
-    ("ssv-optimized", &[]),
-    ("penumbra-map", &[]),
-    ("pw2002", &[]),
-    ("pw-restructured", &[]),
-    ("wedge-blending", &[]),
-    ("dbuffer", &[]),
+/// The methods with the `horizon` key, their options for this measurement, and whether they
+/// have `horizon = integrate`.
+const METHODS: &[(&str, &[&str], bool)] = &[
+    ("nsample", &["nsample.n=256"], true),
+    ("ssv", &[], true),
+    ("ssv-optimized", &[], false),
+    ("penumbra-map", &[], false),
+    ("pw2002", &[], false),
+    ("pw-restructured", &[], false),
+    ("wedge-blending", &[], false),
+    ("dbuffer", &[], false),
 ];
 
 /// Mean |a − b| over the pixels `mask` selects.
@@ -63,9 +65,9 @@ fn main() {
         scenes.extend(real);
     }
     println!(
-        "| scene | light | method | horizon px | whole-light px | off: horizon | clip: horizon | v·f: horizon | off: whole | clip: whole | v·f: whole | raycast noise: horizon / whole |"
+        "| scene | light | method | horizon px | whole-light px | off: horizon | clip: horizon | v·f: horizon | integrate: horizon | off / clip | off / integrate | off: whole | clip: whole | v·f: whole | integrate: whole | raycast noise: horizon / whole |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for name in scenes {
         let mut scene = match load(&name) {
             Ok(s) => s,
@@ -95,7 +97,7 @@ fn main() {
             .expect("raycast")
             .visibility;
         let normals = frame.receiver_normals();
-        for (method, opts) in METHODS {
+        for (method, opts, integrates) in METHODS {
             if !methods::supports_scene(method, &scene) {
                 continue;
             }
@@ -114,6 +116,15 @@ fn main() {
             let clip = methods::run(method, &frame.lit_by(&clip_scene))
                 .expect("clip")
                 .visibility;
+            // Where the method has no integral over the clipped light (or not for this light:
+            // `ssv` under a sphere), a dash.
+            let integrate = integrates
+                .then(|| {
+                    let s = with(Some(&format!("{method}.horizon=integrate")));
+                    methods::run(method, &frame.lit_by(&s)).ok()
+                })
+                .flatten()
+                .map(|o| o.visibility);
             let product = Visibility::Gray(
                 (0..off.len())
                     .map(|i| match receivers[i] {
@@ -130,18 +141,24 @@ fn main() {
                     .collect(),
             );
             let e = |v: &Visibility, m: &[bool]| mean_abs(v, &reference, m);
+            let (e_off, e_clip) = (e(&off, &horizon), e(&clip, &horizon));
+            let dash = || "–".to_string();
+            let integrated =
+                |f: &dyn Fn(&Visibility) -> String| integrate.as_ref().map_or_else(dash, f);
             println!(
-                "| {} | {} | {method} | {} | {} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} / {:.4} |",
+                "| {} | {} | {method} | {} | {} | {e_off:.4} | {e_clip:.4} | {:.4} | {} | {:.1}× | {} | {:.4} | {:.4} | {:.4} | {} | {:.4} / {:.4} |",
                 Path::new(&name).file_stem().unwrap().to_string_lossy(),
                 light.shape.type_name(),
                 horizon.iter().filter(|h| **h).count(),
                 whole.iter().filter(|h| **h).count(),
-                e(&off, &horizon),
-                e(&clip, &horizon),
                 e(&product, &horizon),
+                integrated(&|v| format!("{:.4}", e(v, &horizon))),
+                e_off / e_clip,
+                integrated(&|v| format!("{:.1}×", e_off / e(v, &horizon))),
                 e(&off, &whole),
                 e(&clip, &whole),
                 e(&product, &whole),
+                integrated(&|v| format!("{:.4}", e(v, &whole))),
                 mean_abs(&noise, &reference, &horizon),
                 mean_abs(&noise, &reference, &whole),
             );

@@ -123,6 +123,7 @@ fn main() {
                 coverage,
                 vbuffer,
                 test: ShadowTest::ZPass,
+                integrate: false,
             };
             // Warm the coverage-texture cache so the time is the render's (§3.3: the texture
             // is computed once per light shape).

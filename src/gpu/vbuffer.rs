@@ -143,6 +143,16 @@ impl VBufferTile for VBufferF32Tile {
     }
 }
 
+impl VBufferF32Tile {
+    /// Multiply pixel `i` by `k` (`ssv`'s `horizon = integrate` pass, between pass 1 and
+    /// pass 2): read as a texture and written, like an accumulation (4 bytes each way).
+    pub fn scale(&mut self, i: usize, k: f32, c: &mut Counters) {
+        count!(c.color_read_bytes += 4);
+        count!(c.color_write_bytes += 4);
+        self.values[i] *= k;
+    }
+}
+
 /// One binary16 per pixel (module doc).
 #[derive(Debug, Clone, PartialEq)]
 pub struct VBufferF16Tile {
@@ -180,6 +190,16 @@ impl VBufferTile for VBufferF16Tile {
     }
     fn raw(&self, i: usize) -> Raw {
         Raw::F16(self.values[i].to_bits())
+    }
+}
+
+impl VBufferF16Tile {
+    /// Multiply pixel `i` by `k`, `f16(f32(stored)·k)` rounded once (as
+    /// [`VBufferF32Tile::scale`]; 2 bytes each way). `|k| ≤ 1` in its use: never an overflow.
+    pub fn scale(&mut self, i: usize, k: f32, c: &mut Counters) {
+        count!(c.color_read_bytes += 2);
+        count!(c.color_write_bytes += 2);
+        self.values[i] = f16::from_f32(self.values[i].to_f32() * k);
     }
 }
 

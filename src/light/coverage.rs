@@ -71,6 +71,7 @@
 
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::shader_vec::{SVec2, SVec3, SVec4};
+use crate::light::horizon::SquarePlane;
 use crate::light::lookup_tables::AreaShape;
 use crate::primitives::polygon_clip::{clip_polygon_into, clip_segment, clip_segment_marking};
 use crate::scene::{Light, LightShape};
@@ -240,6 +241,27 @@ impl<T: ShaderFloat> EdgeCoverageProgram<T> {
 
     /// The signed coverage at the receiver `p` ([`edge_coverage_exact`]).
     pub fn at(&self, p: DVec3) -> T {
+        self.covered(p, square_fraction)
+    }
+
+    /// The signed coverage at the receiver `p` of the part of the light in front of its own
+    /// plane `plane` (`horizon = integrate`, [`crate::methods::ssv`]): the projected quad
+    /// clipped to the light square as by [`EdgeCoverageProgram::at`], then by the half-plane
+    /// `plane ≥ 0` (Sutherland–Hodgman, [`clip_polygon_into`]), its area over the **whole**
+    /// light's (so that the sum over a silhouette composes with the fraction in front,
+    /// `docs/horizon.md`). A caller whose plane has every corner of the light in front calls
+    /// [`EdgeCoverageProgram::at`], which this equals there up to the clip's rounding.
+    pub fn at_in_front(&self, p: DVec3, plane: &SquarePlane<T>) -> T {
+        self.covered(p, |clipped| {
+            let mut front: ArrayVec<SVec2<T>, IN_FRONT_CAPACITY> = ArrayVec::new();
+            clip_polygon_into(clipped, |q| plane.at(q), |q| q, |q| front.push(q));
+            square_fraction(&front)
+        })
+    }
+
+    /// The sign of `p`'s side of the quad times `area` of the projected quad clipped to the
+    /// light square (0 where `p` is in the quad's or the light's plane).
+    fn covered(&self, p: DVec3, area: impl FnOnce(&[SVec2<T>]) -> T) -> T {
         let zero = T::zero();
         let sign = self.side.at(p);
         if sign == zero {
@@ -254,7 +276,9 @@ impl<T: ShaderFloat> EdgeCoverageProgram<T> {
         let half = &self.quad_beyond_light_plane[usize::from(projection.flip > zero)];
         let mut in_slab = Polygon::new();
         projection.clip_to_receiver_level_into(half, &mut in_slab);
-        sign * clipped_area_fraction(in_slab.iter().map(|x| projection.apply(*x)))
+        let mut clipped = Polygon::new();
+        clip_to_light_into(in_slab.iter().map(|x| projection.apply(*x)), &mut clipped);
+        sign * area(&clipped)
     }
 }
 
@@ -891,14 +915,6 @@ fn light_border<T: ShaderFloat>(k: usize, x: SVec3<T>) -> T {
     }
 }
 
-/// Clip a homogeneous polygon `(S, T, W)` to the light square and return the fraction of the
-/// square it covers ([`square_fraction`]).
-fn clipped_area_fraction<T: ShaderFloat>(poly: impl IntoIterator<Item = SVec3<T>>) -> T {
-    let mut clipped = Polygon::new();
-    clip_to_light_into(poly, &mut clipped);
-    square_fraction(&clipped)
-}
-
 /// The area of a polygon clipped to the light square over the square's (4 in light
 /// coordinates), unsigned, at most 1: the polygon lies in the square, but where its vertices'
 /// `W` were tiny beside their rounding (a receiver 10⁻⁹ above the light's plane and 10 to the
@@ -961,10 +977,14 @@ type Polygon<V> = ArrayVec<V, POLYGON_CAPACITY>;
 /// The most vertices a fragment program's clipped polygon can have ([`Polygon`]).
 const POLYGON_CAPACITY: usize = 42;
 
+/// The most vertices of a [`Polygon`] clipped once more, by the receiver's plane
+/// ([`EdgeCoverageProgram::at_in_front`]): `⌊3n/2⌋` of [`POLYGON_CAPACITY`].
+const IN_FRONT_CAPACITY: usize = POLYGON_CAPACITY * 3 / 2;
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::primitives::polygon_clip::clip_polygon;
+    use crate::primitives::polygon_clip::{clip_polygon, clip_polygon_to_box};
 
     /// [`Polygon`]'s capacity is the bound of its doc: a clip step that alternates sides at
     /// every vertex returns `⌊3n/2⌋` vertices, no clip of random polygons returns more, and six
@@ -996,6 +1016,66 @@ mod tests {
 
     fn unit_light() -> RectLight {
         RectLight::new(DVec3::ZERO, DVec3::X, DVec3::Y)
+    }
+
+    /// `horizon = integrate`'s identity (`docs/horizon.md`): for a flat square occluder
+    /// between a receiver and the light, pass 1's `1 − count` weighted by the fraction `f` of
+    /// the light in front of the receiver's plane, plus the coverages of its four edges over
+    /// the clipped light ([`EdgeCoverageProgram::at_in_front`]), is the visible part of the
+    /// clipped light over the whole light's area — `f` less the occluder's projection clipped
+    /// to the square and the half-plane, computed here independently (the projected polygon
+    /// clipped with [`clip_polygon`]) — with the light's center in the shadow (count 1) and
+    /// out of it (count 0). Without the plane ([`EdgeCoverageProgram::at`]) the same sum is
+    /// Paper III's `1 − count + Σ`.
+    #[test]
+    fn horizon_clipped_edge_coverages_sum_to_the_visible_part_of_the_clipped_light() {
+        let l = unit_light();
+        let scene_light = Light {
+            center: glam::Vec3::ZERO,
+            shape: LightShape::Rect {
+                u: glam::Vec3::X,
+                v: glam::Vec3::Y,
+            },
+        };
+        let p = DVec3::new(0.3, -0.2, 3.0);
+        // The plane d = (s − 0.3) + 0.5·(t + 0.2) − 0.1·3 = s + t/2 − 1/2 over the light.
+        let n = DVec3::new(1.0, 0.5, 0.1);
+        let plane = SquarePlane::<f64>::of(&scene_light, p, n).unwrap();
+        assert_eq!(plane.corners_in_front(), 2);
+        let f = plane.fraction();
+        for (shift, count) in [(0.0, 1.0), (0.5, 0.0)] {
+            // A square of half-size 0.4 at height 1.5, counterclockwise seen from p; its
+            // projection from p onto the light's plane is the square scaled by 2 about p.
+            let corners: Vec<DVec3> = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                .iter()
+                .map(|&(a, b)| DVec3::new(0.1 + shift + 0.4 * a, 0.1 + 0.4 * b, 1.5))
+                .collect();
+            let projected: Vec<DVec2> = corners
+                .iter()
+                .map(|o| (p + (*o - p) * 2.0).truncate())
+                .collect();
+            let in_light = clip_polygon_to_box(&projected, DVec2::splat(-1.0), DVec2::splat(1.0));
+            let in_front = clip_polygon(&in_light, |q: DVec2| plane.at(SVec2::new(q.x, q.y)));
+            let edges = || (0..4).map(|j| (corners[j], corners[(j + 1) % 4]));
+            let whole: f64 = edges()
+                .map(|(a, b)| EdgeCoverageProgram::<f64>::new(&l, a, b).at(p))
+                .sum();
+            let clipped: f64 = edges()
+                .map(|(a, b)| EdgeCoverageProgram::<f64>::new(&l, a, b).at_in_front(p, &plane))
+                .sum();
+            let v = 1.0 - count + whole;
+            let expected = 1.0 - polygon_area(&in_light) / 4.0;
+            assert!((v - expected).abs() < 1e-12, "{shift}: {v} vs {expected}");
+            let v = f * (1.0 - count) + clipped;
+            let expected = f - polygon_area(&in_front) / 4.0;
+            assert!((v - expected).abs() < 1e-12, "{shift}: {v} vs {expected}");
+            // The plane does take something off: the occluder's shadow reaches behind it.
+            assert!(
+                polygon_area(&in_front) < polygon_area(&in_light) - 0.1,
+                "{shift}"
+            );
+        }
+        assert!(f > 0.2 && f < 0.8, "{f}");
     }
 
     #[test]

@@ -86,9 +86,12 @@ fn fraction_with<T: ShaderFloat>(
     let d0 = n.dot(c - p);
     match &light.shape {
         LightShape::Point => in_front_or_not(d0),
-        LightShape::Rect { u, v } | LightShape::TexturedRect { u, v, .. } => {
-            square_fraction_in_front(d0, n.dot(uniform(*u)), n.dot(uniform(*v)))
+        LightShape::Rect { u, v } | LightShape::TexturedRect { u, v, .. } => SquarePlane {
+            d0,
+            ds: n.dot(uniform(*u)),
+            dt: n.dot(uniform(*v)),
         }
+        .fraction(),
         LightShape::Disk { radius, normal: dn } => disk_fraction_in_front(
             d0,
             T::from_f64(f64::from(*radius)),
@@ -108,6 +111,95 @@ fn fraction_with<T: ShaderFloat>(
     }
 }
 
+/// The receiver's plane over a rectangle light's parameters: the signed distance
+/// `d(s, t) = d0 + s·ds + t·dt` of the light's point `center + s·u + t·v`, `(s, t) ∈ [−1, 1]²`,
+/// in the arithmetic of `T` (`d0 = n·(c − p)`, `ds = n·u`, `dt = n·v`: the operations of
+/// [`shader_fraction_in_front`], so [`SquarePlane::fraction`] is its value bit for bit). What
+/// `horizon = integrate` clips `ssv`'s coverage polygons with
+/// ([`crate::light::coverage::EdgeCoverageProgram::at_in_front`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SquarePlane<T> {
+    /// The distance at the light's center.
+    pub d0: T,
+    /// Its change per unit of `s`.
+    pub ds: T,
+    /// Its change per unit of `t`.
+    pub dt: T,
+}
+
+impl<T: ShaderFloat> SquarePlane<T> {
+    /// The plane through `point` with normal `normal` (as the fragment program reads them:
+    /// the depth-buffer point, the normal buffer's value) over a rectangle `light`; `None` for
+    /// the other shapes.
+    pub fn of(light: &Light, point: DVec3, normal: DVec3) -> Option<Self> {
+        let (LightShape::Rect { u, v } | LightShape::TexturedRect { u, v, .. }) = &light.shape
+        else {
+            return None;
+        };
+        let uniform = |v: Vec3| SVec3::<T>::from_f64(v.as_dvec3());
+        let (p, n) = (SVec3::<T>::from_f64(point), SVec3::<T>::from_f64(normal));
+        Some(SquarePlane {
+            d0: n.dot(uniform(light.center) - p),
+            ds: n.dot(uniform(*u)),
+            dt: n.dot(uniform(*v)),
+        })
+    }
+
+    /// The signed distance at `(s, t)`, `d0 + s·ds + t·dt` in that order.
+    pub fn at(&self, q: SVec2<T>) -> T {
+        self.d0 + q.x * self.ds + q.y * self.dt
+    }
+
+    /// How many of the light's four corners are in front of (or on) the plane: 4, the whole
+    /// light ([`SquarePlane::fraction`] exactly 1), 0, none of it (exactly 0).
+    pub fn corners_in_front(&self) -> usize {
+        square_corners::<T>()
+            .into_iter()
+            .filter(|&q| self.at(q) >= T::zero())
+            .count()
+    }
+
+    /// The fraction of the light in front of the plane ([`shader_fraction_in_front`]): the
+    /// square clipped by the half-plane (Sutherland–Hodgman, one edge), its area by the
+    /// shoelace formula, over 4. With every corner in front the polygon is the square itself
+    /// and the area is exactly 1 in every format (the corners' cross products are ±2).
+    pub fn fraction(&self) -> T {
+        let corners = square_corners::<T>();
+        let (zero, one) = (T::zero(), T::one());
+        // A half-plane cuts a quadrilateral into at most five corners: a fixed array, no
+        // allocation in the per-pixel program.
+        let mut clipped = [corners[0]; 5];
+        let mut n = 0;
+        for (i, &a) in corners.iter().enumerate() {
+            let b = corners[(i + 1) % 4];
+            let (da, db) = (self.at(a), self.at(b));
+            if da >= zero {
+                clipped[n] = a;
+                n += 1;
+            }
+            if (da >= zero) != (db >= zero) {
+                clipped[n] = a + (b - a) * (da / (da - db));
+                n += 1;
+            }
+        }
+        let twice_area = (0..n)
+            .map(|i| clipped[i].perp_dot(clipped[(i + 1) % n]))
+            .fold(zero, |sum, x| sum + x);
+        (twice_area / T::from_f64(8.0)).clamp(zero, one)
+    }
+}
+
+/// The corners of the light's parameter square `[−1, 1]²`, counterclockwise from `(−1, −1)`.
+fn square_corners<T: ShaderFloat>() -> [SVec2<T>; 4] {
+    let one = T::one();
+    [
+        SVec2::new(-one, -one),
+        SVec2::new(one, -one),
+        SVec2::new(one, one),
+        SVec2::new(-one, one),
+    ]
+}
+
 /// 1 when the signed distance `d` is ≥ 0, else 0.
 fn in_front_or_not<T: ShaderFloat>(d: T) -> T {
     if d >= T::zero() {
@@ -115,42 +207,6 @@ fn in_front_or_not<T: ShaderFloat>(d: T) -> T {
     } else {
         T::zero()
     }
-}
-
-/// The fraction of the square `[-1, 1]²` where `d0 + s·ds + t·dt ≥ 0`: the square clipped by
-/// the half-plane (Sutherland–Hodgman, one edge), its area by the shoelace formula, over 4.
-/// With every corner in front the polygon is the square itself and the area is exactly 1 in
-/// every format (the corners' cross products are ±2).
-fn square_fraction_in_front<T: ShaderFloat>(d0: T, ds: T, dt: T) -> T {
-    let one = T::one();
-    let corners = [
-        SVec2::new(-one, -one),
-        SVec2::new(one, -one),
-        SVec2::new(one, one),
-        SVec2::new(-one, one),
-    ];
-    let zero = T::zero();
-    let d = |q: SVec2<T>| d0 + q.x * ds + q.y * dt;
-    // A half-plane cuts a quadrilateral into at most five corners: a fixed array, no
-    // allocation in the per-pixel program.
-    let mut clipped = [corners[0]; 5];
-    let mut n = 0;
-    for (i, &a) in corners.iter().enumerate() {
-        let b = corners[(i + 1) % 4];
-        let (da, db) = (d(a), d(b));
-        if da >= zero {
-            clipped[n] = a;
-            n += 1;
-        }
-        if (da >= zero) != (db >= zero) {
-            clipped[n] = a + (b - a) * (da / (da - db));
-            n += 1;
-        }
-    }
-    let twice_area = (0..n)
-        .map(|i| clipped[i].perp_dot(clipped[(i + 1) % n]))
-        .fold(zero, |sum, x| sum + x);
-    (twice_area / T::from_f64(8.0)).clamp(zero, one)
 }
 
 /// The fraction of a disk (center at signed distance `d0` from the receiver's plane, `radius`,
@@ -437,10 +493,11 @@ mod tests {
     #[test]
     fn a_diagonal_plane_through_a_corner_cuts_a_triangle_of_one_eighth() {
         // s + t ≥ 1.5 ⇔ the corner triangle of legs 0.5: area 0.125 of the square's 4 → 1/32.
-        let f = square_fraction_in_front(-1.5, 1.0, 1.0);
+        let plane = |d0, ds, dt| SquarePlane::<f64> { d0, ds, dt };
+        let f = plane(-1.5, 1.0, 1.0).fraction();
         assert!((f - 0.125 / 4.0).abs() < 1e-15, "{f}");
         // The complement (≤ 1.5) is the rest.
-        let g = square_fraction_in_front(1.5, -1.0, -1.0);
+        let g = plane(1.5, -1.0, -1.0).fraction();
         assert!((g - (1.0 - 0.125 / 4.0)).abs() < 1e-15, "{g}");
     }
 

@@ -1,5 +1,8 @@
-//! `horizon = off | clip`, a key of every soft method's option table (issue 28, item 4): the
-//! receiver's own horizon, which none of the papers models.
+//! `horizon = off | clip | integrate`, a key of every soft method's option table (issue 28,
+//! item 4): the receiver's own horizon, which none of the papers models. `integrate` exists
+//! only in the tables of `nsample` and `ssv` ([`IntegrableHorizonKeys`]), which integrate
+//! over the light clipped by the receiver's plane themselves (`docs/horizon.md`,
+//! "`integrate`"); [`clip_to_horizon`] then leaves their visibility as it is.
 //!
 //! A receiver whose tangent plane cuts an area light sees only the part of the light in front
 //! of that plane; the papers' methods count only the occluders' silhouette volumes, so on these
@@ -46,15 +49,43 @@ option_names! {
         Off = "off",
         /// The visibility limited to the part of the light in front of the receiver's plane.
         Clip = "clip",
+        /// The method's own integral taken over the light clipped by the receiver's plane
+        /// (only the methods whose table is [`IntegrableHorizonKeys`]).
+        Integrate = "integrate",
     }
 }
 
 option_table! {
     /// The `horizon` key, declared once: every soft method's table includes it
-    /// (`..horizon: HorizonKeys`).
+    /// (`..horizon: HorizonKeys`), or [`IntegrableHorizonKeys`] for a method that also
+    /// integrates over the clipped light.
     pub struct HorizonKeys {
         /// the receiver's own horizon (docs/horizon.md): off, the paper's arithmetic, or clip, the visibility limited to the part of the light in front of the receiver's tangent plane (a fragment program at the shader precision, reading the scene pass's receiver-normal buffer)
+        horizon: Horizon [&[Horizon::Off, Horizon::Clip]] = Horizon::Off;
+    }
+}
+
+option_table! {
+    /// The `horizon` key of a method whose own coverage integral can run over the light
+    /// clipped by the receiver's plane (`nsample`, `ssv`): [`HorizonKeys`]' values and
+    /// `integrate`. Declared per method rather than refused at run time, so that every other
+    /// method's table rejects `integrate` when it is read and `docs/options.md` lists it only
+    /// where it exists (`docs/horizon.md`, "`integrate`").
+    pub struct IntegrableHorizonKeys {
+        /// the receiver's own horizon (docs/horizon.md): off, the paper's arithmetic; clip, the visibility limited to the part of the light in front of the receiver's tangent plane; or integrate, the method's own integral over the light clipped by that plane (reading the scene pass's receiver-normal buffer)
         horizon: Horizon = Horizon::Off;
+    }
+}
+
+impl From<HorizonKeys> for Horizon {
+    fn from(keys: HorizonKeys) -> Self {
+        keys.horizon
+    }
+}
+
+impl From<IntegrableHorizonKeys> for Horizon {
+    fn from(keys: IntegrableHorizonKeys) -> Self {
+        keys.horizon
     }
 }
 
@@ -62,17 +93,20 @@ option_table! {
 pub const PASS: &str = "horizon-clip";
 
 /// `visibility`, a method's final per-pixel visibility on the recorder's frame, with the
-/// method's `horizon` key applied (module doc): unchanged with `off`; with `clip`, each
+/// method's `horizon` key applied (module doc): unchanged with `off`, and with `integrate`,
+/// where the method has integrated over the clipped light itself; with `clip`, each
 /// receiver's channels limited to `min(v, f)`, the pass and the normal buffer recorded on
 /// `rec`. Returns the visibility and what the method's settings show under `"horizon"`: the
 /// mode and, with `clip`, how many receivers the plane limited.
 pub fn clip_to_horizon(
     rec: &mut PassRecorder,
-    keys: HorizonKeys,
+    horizon: impl Into<Horizon>,
     visibility: Visibility,
 ) -> (Visibility, serde_json::Value) {
-    match keys.horizon {
-        Horizon::Off => (visibility, serde_json::json!({ "mode": "off" })),
+    match horizon.into() {
+        mode @ (Horizon::Off | Horizon::Integrate) => {
+            (visibility, serde_json::json!({ "mode": mode.written() }))
+        }
         Horizon::Clip => {
             let (v, limited) = crate::with_shader_float!(
                 rec.frame().gpu.shader,
@@ -84,6 +118,25 @@ pub fn clip_to_horizon(
             )
         }
     }
+}
+
+/// Record the receiver-normal buffer for a run that reads it (`clip`, and `integrate` in
+/// the methods that have it): its plan entry and the scene pass's writes to it, 8 bytes per
+/// fragment passing the scene pass's depth test (module doc). The reads are the reading
+/// passes' own to count.
+pub fn uses_receiver_normals(rec: &mut PassRecorder) {
+    let frame = rec.frame();
+    rec.uses(BufferPlan {
+        name: "receiver normals".into(),
+        format: normal_buffer::FORMAT.into(),
+        bytes_per_sample: normal_buffer::BYTES_PER_PIXEL,
+    });
+    let mut writes = Counters::default();
+    count!(
+        writes.color_write_bytes +=
+            frame.pass.counters.depth_passed * u64::from(normal_buffer::BYTES_PER_PIXEL)
+    );
+    rec.count_in_scene_pass(writes);
 }
 
 /// `min(v, f)` of a channel `v` and the fraction `f` (module doc): `v`'s own bits unless `f`
@@ -103,17 +156,7 @@ fn clip_with<T: ShaderFloat>(rec: &mut PassRecorder, visibility: Visibility) -> 
     let lights = &frame.scene.lights;
     let share = T::from_f64(1.0 / lights.len() as f64);
     let normals = frame.receiver_normals();
-    rec.uses(BufferPlan {
-        name: "receiver normals".into(),
-        format: normal_buffer::FORMAT.into(),
-        bytes_per_sample: normal_buffer::BYTES_PER_PIXEL,
-    });
-    let mut writes = Counters::default();
-    count!(
-        writes.color_write_bytes +=
-            frame.pass.counters.depth_passed * u64::from(normal_buffer::BYTES_PER_PIXEL)
-    );
-    rec.count_in_scene_pass(writes);
+    uses_receiver_normals(rec);
     rec.pass(PASS, |pass| {
         let probe = pass.probe();
         let (rgb, limited, c) = shade_receivers(

@@ -22,7 +22,11 @@
 //!
 //! Options: `n` (a perfect square, 1…4096, default 1024), `horizon`
 //! ([`super::horizon_clip`]: with `clip` the averaged visibility is limited to the part of the
-//! light in front of the receiver's plane), and `mode`, `stencil`, `submission` as for
+//! light in front of the receiver's plane; with `integrate` each sample is tested against
+//! that plane, `n·(s − p) ≥ 0` in f64, a sample behind lights nothing and its weight goes to
+//! a behind accumulator, and a pixel with samples behind is `f·lit/front`, the lit share of
+//! the samples in front times the fraction `f` in front ([`in_front_share`];
+//! `docs/horizon.md`, "`integrate`")), and `mode`, `stencil`, `submission` as for
 //! `hard-sv`; `mode = auto` chooses z-fail when the near plane is in the shadow of the
 //! light center or of the shape's extreme points ([`crate::geometry::near_plane::representative_light_points`]).
 
@@ -30,12 +34,15 @@ use super::dump::{row_major, BufferDump, DumpValues, ElementFormat, EventMap};
 use super::hard_sv::{
     stencil_event_kind, stencil_shadow, HardSvOptions, ShadowTest, StencilShadowSettings,
 };
-use super::horizon_clip::{clip_to_horizon, HorizonKeys};
+use super::horizon_clip::{clip_to_horizon, uses_receiver_normals, Horizon, IntegrableHorizonKeys};
 use super::output::MethodOutput;
 use crate::error::InputError;
 use crate::frame::{Frame, BACKGROUND};
 use crate::geometry::near_plane::representative_light_points;
+use crate::gpu::counters::{count, Counters};
+use crate::gpu::normal_buffer;
 use crate::gpu::probe::{Overflow, PrimitiveKind, Raw};
+use crate::light::horizon::shader_fraction_in_front;
 use crate::light::sampling::{stratified, LightSample, Pattern};
 use crate::methods::hard_sv::CountMode;
 use crate::methods::output::BufferPlan;
@@ -43,7 +50,7 @@ use crate::methods::recorder::PassRecorder;
 use crate::options::{option_table, OptionTable, OptionType};
 use crate::scene::{LightShape, Scene};
 use crate::visibility::Visibility;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 /// Default sample count (Paper III §5.1).
@@ -70,7 +77,7 @@ option_table! {
     /// `[options.nsample]` (module doc): those of `hard-sv` and the sample count.
     pub struct NsampleOptions["nsample"] {
         ..shadow: HardSvOptions,
-        ..horizon: HorizonKeys,
+        ..horizon: IntegrableHorizonKeys,
         /// light samples: the centers of √n×√n strata (a perfect square)
         n: u32 [1..=4096] = DEFAULT_SAMPLES;
     }
@@ -96,6 +103,47 @@ pub fn options(
     Ok((samples, settings, o.shadow.mode))
 }
 
+/// `horizon = integrate`'s receiver planes in tile order: per tile and sample, the receiver's
+/// point and its normal as the normal buffer holds it ([`Frame::receiver_normals`]), `None`
+/// for background and the tiles' padding. A light sample `s` is in front where
+/// `n·(s − p) ≥ 0`, in f64 like the accumulation.
+fn receiver_planes(frame: &Frame) -> Vec<Vec<Option<(DVec3, DVec3)>>> {
+    let tiling = &frame.tiling;
+    let (receivers, normals) = (frame.receivers(), frame.receiver_normals());
+    (0..tiling.tile_count())
+        .map(|t| {
+            (0..tiling.tile_len())
+                .map(|i| {
+                    let [x, y] = tiling.position(t, i);
+                    if x >= tiling.width || y >= tiling.height {
+                        return None;
+                    }
+                    let k = (y * tiling.width + x) as usize;
+                    receivers[k].map(|r| (r.point.as_dvec3(), normals[k]))
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// `horizon = integrate`'s value of a pixel some of whose samples lie behind its plane
+/// (module doc), per channel: `f · lit / (total − behind)`, the lit samples' weight over the
+/// weight of those in front times the fraction `f` of the light in front — the mean
+/// visibility over the clipped light, estimated from the samples that fall on it, times its
+/// area, so that a clipped light with nothing in front of it gives `f` itself rather than the
+/// share of the sample grid the plane leaves (a staircase in the plane's position: up to a
+/// row of √n samples, 1/√n of the light, at once). 0 where no sample is in front.
+fn in_front_share(lit: [f64; 3], behind: [f64; 3], total: [f64; 3], f: f64) -> [f64; 3] {
+    [0, 1, 2].map(|ch| {
+        let front = total[ch] - behind[ch];
+        if front > 0.0 {
+            f * lit[ch] / front
+        } else {
+            0.0
+        }
+    })
+}
+
 /// `nsample`'s pinned golden renders ([`crate::methods::Method::goldens`]).
 const GOLDENS: &[crate::methods::Golden] = &[
     crate::methods::Golden::new("cube-of-spheres"),
@@ -115,6 +163,7 @@ const SWEEP: &[crate::methods::OptionPairs] = &[
     &[("n", "256")],
     &[("n", "1024")],
     &[("n", "64"), ("horizon", "clip")],
+    &[("n", "64"), ("horizon", "integrate")],
 ];
 
 /// `nsample` in the registry ([`crate::methods::ALL`]).
@@ -143,7 +192,12 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let mut rec = PassRecorder::new(frame, "nsample");
     let scene = frame.scene;
     let (samples, settings, mode) = options(frame)?;
+    let horizon = NsampleOptions::read(scene)?.horizon;
     let colored = matches!(scene.light().shape, LightShape::TexturedRect { .. });
+    let planes = (Horizon::from(horizon) == Horizon::Integrate).then(|| {
+        uses_receiver_normals(&mut rec);
+        receiver_planes(frame)
+    });
 
     let tiling = &frame.tiling;
     rec.uses(BufferPlan::stencil8());
@@ -159,6 +213,22 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
                 .collect()
         },
     );
+    // `horizon = integrate`: the weight of the samples behind each receiver's plane.
+    let mut behind: Vec<Vec<[f64; 3]>> = match planes {
+        Some(_) => rec.allocate(
+            BufferPlan {
+                name: "behind accumulator".into(),
+                format: "f64x3".into(),
+                bytes_per_sample: 24,
+            },
+            || {
+                (0..tiling.tile_count())
+                    .map(|_| vec![[0.0; 3]; tiling.tile_len()])
+                    .collect()
+            },
+        ),
+        None => vec![Vec::new(); tiling.tile_count()],
+    };
     rec.uses_hiz_depth();
     let mut overflows = vec![
         0u32;
@@ -191,6 +261,14 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             .as_ref()
             .map(|p| p.enter(move |sc| sc.sample = Some(k as u32)))
     };
+    // `horizon = integrate`: each sample's accumulation reads the receiver's normal at every
+    // receiver (its point is the depth buffer's, which the stencil pass reads already).
+    let normal_reads = planes.as_ref().map(|planes| {
+        let receivers = planes.iter().flatten().flatten().count() as u64;
+        let mut reads = Counters::default();
+        count!(reads.color_read_bytes += receivers * u64::from(normal_buffer::BYTES_PER_PIXEL));
+        reads
+    });
     rec.pass(pass_name, |pass| {
         pass.set_runs(samples.len() as u64);
         for (b, chunk) in samples.chunks(batch).enumerate() {
@@ -206,29 +284,51 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
                 let k = b * batch + j;
                 let _scope = scoped(k);
                 pass.count(c);
+                if let Some(reads) = normal_reads {
+                    pass.count(reads);
+                }
                 if frame.dump_buffers {
                     let sample = row_major(tiling, &stencil, |t| &t.overflows);
                     overflows.iter_mut().zip(sample).for_each(|(a, b)| *a += b);
                 }
                 let w = s.weight.map(f64::from);
-                let add = |px: &mut [f64; 3], v: u8| {
-                    if v == 0 {
+                let at = s.position.as_dvec3();
+                // `horizon = integrate`: a sample behind the receiver's plane lights nothing;
+                // its weight goes to the behind accumulator.
+                let in_front = |t: usize, i: usize| {
+                    planes
+                        .as_ref()
+                        .is_none_or(|planes| planes[t][i].is_none_or(|(p, n)| n.dot(at - p) >= 0.0))
+                };
+                let add = |px: &mut [f64; 3], back: &mut [[f64; 3]], i: usize, v: u8, front| {
+                    let sum = match (front, v == 0) {
+                        (true, true) => Some(px),
+                        (true, false) => None,
+                        (false, _) => Some(&mut back[i]),
+                    };
+                    if let Some(sum) = sum {
                         for ch in 0..3 {
-                            px[ch] += w[ch];
+                            sum[ch] += w[ch];
                         }
                     }
                 };
                 let probe = frame.probe_pass("accumulate");
                 acc.par_iter_mut()
+                    .zip(behind.par_iter_mut())
                     .zip(&stencil)
                     .enumerate()
-                    .for_each(
-                        |(t, (a, st))| match probe.as_ref().filter(|p| p.watches_tile(t)) {
-                            None => a.iter_mut().zip(&st.values).for_each(|(px, v)| add(px, *v)),
+                    .for_each(|(t, ((a, back), st))| {
+                        match probe.as_ref().filter(|p| p.watches_tile(t)) {
+                            None => a
+                                .iter_mut()
+                                .zip(&st.values)
+                                .enumerate()
+                                .for_each(|(i, (px, v))| add(px, back, i, *v, in_front(t, i))),
                             Some(p) => {
                                 for (i, (px, v)) in a.iter_mut().zip(&st.values).enumerate() {
                                     let before = *px;
-                                    add(px, *v);
+                                    let front = in_front(t, i);
+                                    add(px, back, i, *v, front);
                                     if let Some(tap) = p.tap(t, i) {
                                         let e = tap
                                             .event()
@@ -238,7 +338,8 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
                                                 "",
                                                 None,
                                             )
-                                            .value("lit", (*v == 0) as u8 as f64)
+                                            .value("lit", (*v == 0 && front) as u8 as f64)
+                                            .value("in_front", front as u8 as f64)
                                             .value("weight", w[0]);
                                         tap.push(e.read("stencil", Raw::U8(*v)));
                                         let e = tap.event().write(
@@ -248,26 +349,52 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
                                             Overflow::NonFinite,
                                             0,
                                         );
-                                        tap.push(e.note(if *v == 0 {
-                                            "stencil 0: the sample lights the pixel"
-                                        } else {
-                                            "stencil ≠ 0: in the sample's shadow"
+                                        tap.push(e.note(match (*v == 0, front) {
+                                            (true, true) => {
+                                                "stencil 0: the sample lights the pixel"
+                                            }
+                                            (true, false) => {
+                                                "stencil 0, but the sample is behind the \
+                                                 receiver's plane (horizon = integrate)"
+                                            }
+                                            (false, _) => "stencil ≠ 0: in the sample's shadow",
                                         }));
                                     }
                                 }
                             }
-                        },
-                    );
+                        }
+                    });
             }
         }
     });
     let flat: Vec<[f64; 3]> = acc.into_iter().flatten().collect();
     let rows = tiling.to_row_major(&flat);
     let prims = frame.prim_ids();
+    // `horizon = integrate`: where some samples fell behind the plane, the lit ones' share of
+    // those in front, times the fraction of the light in front (module doc).
+    let resolved: Option<Vec<[f64; 3]>> = planes.as_ref().map(|_| {
+        let back = tiling.to_row_major(&behind.concat());
+        let total = samples.iter().fold([0.0f64; 3], |sum, s| {
+            [0, 1, 2].map(|ch| sum[ch] + f64::from(s.weight[ch]))
+        });
+        let (receivers, normals) = (frame.receivers(), frame.receiver_normals());
+        (0..rows.len())
+            .map(|i| match receivers[i] {
+                Some(r) if back[i] != [0.0; 3] => {
+                    let f: f64 =
+                        shader_fraction_in_front(scene.light(), r.point.as_dvec3(), normals[i]);
+                    in_front_share(rows[i], back[i], total, f)
+                }
+                _ => rows[i],
+            })
+            .collect()
+    });
+    let values = resolved.as_deref().unwrap_or(&rows);
     let to_f32 = |p: &[f64; 3]| p.map(|x| x.clamp(0.0, 1.0) as f32);
     let visibility = if colored {
         Visibility::Rgb(
-            rows.iter()
+            values
+                .iter()
                 .zip(prims)
                 .map(|(p, id)| {
                     if *id == BACKGROUND {
@@ -280,7 +407,8 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         )
     } else {
         Visibility::Gray(
-            rows.iter()
+            values
+                .iter()
                 .zip(prims)
                 .map(|(p, id)| if *id == BACKGROUND { 1.0 } else { to_f32(p)[0] })
                 .collect(),
@@ -292,11 +420,13 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
             .resolve(&visibility.channels(i), rows[i].iter().any(|v| *v > 1.0))
             .note(if prims[i] == BACKGROUND {
                 "background: lit"
+            } else if values[i] != rows[i] {
+                "horizon = integrate: the fraction in front times the lit samples' weight over \
+                 the weight of those in front, clamped to [0, 1], as f32"
             } else {
                 "the lit samples' weights, clamped to [0, 1], as f32"
             })
     });
-    let horizon = NsampleOptions::read(scene)?.horizon;
     let (visibility, horizon) = clip_to_horizon(&mut rec, horizon, visibility);
     rec.dump(|| {
         let channels = if colored { 3 } else { 1 };

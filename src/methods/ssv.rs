@@ -36,6 +36,15 @@
 //!   and filtering stay as they are. The hard quads of pass 1 and the wedges (§3.1) are
 //!   geometry built on the CPU and submitted as vertices, and stay f64.
 //!
+//! * **The receiver's horizon** (`horizon`, [`super::horizon_clip`]): `clip` limits the
+//!   visibility to the fraction `f` of the light in front of the receiver's plane; `integrate`
+//!   (rectangle lights, exact coverage, f32 or f16 V-buffer) integrates over the clipped light:
+//!   a scale pass between pass 1 and pass 2 ([`HORIZON_SCALE`]) multiplies the V-buffer's
+//!   `1 − count` by `f` and keeps `f` in a fraction buffer, each wedge fragment's coverage is
+//!   clipped by the receiver's half-plane
+//!   ([`EdgeCoverageProgram::at_in_front`](crate::light::coverage::EdgeCoverageProgram::at_in_front)),
+//!   and the resolve clamps to `[0, f]` (`docs/horizon.md`, "`integrate`").
+//!
 //! Choices where the paper is silent:
 //! * The receiver point of a pixel is the depth-buffer point ([`Frame::receivers`]), the same
 //!   one `raycast` uses by default, so the error against the reference is the method's own.
@@ -67,7 +76,7 @@ use super::dump::{row_major, BufferDump, ElementFormat, EventKind, EventMap, VBu
 use super::hard_sv::stencil_dump;
 use super::hard_sv::{shadow_test, stencil_row_major, stencil_shadow, ShadowTest, StencilOverflow};
 use super::hard_sv::{StencilShadowSettings, Submission};
-use super::horizon_clip::{clip_to_horizon, HorizonKeys};
+use super::horizon_clip::{clip_to_horizon, uses_receiver_normals, Horizon, IntegrableHorizonKeys};
 use super::output::MethodOutput;
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, Receiver, FULL_SCREEN};
@@ -79,6 +88,7 @@ use crate::geometry::ssv_wedge::{SsvWedge, WedgeLight};
 use crate::gpu::counters::{count, Counters};
 use crate::gpu::depth::{DepthFunc, DepthState};
 use crate::gpu::hiz::InsideTestRounding;
+use crate::gpu::normal_buffer;
 use crate::gpu::probe::{PrimitiveKind, Tap};
 use crate::gpu::raster::{bin, bin_to, draw, touched_tile_count, touches_tile};
 use crate::gpu::setup::{setup_triangle, CullMode, RasterTriangle};
@@ -95,12 +105,13 @@ use crate::light::coverage::{
 use crate::light::coverage_texture::{
     coverage_texture, CoverageFilter, CoverageTexture, CoverageTextureKey, DEFAULT_N, MAX_N, MIN_N,
 };
+use crate::light::horizon::SquarePlane;
 use crate::methods::hard_sv::CountMode;
 use crate::methods::output::BufferPlan;
 use crate::methods::precision_spec::{NarrowFormat, OverflowKnobs, PrecisionSpec, StackLight};
 use crate::methods::recorder::PassRecorder;
 use crate::options::{option_names, option_table, OptionTable, OptionType};
-use crate::scene::LightShape;
+use crate::scene::{Light, LightShape};
 use crate::visibility::Visibility;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -129,6 +140,9 @@ pub struct SsvSettings {
     pub vbuffer: VBufferFormat,
     /// z-pass or z-fail for pass 1.
     pub test: ShadowTest,
+    /// `horizon = integrate` (module doc, "The receiver's horizon"): the visibility
+    /// integrated over the light clipped by the receiver's tangent plane.
+    pub integrate: bool,
 }
 
 option_names! {
@@ -162,7 +176,7 @@ option_names! {
 option_table! {
     /// `[options.ssv]` (module doc).
     pub struct SsvOptions["ssv"] {
-        ..horizon: HorizonKeys,
+        ..horizon: IntegrableHorizonKeys,
         /// count pass 1 z-pass or z-fail; auto: z-fail when the near plane is in the light center's shadow
         mode: CountMode = CountMode::Auto;
         /// coverage of an edge: exact clipping (Paper III §3.2.2) or the 4D coverage texture (§3.3; rectangle lights)
@@ -223,6 +237,35 @@ pub fn read_settings(frame: &Frame) -> Result<(SsvSettings, CountMode), InputErr
             "textured lights need the RGB f32 V-buffer (vbuffer = \"f32\"); f16 and 8bit are grey",
         ));
     }
+    let integrate = Horizon::from(o.horizon) == Horizon::Integrate;
+    if integrate {
+        let refused = if matches!(scene.light().shape, LightShape::Sphere { .. }) {
+            Some(
+                "is not implemented for sphere lights: the clipped light would be a circular \
+                 segment cut by each edge's sector (use horizon = \"clip\")",
+            )
+        } else if textured {
+            Some(
+                "is not implemented for textured lights: their coverage is the RGB coverage \
+                 texture (Paper III §3.3), indexed by the edge clipped to the whole light",
+            )
+        } else if coverage == CoverageKind::Texture {
+            Some(
+                "needs coverage = \"exact\": the coverage texture (Paper III §3.3) is indexed by \
+                 the edge clipped to the whole light, not by the receiver's plane",
+            )
+        } else if vbuffer == VBufferFormat::Split8 {
+            Some(
+                "needs a float V-buffer (vbuffer = \"f32\" or \"f16\"): the 8-bit version \
+                 keeps pass 1 in the stencil, which its horizon pass cannot scale",
+            )
+        } else {
+            None
+        };
+        if let Some(why) = refused {
+            return Err(bad("horizon", &format!("horizon = \"integrate\" {why}")));
+        }
+    }
     let coverage = match coverage {
         CoverageKind::Exact => CoverageMode::Exact,
         CoverageKind::Texture => CoverageMode::Texture {
@@ -235,6 +278,7 @@ pub fn read_settings(frame: &Frame) -> Result<(SsvSettings, CountMode), InputErr
             coverage,
             vbuffer,
             test: shadow_test(o.mode, frame, &[scene.light().center]),
+            integrate,
         },
         o.mode,
     ))
@@ -259,12 +303,17 @@ struct CoverageSource<'a, T> {
     texture: Option<Arc<CoverageTexture>>,
     receivers: &'a [Option<Receiver>],
     width: u32,
+    /// With `horizon = integrate`, the light and the receiver-normal buffer the program
+    /// reads each fragment's plane from.
+    horizon: Option<(&'a Light, &'a [DVec3])>,
 }
 
 impl<T: ShaderFloat> CoverageSource<'_, T> {
-    /// The signed per-channel coverage of edge `k`, `w`, at `p` (module doc), computed in the
-    /// shader precision `T` (module doc, "Shader precision").
-    fn coverage(&self, k: usize, w: &EdgeWedge, p: DVec3) -> [f32; 3] {
+    /// The signed per-channel coverage of edge `k`, `w`, at `p`, the receiver of pixel `i`
+    /// (module doc), computed in the shader precision `T` (module doc, "Shader precision");
+    /// with `horizon = integrate`, of the part of the light in front of the receiver's plane
+    /// (a light wholly in front takes the default program, wholly behind covers nothing).
+    fn coverage(&self, k: usize, w: &EdgeWedge, p: DVec3, i: usize) -> [f32; 3] {
         let light = match self.light {
             WedgeLight::Rect(light) => light,
             WedgeLight::Sphere { center, radius } => {
@@ -282,7 +331,21 @@ impl<T: ShaderFloat> CoverageSource<'_, T> {
                 t.lookup(a.to_f64(), b.to_f64(), filter)
                     .map(|v| (s * T::from_f64(v)).to_f64() as f32)
             }
-            _ => [self.programs[k].at(p).to_f64() as f32; 3],
+            _ => {
+                let program = &self.programs[k];
+                let plane = self
+                    .horizon
+                    .and_then(|(light, normals)| SquarePlane::<T>::of(light, p, normals[i]));
+                let c = match plane {
+                    Some(plane) => match plane.corners_in_front() {
+                        4 => program.at(p),
+                        0 => T::zero(),
+                        _ => program.at_in_front(p, &plane),
+                    },
+                    None => program.at(p),
+                };
+                [c.to_f64() as f32; 3]
+            }
         }
     }
 }
@@ -307,16 +370,25 @@ pub struct SsvRender {
 /// buffers, the pixels the resolve clamps and the dumps (module doc) go to `rec`.
 pub fn render(rec: &mut PassRecorder, settings: &SsvSettings) -> SsvRender {
     crate::with_shader_float!(rec.frame().gpu.shader, T => match settings.vbuffer {
-        VBufferFormat::F32 => render_with::<VBufferF32Tile, T>(rec, settings),
-        VBufferFormat::F16 => render_with::<VBufferF16Tile, T>(rec, settings),
-        VBufferFormat::RgbF32 => render_with::<VBufferRgbTile, T>(rec, settings),
-        VBufferFormat::Split8 => render_with::<VBuffer8Tile, T>(rec, settings),
+        VBufferFormat::F32 => {
+            render_with::<VBufferF32Tile, T>(rec, settings, Some(VBufferF32Tile::scale))
+        }
+        VBufferFormat::F16 => {
+            render_with::<VBufferF16Tile, T>(rec, settings, Some(VBufferF16Tile::scale))
+        }
+        VBufferFormat::RgbF32 => render_with::<VBufferRgbTile, T>(rec, settings, None),
+        VBufferFormat::Split8 => render_with::<VBuffer8Tile, T>(rec, settings, None),
     })
 }
+
+/// A V-buffer format's multiplication of a pixel by a factor (`horizon = integrate`'s
+/// scale pass; the grey float formats).
+type Scale<V> = fn(&mut V, usize, f32, &mut Counters);
 
 fn render_with<V: VBufferDump, T: ShaderFloat>(
     rec: &mut PassRecorder,
     settings: &SsvSettings,
+    scale: Option<Scale<V>>,
 ) -> SsvRender {
     let frame = rec.frame();
     let scene = frame.scene;
@@ -378,6 +450,12 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(
         });
         None
     };
+
+    // `horizon = integrate`: pass 1's count weighted by the fraction in front.
+    let fractions = settings.integrate.then(|| {
+        let scale = scale.expect("read_settings refuses integrate without a grey float V-buffer");
+        horizon_scale_pass::<V, T>(rec, &mut vbuf, scale)
+    });
 
     // Pass 2: wedges.
     rec.pass("ssv-wedges", |pass| {
@@ -443,6 +521,9 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(
             texture,
             receivers,
             width: scene.width,
+            horizon: fractions
+                .is_some()
+                .then(|| (scene.light(), frame.receiver_normals())),
         };
         let probe = pass.probe();
         // The watched fragment's event, built only there.
@@ -544,7 +625,11 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(
                     return stop("receiver outside the wedge: discarded");
                 }
                 count!(c.fragments_shaded += 1);
-                let coverage = source.coverage(k as usize, ew, p);
+                if source.horizon.is_some() {
+                    count!(c.color_read_bytes += u64::from(normal_buffer::BYTES_PER_PIXEL));
+                }
+                let i = (f.y * source.width + f.x) as usize;
+                let coverage = source.coverage(k as usize, ew, p, i);
                 add_probed(vb, f.local, coverage, c, tap, |tap| {
                     event(tap).value("coverage", coverage[0] as f64)
                 });
@@ -562,10 +647,18 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(
                 let v = vbuf[tiling.tile_of(x, y)].resolve(tiling.local(x, y));
                 let umbra = stencil.as_ref().map_or(0.0, |s| 1.0 - s[i] as f32);
                 let unclamped = v.map(|x| x + umbra);
-                let clamped = unclamped.iter().any(|x| !(0.0..=1.0).contains(x));
-                (unclamped.map(|x| x.clamp(0.0, 1.0)), clamped)
+                // With `horizon = integrate` the visible part of the clipped light is at most
+                // the fraction in front (1 where the whole light is).
+                let top = fractions.as_ref().map_or(1.0, |f| f[i]);
+                let clamped = unclamped.iter().any(|x| !(0.0..=top).contains(x));
+                (unclamped.map(|x| x.clamp(0.0, top)), clamped)
             })
             .unzip();
+        if fractions.is_some() {
+            // The resolve's read of the fraction buffer, at every receiver.
+            let read = receivers.iter().flatten().count() as u64 * u64::from(FRACTION_BYTES);
+            count!(pass2.color_read_bytes += read);
+        }
         pass.clamped(clamped.iter().filter(|&&c| c).count() as u64);
         pass.count(pass2);
         pass.dump(|| {
@@ -618,6 +711,91 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(
             visibility,
             wedges: (edges.len(), full_screen),
         }
+    })
+}
+
+/// The name of `horizon = integrate`'s pass between pass 1 and pass 2.
+pub const HORIZON_SCALE: &str = "ssv-horizon-scale";
+
+/// Bytes per pixel of `horizon = integrate`'s fraction buffer (R32F).
+const FRACTION_BYTES: u32 = 4;
+
+/// `horizon = integrate`'s pass between pass 1 and pass 2 (module doc, "The receiver's
+/// horizon"): at every receiver, the fraction `f` of the light in front of its tangent plane
+/// (the fragment program of `horizon = clip`, in `T`, from the receiver-normal buffer)
+/// multiplies the V-buffer, which holds pass 1's `1 − count` there, and is written to the
+/// fraction buffer the resolve clamps with. Returns the fractions row-major, 1 for background.
+fn horizon_scale_pass<V: VBufferTile, T: ShaderFloat>(
+    rec: &mut PassRecorder,
+    vbuf: &mut [V],
+    scale: Scale<V>,
+) -> Vec<f32> {
+    let frame = rec.frame();
+    uses_receiver_normals(rec);
+    rec.uses(BufferPlan {
+        name: "horizon fraction".into(),
+        format: "R32F".into(),
+        bytes_per_sample: FRACTION_BYTES,
+    });
+    let light = frame.scene.light();
+    let (receivers, normals) = (frame.receivers(), frame.receiver_normals());
+    let tiling = &frame.tiling;
+    rec.pass(HORIZON_SCALE, |pass| {
+        let probe = pass.probe();
+        let per_tile: Vec<(Vec<(usize, f32)>, Counters)> = vbuf
+            .par_iter_mut()
+            .enumerate()
+            .map(|(t, vb)| {
+                let watched = probe.as_ref().filter(|p| p.watches_tile(t));
+                let mut c = Counters::default();
+                let mut out = Vec::new();
+                for i in 0..tiling.tile_len() {
+                    let [x, y] = tiling.position(t, i);
+                    if x >= tiling.width || y >= tiling.height {
+                        continue;
+                    }
+                    let k = (y * tiling.width + x) as usize;
+                    let Some(r) = receivers[k] else {
+                        continue;
+                    };
+                    count!(c.fragments_shaded += 1);
+                    count!(c.color_read_bytes += u64::from(normal_buffer::BYTES_PER_PIXEL));
+                    count!(c.color_write_bytes += u64::from(FRACTION_BYTES));
+                    let f = SquarePlane::<T>::of(light, r.point.as_dvec3(), normals[k])
+                        .expect("read_settings refuses integrate but under a rectangle")
+                        .fraction()
+                        .to_f64() as f32;
+                    match watched.and_then(|p| p.tap(t, i)) {
+                        None => scale(vb, i, f, &mut c),
+                        Some(tap) => {
+                            let before = vb.raw(i);
+                            scale(vb, i, f, &mut c);
+                            let e = tap
+                                .event()
+                                .value("fraction_in_front", f64::from(f))
+                                .write("vbuffer", before, vb.raw(i), V::FORMAT.overflow(), 0)
+                                .note(
+                                    "pass 1's 1 − count times the fraction of the light in \
+                                     front of the receiver's plane (horizon = integrate)",
+                                );
+                            tap.push(e);
+                        }
+                    }
+                    out.push((k, f));
+                }
+                (out, c)
+            })
+            .collect();
+        let mut fractions = vec![1.0; receivers.len()];
+        let mut counters = Counters::default();
+        for (out, c) in per_tile {
+            counters += c;
+            for (k, f) in out {
+                fractions[k] = f;
+            }
+        }
+        pass.count(counters);
+        fractions
     })
 }
 
@@ -859,6 +1037,11 @@ const SWEEP: &[crate::methods::OptionPairs] = &[
         ("coverage", "exact"),
         ("vbuffer", "f32"),
         ("horizon", "clip"),
+    ],
+    &[
+        ("coverage", "exact"),
+        ("vbuffer", "f32"),
+        ("horizon", "integrate"),
     ],
 ];
 

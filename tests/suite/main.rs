@@ -33,6 +33,7 @@ mod hard_case_catalog;
 mod hard_shadow_volumes;
 mod hiz;
 mod horizon_clip;
+mod horizon_integrate;
 mod multi_light;
 mod optimized_ssv;
 mod options;
