@@ -1,7 +1,7 @@
 //! What the emulated fragment programs execute, counted (issue 29 item 1; `docs/gpu-model.md`
 //! "Fragment-program work"): the work the GPU cost model's shade term prices.
 //!
-//! Every operation of a fragment program goes through its scalar, a [`ShaderFloat`] chosen by
+//! Every operation of a fragment program goes through its scalar, a [`ShaderFloat`](super::shader_float::ShaderFloat) chosen by
 //! [`with_shader_float!`](crate::with_shader_float) (the default precision's scalar is
 //! [`ShaderF64`](super::shader_float::ShaderF64), plain f64 arithmetic that counts). Each
 //! operation adds its instruction count to a thread-local tally ([`alu`], [`transcendental`]),

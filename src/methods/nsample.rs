@@ -25,7 +25,7 @@
 //! light in front of the receiver's plane; with `integrate` each sample is tested against
 //! that plane, `n·(s − p) ≥ 0` in f64, a sample behind lights nothing and its weight goes to
 //! a behind accumulator, and a pixel with samples behind is `f·lit/front`, the lit share of
-//! the samples in front times the fraction `f` in front ([`in_front_share`];
+//! the samples in front times the fraction `f` in front (`in_front_share`;
 //! `docs/horizon.md`, "`integrate`")), and `mode`, `stencil`, `submission` as for
 //! `hard-sv`; `mode = auto` chooses z-fail when the near plane is in the shadow of the
 //! light center or of the shape's extreme points ([`crate::geometry::near_plane::representative_light_points`]).
@@ -201,32 +201,21 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
 
     let tiling = &frame.tiling;
     rec.uses(BufferPlan::stencil8());
-    let mut acc: Vec<Vec<[f64; 3]>> = rec.allocate(
-        BufferPlan {
-            name: "accumulator".into(),
-            format: "f64x3".into(),
-            bytes_per_sample: 24,
-        },
-        || {
-            (0..tiling.tile_count())
-                .map(|_| vec![[0.0; 3]; tiling.tile_len()])
-                .collect()
-        },
-    );
+    // An f64x3 accumulator per tile, zeroed, and its plan entry.
+    let accumulator = |name: &str| BufferPlan {
+        name: name.into(),
+        format: "f64x3".into(),
+        bytes_per_sample: 24,
+    };
+    let zeroed = || -> Vec<Vec<[f64; 3]>> {
+        (0..tiling.tile_count())
+            .map(|_| vec![[0.0; 3]; tiling.tile_len()])
+            .collect()
+    };
+    let mut acc = rec.allocate(accumulator("accumulator"), zeroed);
     // `horizon = integrate`: the weight of the samples behind each receiver's plane.
     let mut behind: Vec<Vec<[f64; 3]>> = match planes {
-        Some(_) => rec.allocate(
-            BufferPlan {
-                name: "behind accumulator".into(),
-                format: "f64x3".into(),
-                bytes_per_sample: 24,
-            },
-            || {
-                (0..tiling.tile_count())
-                    .map(|_| vec![[0.0; 3]; tiling.tile_len()])
-                    .collect()
-            },
-        ),
+        Some(_) => rec.allocate(accumulator("behind accumulator"), zeroed),
         None => vec![Vec::new(); tiling.tile_count()],
     };
     rec.uses_hiz_depth();
