@@ -6,6 +6,12 @@
 //! with `integrate` where the method has it (`nsample`, `ssv` under a rectangle).
 //! The reference's own noise on each class is the mean |e| between two `raycast` seeds.
 //!
+//! The *lower-only floor* is the mean over the horizon receivers of `max(0, truth − off)`:
+//! the part of `off`'s error where it is too dark. A correction that can only lower a value —
+//! `clip` and `v·f` — leaves that part as it is, so its horizon error cannot go below the
+//! floor, and `off / floor` bounds the factor such a correction can reach (if it is under 3,
+//! the 3× is out of reach of `clip` on that scene, whatever the fraction in front).
+//!
 //! `cargo run --release --example horizon_measure [SIZE] [SCENE…]` (default 256,
 //! `cube-of-spheres` and `scenes/real/*.toml`; a scene is a built-in name or a file).
 
@@ -31,16 +37,22 @@ const METHODS: &[(&str, &[&str], bool)] = &[
     ("dbuffer", &[], false),
 ];
 
+/// Mean of `term(i)` over the pixels `mask` selects.
+fn mean_over(mask: &[bool], term: impl Fn(usize) -> f32) -> f64 {
+    let (sum, n) = (0..mask.len())
+        .filter(|&i| mask[i])
+        .fold((0.0, 0usize), |(s, n), i| (s + f64::from(term(i)), n + 1));
+    sum / n.max(1) as f64
+}
+
 /// Mean |a − b| over the pixels `mask` selects.
 fn mean_abs(a: &Visibility, b: &Visibility, mask: &[bool]) -> f64 {
-    let (sum, n) = mask
-        .iter()
-        .enumerate()
-        .filter(|(_, m)| **m)
-        .fold((0.0, 0usize), |(s, n), (i, _)| {
-            (s + f64::from((a.gray(i) - b.gray(i)).abs()), n + 1)
-        });
-    sum / n.max(1) as f64
+    mean_over(mask, |i| (a.gray(i) - b.gray(i)).abs())
+}
+
+/// Mean of `max(0, b − a)` over the pixels `mask` selects: where `a` is darker than `b`.
+fn mean_too_dark(a: &Visibility, b: &Visibility, mask: &[bool]) -> f64 {
+    mean_over(mask, |i| (b.gray(i) - a.gray(i)).max(0.0))
 }
 
 fn load(name: &str) -> Result<Scene, String> {
@@ -65,9 +77,9 @@ fn main() {
         scenes.extend(real);
     }
     println!(
-        "| scene | light | method | horizon px | whole-light px | off: horizon | clip: horizon | v·f: horizon | integrate: horizon | off / clip | off / integrate | off: whole | clip: whole | v·f: whole | integrate: whole | raycast noise: horizon / whole |"
+        "| scene | light | method | horizon px | whole-light px | off: horizon | clip: horizon | v·f: horizon | integrate: horizon | lower-only floor: horizon | off / clip | off / floor | off / integrate | off: whole | clip: whole | v·f: whole | integrate: whole | raycast noise: horizon / whole |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for name in scenes {
         let mut scene = match load(&name) {
             Ok(s) => s,
@@ -142,11 +154,12 @@ fn main() {
             );
             let e = |v: &Visibility, m: &[bool]| mean_abs(v, &reference, m);
             let (e_off, e_clip) = (e(&off, &horizon), e(&clip, &horizon));
+            let floor = mean_too_dark(&off, &reference, &horizon);
             let dash = || "–".to_string();
             let integrated =
                 |f: &dyn Fn(&Visibility) -> String| integrate.as_ref().map_or_else(dash, f);
             println!(
-                "| {} | {} | {method} | {} | {} | {e_off:.4} | {e_clip:.4} | {:.4} | {} | {:.1}× | {} | {:.4} | {:.4} | {:.4} | {} | {:.4} / {:.4} |",
+                "| {} | {} | {method} | {} | {} | {e_off:.4} | {e_clip:.4} | {:.4} | {} | {floor:.4} | {:.1}× | {:.1}× | {} | {:.4} | {:.4} | {:.4} | {} | {:.4} / {:.4} |",
                 Path::new(&name).file_stem().unwrap().to_string_lossy(),
                 light.shape.type_name(),
                 horizon.iter().filter(|h| **h).count(),
@@ -154,6 +167,7 @@ fn main() {
                 e(&product, &horizon),
                 integrated(&|v| format!("{:.4}", e(v, &horizon))),
                 e_off / e_clip,
+                e_off / floor,
                 integrated(&|v| format!("{:.1}×", e_off / e(v, &horizon))),
                 e(&off, &whole),
                 e(&clip, &whole),

@@ -71,6 +71,19 @@ impl Html {
         self
     }
 
+    /// A table's head row: one `<th class=…>` per `(class, head)`, an empty class omitted.
+    pub fn head_row(&mut self, heads: &[(&str, &str)]) -> &mut Self {
+        self.open("tr", &[]);
+        for &(class, head) in heads {
+            if class.is_empty() {
+                self.element("th", &[], head);
+            } else {
+                self.element("th", &[("class", class)], head);
+            }
+        }
+        self.close()
+    }
+
     /// Closes the innermost open element.
     ///
     /// # Panics

@@ -163,8 +163,7 @@ pub fn section(h: &mut Html, root: &Path, rel: &Path, p: &Peers, id: &str) {
     }
     h.close();
     h.open("table", &[]);
-    h.open("tr", &[]);
-    for (class, head) in [
+    h.head_row(&[
         ("name", "peer"),
         ("name", "pass"),
         ("", "median s"),
@@ -172,10 +171,7 @@ pub fn section(h: &mut Html, root: &Path, rel: &Path, p: &Peers, id: &str) {
         ("", "max s"),
         ("", "runs"),
         ("", "error vs raycast"),
-    ] {
-        h.element("th", &[("class", class)], head);
-    }
-    h.close();
+    ]);
     for peer in &p.peers {
         for pass in &peer.passes {
             h.open("tr", &[]);
@@ -192,18 +188,14 @@ pub fn section(h: &mut Html, root: &Path, rel: &Path, p: &Peers, id: &str) {
     h.close();
     if !p.rows.is_empty() {
         h.open("table", &[]);
-        h.open("tr", &[]);
-        for (class, head) in [
+        h.head_row(&[
             ("name", "issue 32 row"),
             ("", "penumbra s"),
             ("", "peer s"),
             ("", "penumbra / peer"),
             ("", "goal"),
             ("", "met"),
-        ] {
-            h.element("th", &[("class", class)], head);
-        }
-        h.close();
+        ]);
         for r in &p.rows {
             h.open("tr", &[]);
             h.element("td", &[("class", "name")], &r.row);
