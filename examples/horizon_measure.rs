@@ -11,6 +11,12 @@
 //! `clip` and `v·f` — leaves that part as it is, so its horizon error cannot go below the
 //! floor, and `off / floor` bounds the factor such a correction can reach (if it is under 3,
 //! the 3× is out of reach of `clip` on that scene, whatever the fraction in front).
+//! `clip`'s own horizon error is split the same way into its too-dark and its too-bright part
+//! (`mean max(0, clip − truth)`: light in front of the plane that something else hides and
+//! the method misses).
+//! The last two columns name the horizon pixel where `off` is farthest below the truth and the
+//! one where `clip` is farthest above it (`x,y`, the method's value → `raycast`'s), the ones to
+//! hand to `penumbra probe`.
 //!
 //! `cargo run --release --example horizon_measure [SIZE] [SCENE…]` (default 256,
 //! `cube-of-spheres` and `scenes/real/*.toml`; a scene is a built-in name or a file).
@@ -77,9 +83,11 @@ fn main() {
         scenes.extend(real);
     }
     println!(
-        "| scene | light | method | horizon px | whole-light px | off: horizon | clip: horizon | v·f: horizon | integrate: horizon | lower-only floor: horizon | off / clip | off / floor | off / integrate | off: whole | clip: whole | v·f: whole | integrate: whole | raycast noise: horizon / whole |"
+        "| scene | light | method | horizon px | whole-light px | off: horizon | clip: horizon | v·f: horizon | integrate: horizon | lower-only floor: horizon | clip too bright: horizon | off / clip | off / floor | off / integrate | off: whole | clip: whole | v·f: whole | integrate: whole | raycast noise: horizon / whole | darkest below truth: x,y off→truth | brightest above truth: x,y clip→truth |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!(
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    );
     for name in scenes {
         let mut scene = match load(&name) {
             Ok(s) => s,
@@ -153,13 +161,33 @@ fn main() {
                     .collect(),
             );
             let e = |v: &Visibility, m: &[bool]| mean_abs(v, &reference, m);
+            let dash = || "–".to_string();
             let (e_off, e_clip) = (e(&off, &horizon), e(&clip, &horizon));
             let floor = mean_too_dark(&off, &reference, &horizon);
-            let dash = || "–".to_string();
+            let clip_bright = mean_too_dark(&reference, &clip, &horizon);
+            // The horizon pixel where `v` exceeds the truth most (`sign` −1: falls below it).
+            let extreme = |v: &Visibility, sign: f32| {
+                (0..v.len())
+                    .filter(|&i| horizon[i])
+                    .max_by(|&i, &j| {
+                        let by = |k: usize| sign * (v.gray(k) - reference.gray(k));
+                        by(i).total_cmp(&by(j)).then(j.cmp(&i))
+                    })
+                    .map_or_else(dash, |i| {
+                        format!(
+                            "{},{} {:.3}→{:.3}",
+                            i as u32 % size,
+                            i as u32 / size,
+                            v.gray(i),
+                            reference.gray(i)
+                        )
+                    })
+            };
+            let (darkest, brightest) = (extreme(&off, -1.0), extreme(&clip, 1.0));
             let integrated =
                 |f: &dyn Fn(&Visibility) -> String| integrate.as_ref().map_or_else(dash, f);
             println!(
-                "| {} | {} | {method} | {} | {} | {e_off:.4} | {e_clip:.4} | {:.4} | {} | {floor:.4} | {:.1}× | {:.1}× | {} | {:.4} | {:.4} | {:.4} | {} | {:.4} / {:.4} |",
+                "| {} | {} | {method} | {} | {} | {e_off:.4} | {e_clip:.4} | {:.4} | {} | {floor:.4} | {clip_bright:.4} | {:.1}× | {:.1}× | {} | {:.4} | {:.4} | {:.4} | {} | {:.4} / {:.4} | {darkest} | {brightest} |",
                 Path::new(&name).file_stem().unwrap().to_string_lossy(),
                 light.shape.type_name(),
                 horizon.iter().filter(|h| **h).count(),
