@@ -31,8 +31,9 @@ use std::time::Instant;
 
 /// How far off its triangle's plane a depth-buffer receiver may lie, relative to the scene's
 /// diagonal, before [`Frame::receivers`] puts it on the plane: half the ray-origin offset of
-/// the `raycast` reference (`methods::raycast::ORIGIN_OFFSET`), so that a receiver the depth
-/// buffer holds well enough is never below the surface its shadow rays start from.
+/// the `raycast` reference (`methods::raycast::ORIGIN_OFFSET` is defined as twice this), so
+/// that a receiver the depth buffer holds well enough is never below the surface its shadow
+/// rays start from.
 pub const RECEIVER_PLANE_TOLERANCE: f64 = 0.5e-4;
 
 /// The pixel at which no geometry was drawn.
@@ -185,12 +186,48 @@ pub struct Frame<'s> {
     /// The receiver-normal buffer, row-major, computed on first use
     /// ([`Frame::receiver_normals`]).
     receiver_normals: OnceLock<Vec<DVec3>>,
+    /// Each mesh's axis-aligned box and the box of every receiver point, computed on first
+    /// use ([`Frame::within_light_influence`]).
+    influence_boxes: OnceLock<InfluenceBoxes>,
     /// Whether methods hand back every buffer they resolved, with its event map
     /// ([`crate::methods::dump`], `--dump-buffers`); false after [`Frame::render`], set with
     /// [`Frame::dumping`].
     pub dump_buffers: bool,
     /// The probe the methods' passes record into ([`crate::gpu::probe`]), if one is attached.
     pub probe: Option<Arc<Probe>>,
+}
+
+/// What [`Frame::within_light_influence`] compares: each mesh's axis-aligned box, and the box
+/// of every receiver point of the frame (`None` when no pixel shows a surface).
+#[derive(Debug, Clone)]
+struct InfluenceBoxes {
+    meshes: Vec<(DVec3, DVec3)>,
+    receivers: Option<(DVec3, DVec3)>,
+}
+
+impl InfluenceBoxes {
+    fn new(frame: &Frame) -> Self {
+        let bounds = |points: &mut dyn Iterator<Item = DVec3>| {
+            let first = points.next()?;
+            Some(points.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
+        };
+        let empty = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        Self {
+            meshes: frame
+                .scene
+                .meshes
+                .iter()
+                .map(|m| bounds(&mut m.positions.iter().map(|p| p.as_dvec3())).unwrap_or(empty))
+                .collect(),
+            receivers: bounds(
+                &mut frame
+                    .receivers()
+                    .iter()
+                    .flatten()
+                    .map(|r| r.point.as_dvec3()),
+            ),
+        }
+    }
 }
 
 impl<'s> Frame<'s> {
@@ -293,6 +330,7 @@ impl<'s> Frame<'s> {
             depth_receivers: OnceLock::new(),
             receiver_bounds: OnceLock::new(),
             receiver_normals: OnceLock::new(),
+            influence_boxes: OnceLock::new(),
             dump_buffers: false,
             probe: None,
         })
@@ -304,19 +342,87 @@ impl<'s> Frame<'s> {
         self
     }
 
-    /// The meshes that cast shadows with their adjacency ([`Frame::casters`]), in scene order:
-    /// what every method builds silhouettes, volumes and wedges from.
+    /// The meshes that cast shadows ([`Frame::casters`]) within the light's influence
+    /// ([`Frame::within_light_influence`]), with their adjacency, in scene order: what every
+    /// method builds silhouettes, volumes and wedges from. A caster whose shadow reaches no
+    /// receiver of the frame submits nothing.
     pub fn caster_meshes(&self) -> Vec<(&'s Mesh, &Adjacency)> {
-        self.casters
-            .iter()
-            .map(|(k, adj)| (&self.scene.meshes[*k], adj))
+        self.influencing_casters()
+            .map(|(k, adj)| (&self.scene.meshes[k], adj))
             .collect()
     }
 
-    /// `meshes[i] (name)`, the object an error names, for the `k`-th of [`Frame::casters`].
+    /// The scene index of the `k`-th mesh of [`Frame::caster_meshes`].
+    pub fn caster_mesh_index(&self, k: usize) -> usize {
+        self.influencing_casters()
+            .nth(k)
+            .map(|(i, _)| i)
+            .expect("a caster index of caster_meshes")
+    }
+
+    /// `meshes[i] (name)`, the object an error names, for the `k`-th of
+    /// [`Frame::caster_meshes`].
     pub fn caster_object(&self, k: usize) -> String {
-        let i = self.casters[k].0;
+        let i = self.caster_mesh_index(k);
         format!("meshes[{i}] ({})", self.scene.meshes[i].name)
+    }
+
+    fn influencing_casters(&self) -> impl Iterator<Item = (usize, &Adjacency)> + '_ {
+        self.casters
+            .iter()
+            .filter(|(k, _)| self.within_light_influence(*k))
+            .map(|(k, adj)| (*k, adj))
+    }
+
+    /// Whether mesh `mesh` of the scene can change the light of a receiver this frame shows:
+    /// `false` only where, for every light, some axis direction `d` (±x, ±y, ±z) separates
+    /// the mesh from both. The mesh's box lies beyond the light's box along `d` (its least
+    /// `d·x` at least the light's greatest), and every receiver point lies short of the mesh
+    /// along `d` by more than a tolerance. Every shadow point of the mesh is `l + t(b − l)`
+    /// with `l` on the light, `b` on the mesh and `t ≥ 1`, so `d·x ≥ d·b ≥` the mesh's least
+    /// `d·x` there: its shadow volume, umbra and penumbra lie wholly beyond every receiver,
+    /// and no pixel's visibility depends on it. The tolerance is 10⁻³ of the diagonal of the
+    /// receivers' and the mesh's boxes, so that the receivers' positions, rebuilt from the
+    /// depth buffer, cannot reach it by rounding. A frame that shows no receiver keeps every
+    /// mesh.
+    pub fn within_light_influence(&self, mesh: usize) -> bool {
+        let boxes = self
+            .influence_boxes
+            .get_or_init(|| InfluenceBoxes::new(self));
+        let Some((rlo, rhi)) = boxes.receivers else {
+            return true;
+        };
+        let (blo, bhi) = boxes.meshes[mesh];
+        let tol = 1e-3 * (rhi.max(bhi) - rlo.min(blo)).length();
+        !self.scene.lights.iter().all(|light| {
+            let (llo, lhi) = light.bounds();
+            (0..3).any(|k| {
+                (blo[k] >= lhi[k] && rhi[k] < blo[k] - tol)
+                    || (bhi[k] <= llo[k] && rlo[k] > bhi[k] + tol)
+            })
+        })
+    }
+
+    /// The axis-aligned bounds (min, max) of the vertices of the meshes within the light's
+    /// influence ([`Frame::within_light_influence`]), and with `lights` every light center
+    /// too: [`Scene::mesh_bounds`]' and [`Scene::bounds`]' points without the meshes that
+    /// change no pixel. With no point, the first light's center.
+    pub fn influence_bounds(&self, lights: bool) -> (Vec3, Vec3) {
+        let centers = self.scene.lights.iter().map(|l| &l.center);
+        let vertices = self
+            .scene
+            .meshes
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| self.within_light_influence(*k))
+            .flat_map(|(_, m)| m.positions.iter());
+        let mut points: Box<dyn Iterator<Item = &Vec3>> = if lights {
+            Box::new(centers.chain(vertices))
+        } else {
+            Box::new(vertices)
+        };
+        let first = points.next().copied().unwrap_or(self.scene.light().center);
+        points.fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
     }
 
     /// This frame for `scene`, a scene that differs from this frame's only in its lights
@@ -343,6 +449,7 @@ impl<'s> Frame<'s> {
             depth_receivers: self.depth_receivers.clone(),
             receiver_bounds: self.receiver_bounds.clone(),
             receiver_normals: self.receiver_normals.clone(),
+            influence_boxes: self.influence_boxes.clone(),
             dump_buffers: self.dump_buffers,
             probe: self.probe.clone(),
         }

@@ -127,7 +127,7 @@ pub fn probe_pixel(
         events: shown,
         visibility,
         reference,
-        reference_samples: methods::raycast::reference_samples(scene)?,
+        reference_samples: methods::raycast::reference_samples(&frame)?,
         error,
     })
 }

@@ -359,7 +359,7 @@ pub fn table_notes(scene: &Scene, runs: &[MethodRun]) -> Vec<String> {
         notes.push(
             "note: a sphere light is the disk facing each receiver for raycast (unless \
              raycast.sphere = fixed-disk) and the wedge methods, but one disk facing the \
-             center of the mesh bounds for nsample"
+             center of the bounds of the meshes within the light's influence for nsample"
                 .into(),
         );
     }

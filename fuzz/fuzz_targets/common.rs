@@ -1199,7 +1199,7 @@ pub fn tight_wedge(data: &[u8]) {
         cli_options: Default::default(),
         ambient: 0.0,
     };
-    let (lo, hi) = wedge_clip_box(&scene);
+    let (lo, hi) = wedge_clip_box(scene.bounds());
     let at =
         || format!("edge {a} {b}, light {model:?}, tight {tight}, {sides} sides, box {lo} {hi}");
 

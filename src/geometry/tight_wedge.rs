@@ -68,7 +68,7 @@
 use super::ssv_wedge::{SsvWedge, WedgeLight};
 use crate::gpu::shader_float::ShaderFloat;
 use crate::gpu::shader_vec::SVec3;
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 use std::cmp::Ordering;
 
 /// A half-space `normal · x ≤ offset`.
@@ -685,12 +685,14 @@ pub fn quad_inner_halfspace(c: DVec3, a: DVec3, b: DVec3) -> HalfSpace {
     }
 }
 
-/// The box wedges are clipped to (module doc, "Finite wedges"): the scene's bounds enlarged
-/// by 1% of their diagonal plus 10⁻³. The diagonal is the f32 one the goldens pin, or the f64
-/// one where that overflows: a scene may span more than the f32 range (found by fuzzing: an
-/// infinite box, whose clipped wedges had infinite and NaN vertices).
-pub fn wedge_clip_box(scene: &crate::scene::Scene) -> (DVec3, DVec3) {
-    let (lo, hi) = scene.bounds();
+/// The box wedges are clipped to (module doc, "Finite wedges"): the scene's bounds (`bounds`:
+/// [`crate::scene::Scene::bounds`], or [`crate::frame::Frame::influence_bounds`] without the
+/// meshes whose shadow reaches no receiver) enlarged by 1% of their diagonal plus 10⁻³. The
+/// diagonal is the f32 one the goldens pin, or the f64 one where that overflows: a scene may
+/// span more than the f32 range (found by fuzzing: an infinite box, whose clipped wedges had
+/// infinite and NaN vertices).
+pub fn wedge_clip_box(bounds: (Vec3, Vec3)) -> (DVec3, DVec3) {
+    let (lo, hi) = bounds;
     let diagonal = (hi - lo).length();
     let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
     let diagonal = if diagonal.is_finite() {

@@ -124,8 +124,11 @@ pub struct LightView {
 }
 
 impl LightView {
-    /// Fit a view from `center` covering every mesh vertex of `scene` (module doc), rendering
-    /// into a square target of format `depth` tiled by `tiling` (its width is the map size).
+    /// Fit a view from `center` covering every vertex of the meshes of `scene` that `covers`
+    /// accepts (by index; module doc), rendering into a square target of format `depth` tiled
+    /// by `tiling` (its width is the map size). The methods leave out the meshes whose shadow
+    /// reaches no receiver ([`crate::frame::Frame::within_light_influence`]): they are still
+    /// rendered, and clipped.
     ///
     /// Errors: the first vertex (mesh order, vertex order) farther than
     /// [`MAX_LIGHT_VIEW_HALF_ANGLE_DEG`] from the axis.
@@ -134,12 +137,18 @@ impl LightView {
         center: Vec3,
         tiling: Tiling,
         depth: DepthFormat,
+        covers: impl Fn(usize) -> bool,
     ) -> Result<Self, UncoveredVertex> {
         let c = center.as_dvec3();
-        let directions: Vec<DVec3> = scene
-            .meshes
-            .iter()
-            .flat_map(|m| m.positions.iter())
+        let covered = || {
+            scene
+                .meshes
+                .iter()
+                .enumerate()
+                .filter(|(mi, _)| covers(*mi))
+        };
+        let directions: Vec<DVec3> = covered()
+            .flat_map(|(_, m)| m.positions.iter())
             .map(|p| (p.as_dvec3() - c).normalize_or_zero())
             .collect();
         let axis = enclosing_cone_axis(&directions);
@@ -158,7 +167,7 @@ impl LightView {
         ];
         let (mut near, mut far) = (f64::INFINITY, 0.0f64);
         let mut worst: Option<UncoveredVertex> = None;
-        for (mi, m) in scene.meshes.iter().enumerate() {
+        for (mi, m) in covered() {
             for (vi, p) in m.positions.iter().enumerate() {
                 let v = p.as_dvec3() - c;
                 let d = v.dot(axis);
@@ -451,7 +460,10 @@ mod tests {
         ] {
             let scene = builtin::load(name).unwrap();
             for light in &scene.lights {
-                let view = LightView::fit(&scene, light.center, tiling(128), DepthFormat::D24)
+                let view =
+                    LightView::fit(&scene, light.center, tiling(128), DepthFormat::D24, |_| {
+                        true
+                    })
                     .unwrap_or_else(|e| panic!("{name}: {e:?}"));
                 for m in &scene.meshes {
                     for p in &m.positions {
@@ -476,13 +488,13 @@ mod tests {
             c + Vec3::new(1.0, 0.6, 1.0),
             [0.5; 3],
         ));
-        let e = LightView::fit(&scene, c, tiling(64), DepthFormat::D24).unwrap_err();
+        let e = LightView::fit(&scene, c, tiling(64), DepthFormat::D24, |_| true).unwrap_err();
         assert!(e.angle_deg > MAX_LIGHT_VIEW_HALF_ANGLE_DEG, "{e:?}");
         let p = scene.meshes[e.mesh].positions[e.vertex];
         assert_eq!(p, e.position);
         // Without the slab the scene is covered.
         scene.meshes.pop();
-        LightView::fit(&scene, c, tiling(64), DepthFormat::D24).unwrap();
+        LightView::fit(&scene, c, tiling(64), DepthFormat::D24, |_| true).unwrap();
     }
 
     #[test]
@@ -505,8 +517,14 @@ mod tests {
     #[test]
     fn nearest_texel_is_the_texel_nearest_sampling_reads_and_distance_is_depth() {
         let scene = builtin::load("single-quad").unwrap();
-        let view =
-            LightView::fit(&scene, scene.light().center, tiling(16), DepthFormat::D24).unwrap();
+        let view = LightView::fit(
+            &scene,
+            scene.light().center,
+            tiling(16),
+            DepthFormat::D24,
+            |_| true,
+        )
+        .unwrap();
         let id = |t: usize, l: usize| (t * 1000 + l) as f64;
         for (x, y) in [(0.2f32, 0.3f32), (7.5, 9.99), (15.9, 0.0), (-3.0, 20.0)] {
             let (t, l) = view.nearest_texel(x, y);
@@ -541,7 +559,8 @@ mod tests {
             let scene = builtin::load(name).unwrap();
             for format in [DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F] {
                 let view =
-                    LightView::fit(&scene, scene.light().center, tiling(128), format).unwrap();
+                    LightView::fit(&scene, scene.light().center, tiling(128), format, |_| true)
+                        .unwrap();
                 for offset in offsets {
                     let (on, c_on) = view.render_depth(&scene, offset, Some(8), None);
                     let (off, c_off) = view.render_depth(&scene, offset, None, None);
@@ -561,8 +580,14 @@ mod tests {
     #[test]
     fn shadow_map_stores_the_nearest_surface_and_the_offset_moves_it_back() {
         let scene = builtin::load("single-quad").unwrap();
-        let view =
-            LightView::fit(&scene, scene.light().center, tiling(64), DepthFormat::D24).unwrap();
+        let view = LightView::fit(
+            &scene,
+            scene.light().center,
+            tiling(64),
+            DepthFormat::D24,
+            |_| true,
+        )
+        .unwrap();
         let (plain, c) = view.render_depth(
             &scene,
             PolygonOffset::NONE,

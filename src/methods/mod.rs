@@ -450,7 +450,10 @@ pub fn fit_light_view(
     let scene = frame.scene;
     let tiling = Tiling::new(map_size, map_size, frame.tiling.tile)
         .map_err(|e| scene.option_error(method, "map-size", e))?;
-    LightView::fit(scene, scene.light().center, tiling, depth).map_err(|u| {
+    LightView::fit(scene, scene.light().center, tiling, depth, |mi| {
+        frame.within_light_influence(mi)
+    })
+    .map_err(|u| {
         let m = &scene.meshes[u.mesh];
         InputError::at(
             &scene.source,

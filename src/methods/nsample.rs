@@ -48,7 +48,7 @@ use crate::methods::hard_sv::CountMode;
 use crate::methods::output::BufferPlan;
 use crate::methods::recorder::PassRecorder;
 use crate::options::{option_table, OptionTable, OptionType};
-use crate::scene::{LightShape, Scene};
+use crate::scene::LightShape;
 use crate::visibility::Visibility;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -60,16 +60,11 @@ pub const DEFAULT_SAMPLES: u32 = 1024;
 /// own stencil buffer until the batch is accumulated (1 byte per pixel, `memory`'s estimate).
 pub const MAX_CONCURRENT_SAMPLES: usize = 8;
 
-/// The point a sphere light's sampling disk faces: the center of the mesh bounds.
-pub fn sphere_disk_target(scene: &Scene) -> Vec3 {
-    let mut lo = Vec3::splat(f32::MAX);
-    let mut hi = Vec3::splat(f32::MIN);
-    for m in &scene.meshes {
-        for p in &m.positions {
-            lo = lo.min(*p);
-            hi = hi.max(*p);
-        }
-    }
+/// The point a sphere light's sampling disk faces: the center of the bounds of the meshes
+/// within the light's influence ([`Frame::influence_bounds`]), so that a mesh whose shadow
+/// reaches no receiver of the frame does not turn the disk.
+pub fn sphere_disk_target(frame: &Frame) -> Vec3 {
+    let (lo, hi) = frame.influence_bounds(false);
     (lo + hi) * 0.5
 }
 
@@ -97,7 +92,7 @@ pub fn options(
         scene.light(),
         o.n,
         Pattern::Centered,
-        sphere_disk_target(frame.scene),
+        sphere_disk_target(frame),
     )
     .map_err(|e| scene.option_error(NsampleOptions::NAME, "n", e))?;
     Ok((samples, settings, o.shadow.mode))
@@ -187,6 +182,45 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     precision: crate::methods::precision_spec::PrecisionSpec::NO_SHADER_ARITHMETIC,
 };
 
+/// Bytes of one accumulator pixel (f64x3), read and written where a sample adds to it.
+const ACCUMULATOR_BYTES: u32 = 24;
+
+/// What one sample's accumulation does on the GPU (Paper III §5.1's accumulation of the N hard
+/// shadows): a screen pass over the receivers with the stencil test `EQUAL 0` — one stencil
+/// byte read per receiver — that adds the sample's weight to the accumulator by blending, a
+/// read and a write of it, where the test passes (and, with `horizon = integrate`, to the
+/// behind accumulator where the sample is behind the receiver's plane). Background pixels are
+/// not counted: their value is replaced by 1 at the resolve.
+#[derive(Debug, Default, Clone, Copy)]
+struct AccumulateWork {
+    /// Receivers whose stencil the pass tests.
+    receivers: u64,
+    /// Receivers whose accumulator (or behind accumulator) the pass reads and writes.
+    updates: u64,
+}
+
+impl AccumulateWork {
+    fn add(&mut self, receiver: bool, updated: bool) {
+        self.receivers += u64::from(receiver);
+        self.updates += u64::from(receiver && updated);
+    }
+
+    fn merged(self, other: Self) -> Self {
+        Self {
+            receivers: self.receivers + other.receivers,
+            updates: self.updates + other.updates,
+        }
+    }
+
+    fn counters(self) -> Counters {
+        let mut c = Counters::default();
+        count!(c.stencil_read_bytes += self.receivers);
+        count!(c.color_read_bytes += self.updates * u64::from(ACCUMULATOR_BYTES));
+        count!(c.color_write_bytes += self.updates * u64::from(ACCUMULATOR_BYTES));
+        c
+    }
+}
+
 /// Run `nsample` on a rendered frame.
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let mut rec = PassRecorder::new(frame, "nsample");
@@ -205,7 +239,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let accumulator = |name: &str| BufferPlan {
         name: name.into(),
         format: "f64x3".into(),
-        bytes_per_sample: 24,
+        bytes_per_sample: ACCUMULATOR_BYTES,
     };
     let zeroed = || -> Vec<Vec<[f64; 3]>> {
         (0..tiling.tile_count())
@@ -289,35 +323,44 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
                         .as_ref()
                         .is_none_or(|planes| planes[t][i].is_none_or(|(p, n)| n.dot(at - p) >= 0.0))
                 };
+                // Adds the sample's weight where it lights the pixel (or, behind the plane, to
+                // the behind accumulator); whether an accumulator was read and written.
                 let add = |px: &mut [f64; 3], back: &mut [[f64; 3]], i: usize, v: u8, front| {
                     let sum = match (front, v == 0) {
                         (true, true) => Some(px),
                         (true, false) => None,
                         (false, _) => Some(&mut back[i]),
                     };
+                    let updated = sum.is_some();
                     if let Some(sum) = sum {
                         for ch in 0..3 {
                             sum[ch] += w[ch];
                         }
                     }
+                    updated
                 };
                 let probe = frame.probe_pass("accumulate");
-                acc.par_iter_mut()
+                let accumulated: AccumulateWork = acc
+                    .par_iter_mut()
                     .zip(behind.par_iter_mut())
                     .zip(&stencil)
                     .enumerate()
-                    .for_each(|(t, ((a, back), st))| {
+                    .map(|(t, ((a, back), st))| {
+                        let receiver = |i: usize| frame.tiles[t].prim[i] != BACKGROUND;
+                        let mut work = AccumulateWork::default();
                         match probe.as_ref().filter(|p| p.watches_tile(t)) {
-                            None => a
-                                .iter_mut()
-                                .zip(&st.values)
-                                .enumerate()
-                                .for_each(|(i, (px, v))| add(px, back, i, *v, in_front(t, i))),
+                            None => {
+                                for (i, (px, v)) in a.iter_mut().zip(&st.values).enumerate() {
+                                    let updated = add(px, back, i, *v, in_front(t, i));
+                                    work.add(receiver(i), updated);
+                                }
+                            }
                             Some(p) => {
                                 for (i, (px, v)) in a.iter_mut().zip(&st.values).enumerate() {
                                     let before = *px;
                                     let front = in_front(t, i);
-                                    add(px, back, i, *v, front);
+                                    let updated = add(px, back, i, *v, front);
+                                    work.add(receiver(i), updated);
                                     if let Some(tap) = p.tap(t, i) {
                                         let e = tap
                                             .event()
@@ -352,7 +395,10 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
                                 }
                             }
                         }
-                    });
+                        work
+                    })
+                    .reduce(AccumulateWork::default, AccumulateWork::merged);
+                pass.count(accumulated.counters());
             }
         }
     });

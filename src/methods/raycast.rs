@@ -115,8 +115,10 @@ use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 /// Ray-origin offset along the receiver normal, relative to the scene diagonal (module doc,
-/// "Shadow rays").
-pub const ORIGIN_OFFSET: f64 = 1e-4;
+/// "Shadow rays"): 10⁻⁴, twice the tolerance within which [`Frame::receivers`] snaps a
+/// depth-buffer receiver onto its triangle's plane, so that a snapped receiver is never below
+/// the point its shadow rays start from — by construction, not by a test.
+pub const ORIGIN_OFFSET: f64 = 2.0 * crate::frame::RECEIVER_PLANE_TOLERANCE;
 
 /// The part of the ray-origin offset that scales with the coordinates' magnitude, in f32 ulps
 /// (module doc, "Shadow rays"): receivers are f32 points, rounded by half an ulp.
@@ -152,7 +154,7 @@ pub enum SphereDisk {
     /// methods' coverage uses): the default.
     FacingReceiver,
     /// One disk for all receivers, facing this point (what `nsample` must use: one set of
-    /// light samples per frame, facing the center of the mesh bounds).
+    /// light samples per frame, facing the center of the bounds of the meshes within the light's influence).
     Facing(Vec3),
 }
 
@@ -1010,7 +1012,7 @@ pub const METHOD: super::Method = super::Method {
     bytes_per_pixel: 72,
     default_run: super::DefaultRun::EveryScene,
     sums_per_silhouette_edge: false,
-    check: |frame| raycast_options(frame.scene).map(drop),
+    check: |frame| raycast_options(frame).map(drop),
     run,
     goldens: GOLDENS,
     sweep: SWEEP,
@@ -1021,7 +1023,7 @@ pub const METHOD: super::Method = super::Method {
 /// from the receiver point, with `samples` jittered stratified samples (default 1024, a perfect
 /// square) and `seed`. A sphere light is the disk facing each receiver (`sphere =
 /// facing-receiver`, the papers' definition) or, with `sphere = fixed-disk`, `nsample`'s one
-/// disk facing the center of the mesh bounds, so the two references can be compared on one
+/// disk facing the center of the bounds of the meshes within the light's influence, so the two references can be compared on one
 /// definition. `receiver = "depth-buffer"` (default) uses the depth-buffer point the
 /// rasterized methods see; `"primary-ray"` the exact hit of the ray through the pixel center
 /// with the visible triangle's plane.
@@ -1029,7 +1031,7 @@ fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     // The frame's scene pass writes the depth buffer whatever the receivers are read from.
     let mut rec = PassRecorder::new(frame, "raycast");
     let scene = frame.scene;
-    let (settings, receiver) = raycast_options(scene)?;
+    let (settings, receiver) = raycast_options(frame)?;
     let visibility = rec.pass("raycast", |pass| {
         let primary;
         let receivers = if receiver == ReceiverPoint::PrimaryRay {
@@ -1111,7 +1113,7 @@ option_names! {
     pub enum SphereAs {
         /// The disk through the center facing each receiver (the papers' definition).
         FacingReceiver = "facing-receiver",
-        /// `nsample`'s one disk, facing the center of the mesh bounds.
+        /// `nsample`'s one disk, facing the center of the bounds of the meshes within the light's influence.
         FixedDisk = "fixed-disk",
     }
 }
@@ -1135,7 +1137,7 @@ option_table! {
         seed: u64 [0..=u64::MAX >> 1] = 0;
         /// the pixel's point: the depth buffer's (what the rasterized methods see) or the pixel ray's exact hit
         receiver: ReceiverPoint = ReceiverPoint::DepthBuffer;
-        /// a sphere light as the disk facing each receiver (the papers'), or as nsample's one disk facing the center of the mesh bounds
+        /// a sphere light as the disk facing each receiver (the papers'), or as nsample's one disk facing the center of the bounds of the meshes within the light's influence
         sphere: SphereAs = SphereAs::FacingReceiver;
     }
 }
@@ -1149,7 +1151,7 @@ pub fn raycast_where(
     seed_offset: u64,
 ) -> Result<Visibility, InputError> {
     let one_light = |f: &Frame| -> Result<Visibility, InputError> {
-        let (mut settings, receiver) = raycast_options(f.scene)?;
+        let (mut settings, receiver) = raycast_options(f)?;
         settings.seed = settings.seed.wrapping_add(seed_offset);
         let all = if receiver == ReceiverPoint::PrimaryRay {
             f.primary_ray_receivers()
@@ -1176,18 +1178,20 @@ pub fn raycast_where(
 }
 
 /// The light samples per pixel of the reference (`[options.raycast]`'s `samples`).
-pub fn reference_samples(scene: &Scene) -> Result<u32, InputError> {
-    Ok(raycast_options(scene)?.0.samples)
+pub fn reference_samples(frame: &Frame) -> Result<u32, InputError> {
+    Ok(raycast_options(frame)?.0.samples)
 }
 
-/// Read and check `[options.raycast]`: the settings and the receiver choice.
-fn raycast_options(scene: &Scene) -> Result<(RaycastSettings, ReceiverPoint), InputError> {
+/// Read and check `[options.raycast]` of `frame`'s scene: the settings and the receiver
+/// choice (`sphere = fixed-disk` faces `nsample`'s disk, [`super::nsample::sphere_disk_target`]).
+fn raycast_options(frame: &Frame) -> Result<(RaycastSettings, ReceiverPoint), InputError> {
+    let scene = frame.scene;
     let o = RaycastOptions::read(scene)?;
     let settings = RaycastSettings {
         samples: o.samples,
         seed: o.seed,
         sphere_disk: match o.sphere {
-            SphereAs::FixedDisk => SphereDisk::Facing(super::nsample::sphere_disk_target(scene)),
+            SphereAs::FixedDisk => SphereDisk::Facing(super::nsample::sphere_disk_target(frame)),
             SphereAs::FacingReceiver => SphereDisk::FacingReceiver,
         },
     };
@@ -1682,11 +1686,6 @@ mod tests {
     /// A deterministic value in [0,1) for the pair (i, j).
     fn jitter_pair(i: usize, j: usize) -> f64 {
         ((i * 7919 + j * 104729) % 1000) as f64 / 1000.0
-    }
-
-    #[test]
-    fn receivers_are_snapped_below_half_the_ray_offset() {
-        assert_eq!(crate::frame::RECEIVER_PLANE_TOLERANCE, ORIGIN_OFFSET / 2.0);
     }
 
     #[test]

@@ -584,7 +584,7 @@ fn render_group<T: ShaderFloat>(
         tap.event().clear("v-sub", Raw::Rgba8([0; 4]))
     });
     frame.probe_record("clear", |tap, _| tap.event().clear("stencil", Raw::U8(0)));
-    let (lo, hi) = wedge_clip_box(frame.scene);
+    let (lo, hi) = wedge_clip_box(frame.influence_bounds(true));
     let c = light.center();
 
     // Wedge halves in edge order (inner, then outer).

@@ -124,6 +124,29 @@ pub struct Light {
     pub shape: LightShape,
 }
 
+impl Light {
+    /// The axis-aligned box (min, max) of every point of the light, in f64: the center of a
+    /// point light, a rectangle's corners, a disk's rim (`center ± radius·√(1 − n_k²)` along
+    /// axis k, for its unit normal `n`), a sphere's `center ± radius`.
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        let c = self.center.as_dvec3();
+        let half = match &self.shape {
+            LightShape::Point => DVec3::ZERO,
+            LightShape::Sphere { radius } => DVec3::splat(f64::from(*radius)),
+            LightShape::Disk { radius, normal } => {
+                let n = normal.as_dvec3().normalize_or_zero();
+                let r = f64::from(*radius);
+                let rim = |nk: f64| (1.0 - nk * nk).max(0.0).sqrt() * r;
+                DVec3::new(rim(n.x), rim(n.y), rim(n.z))
+            }
+            LightShape::Rect { u, v } | LightShape::TexturedRect { u, v, .. } => {
+                u.as_dvec3().abs() + v.as_dvec3().abs()
+            }
+        };
+        (c - half, c + half)
+    }
+}
+
 /// A closed, two-manifold triangle mesh in world space (transform already applied).
 /// Triangles are counter-clockwise seen from outside (outward normals by the right-hand rule).
 #[derive(Debug, Clone, PartialEq)]
@@ -341,6 +364,41 @@ impl Scene {
 
 #[cfg(test)]
 mod tests {
+    use super::{Light, LightShape};
+    use glam::{DVec3, Vec3};
+
+    /// A light's box holds its extreme points: a disk's rim reaches `radius·√(1 − n_k²)` along
+    /// axis k (a disk facing +y is flat in y; one tilted 45° in x–y reaches `r/√2` in x and y).
+    #[test]
+    fn a_lights_box_is_the_box_of_its_points() {
+        let at = |shape| Light {
+            center: Vec3::new(1.0, 2.0, 3.0),
+            shape,
+        };
+        let disk = |normal| LightShape::Disk {
+            radius: 2.0,
+            normal,
+        };
+        let half = |l: Light| {
+            let (lo, hi) = l.bounds();
+            assert_eq!(lo + hi, 2.0 * l.center.as_dvec3());
+            (hi - lo) / 2.0
+        };
+        assert_eq!(half(at(disk(Vec3::Y))), DVec3::new(2.0, 0.0, 2.0));
+        let tilted = half(at(disk(Vec3::new(1.0, 1.0, 0.0).normalize())));
+        assert!((tilted - DVec3::new(2f64.sqrt(), 2f64.sqrt(), 2.0)).length() < 1e-6);
+        assert_eq!(
+            half(at(LightShape::Sphere { radius: 0.5 })),
+            DVec3::splat(0.5)
+        );
+        let rect = LightShape::Rect {
+            u: Vec3::new(1.0, 0.0, 1.0),
+            v: Vec3::new(0.0, 0.0, -0.5),
+        };
+        assert_eq!(half(at(rect)), DVec3::new(1.0, 0.0, 1.5));
+        assert_eq!(half(at(LightShape::Point)), DVec3::ZERO);
+    }
+
     /// `--width` or `--height` alone keeps the aspect ratio; both replace both.
     #[test]
     fn resize_keeps_the_aspect_ratio_when_one_side_is_given() {

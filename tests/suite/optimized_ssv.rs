@@ -408,7 +408,7 @@ fn tight_wedges_lie_within_paper_iii_wedges_on_the_frame() {
         let light = s.light();
         let model = LightModel::from_shape(light.center, &light.shape).unwrap();
         let paper3_light = WedgeLight::from_light(light).unwrap();
-        let (lo, hi) = wedge_clip_box(&s);
+        let (lo, hi) = wedge_clip_box(s.bounds());
         let receivers: Vec<DVec3> = frame
             .receivers()
             .iter()

@@ -212,7 +212,7 @@ fn aliasing_falls_as_the_map_grows() {
     let mut wrong = Vec::new();
     for n in [256u32, 512, 1024, 2048] {
         let tiling = Tiling::new(n, n, 8).unwrap();
-        let view = LightView::fit(&scene, light, tiling, DepthFormat::D24).unwrap();
+        let view = LightView::fit(&scene, light, tiling, DepthFormat::D24, |_| true).unwrap();
         let (shadow_map, _) = view.render_depth(&scene, offset, Some(DEFAULT_HIZ_TILE_SIZE), None);
         let mut count = 0;
         for rcv in receivers.iter().flatten() {

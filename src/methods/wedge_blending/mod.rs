@@ -319,7 +319,7 @@ pub fn silhouettes(frame: &Frame, s: &Settings) -> Result<Vec<Silhouette>, Input
     };
     let mut out = Vec::new();
     for (k, (mesh, adj)) in frame.caster_meshes().into_iter().enumerate() {
-        let mi = frame.casters[k].0;
+        let mi = frame.caster_mesh_index(k);
         let facing = light_facing(mesh, c);
         let edges = possible_silhouettes(mesh, adj, &facing);
         let loops = silhouette_loops(&edges)
@@ -740,7 +740,7 @@ fn render_with<S: VBufferStorage, T: ShaderFloat>(
     let light = RectLight::from_light(frame.scene.light()).expect("options checked a rect light");
     let c = light.center;
     let corners = light.corners();
-    let (lo, hi) = wedge_clip_box(frame.scene);
+    let (lo, hi) = wedge_clip_box(frame.influence_bounds(true));
     let receivers = frame.receivers();
     let eye = frame.scene.camera.eye;
     let eye_radius = frame.near_plane_radius();
