@@ -59,7 +59,7 @@
 //! divided by the nearest value the paper's figure allows (×1.00 inside a range or an
 //! inequality). The counters, and so every number printed, are deterministic.
 //!
-//! `cargo run --release --example gpu_model_validation` (about two minutes on two cores).
+//! `cargo run --release --example gpu_model_validation` (about 20 s on two cores).
 
 use penumbra::frame::Frame;
 use penumbra::gpu::counters::Counters;
