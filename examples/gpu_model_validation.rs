@@ -70,7 +70,7 @@ use penumbra::scene::procedural::{torus, transformed, uv_sphere};
 use penumbra::scene::{builtin, Light, LightShape, Scene};
 use std::fmt::Write as _;
 
-/// The profile ids of the papers' GPUs (`src/gpu_model/profiles.toml`).
+/// Papers I's and II's GPU (the profile ids are those of `src/gpu_model/profiles.toml`).
 const GEFORCE3: &str = "geforce3";
 /// Paper III's GPU.
 const FX5800: &str = "geforce-fx-5800-ultra";
@@ -91,13 +91,17 @@ struct Time {
 }
 
 impl Time {
-    /// The modeled time of `passes` on the profile `gpu`.
-    fn of(gpu: &str, passes: &[PassStats]) -> Time {
-        let e = estimate(gpu, passes);
+    /// The frame time of an estimate.
+    fn of_estimate(e: &FrameEstimate) -> Time {
         Time {
             low: e.seconds.low,
             high: e.seconds.high,
         }
+    }
+
+    /// The modeled time of `passes` on the profile `gpu`.
+    fn of(gpu: &str, passes: &[PassStats]) -> Time {
+        Time::of_estimate(&estimate(gpu, passes))
     }
 }
 
@@ -256,11 +260,10 @@ fn run(label: &str, scene: &Scene, method: &str, opts: &[&str], gpu: &str) -> Ru
         1e3 * e.seconds.low,
         1e3 * e.seconds.high,
     );
-    let time = Time {
-        low: e.seconds.low,
-        high: e.seconds.high,
-    };
-    Run { out, time }
+    Run {
+        out,
+        time: Time::of_estimate(&e),
+    }
 }
 
 /// A built-in scene at `width` × `height`.
