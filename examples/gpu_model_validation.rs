@@ -719,6 +719,24 @@ fn forest_2006(claims: &mut Vec<Claim>) {
     });
 }
 
+/// What a claim compares without the scene it names in its last brackets.
+fn kind(claim: &str) -> &str {
+    claim.rsplit_once(" (").map_or(claim, |(k, _)| k)
+}
+
+/// `claims` with the rows of one kind (the same comparison on several scenes) together, the
+/// kinds in the order they first appear.
+fn grouped(mut claims: Vec<Claim>) -> Vec<Claim> {
+    let mut kinds: Vec<String> = Vec::new();
+    for c in &claims {
+        if !kinds.iter().any(|k| k == kind(&c.claim)) {
+            kinds.push(kind(&c.claim).to_string());
+        }
+    }
+    claims.sort_by_key(|c| kinds.iter().position(|k| k == kind(&c.claim)));
+    claims
+}
+
 /// The validation table, as `docs/gpu-model.md` holds it.
 fn table(claims: &[Claim]) -> String {
     let mut out = String::new();
@@ -760,5 +778,5 @@ fn main() {
     cgi_2004(&mut claims);
     forest_2006(&mut claims);
     println!("\n## Claims (ratios of modeled times or of counters; ratio error = model's middle ÷ the nearest value the paper allows)\n");
-    print!("{}", table(&claims));
+    print!("{}", table(&grouped(claims)));
 }
