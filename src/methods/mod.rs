@@ -273,8 +273,15 @@ pub fn selected(scene: &Scene) -> Result<Vec<String>, InputError> {
             .map(|m| m.to_string())
             .collect()),
         Some(list) => {
-            for m in list {
+            for (k, m) in list.iter().enumerate() {
                 check_method(m, scene)?;
+                if list[..k].contains(m) {
+                    return Err(InputError::at(
+                        &scene.source,
+                        "methods",
+                        format!("method {m:?} is listed twice (each method renders once)"),
+                    ));
+                }
             }
             Ok(list.clone())
         }

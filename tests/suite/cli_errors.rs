@@ -243,6 +243,12 @@ fn bad_options_and_methods() {
             &["unknown method"],
         ),
         (
+            "a method listed twice",
+            &["--methods", "hard-sv,hard-sv"],
+            scene,
+            &["method \"hard-sv\" is listed twice"],
+        ),
+        (
             "unknown option table",
             &["--methods", "hard-sv", "--opt", "bogus.x=1"],
             "--opt bogus.x=1",
