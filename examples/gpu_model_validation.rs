@@ -51,7 +51,10 @@
 //!   penumbra-wedges algorithm runs twice as fast as our algorithm. However, when we use more
 //!   polygons the penumbra-wedges performance decreases faster than our approach because the
 //!   penumbra-wedges are quickly CPU limited". The plain penumbra wedges on a rectangle light
-//!   are `ssv-optimized` (Paper IV, the implementation Forest et al. build on).
+//!   are `ssv-optimized` (Paper IV, the implementation Forest et al. build on). And their
+//!   SLI (two GPUs, alternate-frame, [`penumbra::gpu_model::sli`]): "with only 3048 polygons,
+//!   the SLI gain is already negligible" for the plain wedges, "between 80% and 100%" for
+//!   wedge blending.
 //!
 //! Output: one line per render (modeled low–high time, the heaviest pass and what bounds it),
 //! then the table of claims: the paper's figure, the model's ratio with every figure at its
@@ -105,12 +108,16 @@ impl Time {
     }
 }
 
+/// The built-in profile `gpu`.
+fn profile(gpu: &str) -> &'static gpu_model::GpuProfile {
+    gpu_model::profiles()
+        .get(gpu)
+        .unwrap_or_else(|| panic!("built-in GPU profile {gpu}"))
+}
+
 /// [`gpu_model::estimate`] on the built-in profile `gpu`.
 fn estimate(gpu: &str, passes: &[PassStats]) -> FrameEstimate {
-    let profile = gpu_model::profiles()
-        .get(gpu)
-        .unwrap_or_else(|| panic!("built-in GPU profile {gpu}"));
-    gpu_model::estimate(profile, passes)
+    gpu_model::estimate(profile(gpu), passes)
 }
 
 /// The model's ratio of two quantities: at the fast end, at the slow end, and their geometric
@@ -121,6 +128,8 @@ struct Ratio {
     low: f64,
     /// The high estimates' ratio.
     high: f64,
+    /// A ratio of counted work, not of modeled time.
+    counted: bool,
 }
 
 impl Ratio {
@@ -129,13 +138,18 @@ impl Ratio {
         Ratio {
             low: a.low / b.low,
             high: a.high / b.high,
+            counted: false,
         }
     }
 
     /// `a / b` of two counts.
     fn counts(a: u64, b: u64) -> Ratio {
         let r = a as f64 / b as f64;
-        Ratio { low: r, high: r }
+        Ratio {
+            low: r,
+            high: r,
+            counted: true,
+        }
     }
 
     /// The geometric middle of the two ends.
@@ -699,6 +713,36 @@ fn forest_2006(claims: &mut Vec<Claim>) {
         let blending = run(name, &scene, "wedge-blending", &[], G70);
         let wedges = run(name, &scene, "ssv-optimized", &[], G70);
         let gap = Ratio::times(blending.time, wedges.time);
+        // §5.2's SLI (alternate-frame, two GPUs): the one-GPU frame time over the interval.
+        let sli_gain = |r: &Run| {
+            let afr = gpu_model::sli::estimate_sli(
+                profile(G70),
+                &r.out.stats.passes,
+                gpu_model::sli::SliMode::AlternateFrame,
+                2,
+            );
+            Ratio::times(r.time, Time::of_estimate(&afr))
+        };
+        if spheres == 1 {
+            claims.push(Claim {
+                claim: format!("SLI (AFR, 2 GPUs) gain of wedge-blending, frame rate, {spheres} × 762 triangles"),
+                paper: "Forest et al. 2006 §5.2",
+                printed: "\"the SLI gain is between 80% and 100%\"".into(),
+                figure: Figure::Range(1.8, 2.0),
+                model: sli_gain(&blending),
+            });
+        }
+        if spheres == 4 {
+            claims.push(Claim {
+                claim: format!(
+                    "SLI (AFR, 2 GPUs) gain of plain wedges, frame rate, {spheres} × 762 triangles"
+                ),
+                paper: "Forest et al. 2006 §5.2",
+                printed: "\"with only 3048 polygons, the SLI gain is already negligible\"".into(),
+                figure: Figure::Below(1.1),
+                model: sli_gain(&wedges),
+            });
+        }
         claims.push(Claim {
             claim: format!("wedge-blending against plain wedges (ssv-optimized), frame time, {spheres} × 762 triangles"),
             paper,
@@ -717,6 +761,7 @@ fn forest_2006(claims: &mut Vec<Claim>) {
         model: Ratio {
             low: last.low / first.low,
             high: last.high / first.high,
+            counted: false,
         },
     });
 }
@@ -750,7 +795,7 @@ fn table(claims: &[Claim]) -> String {
     for c in claims {
         let mid = c.model.mid();
         let error = mid / c.figure.nearest(mid);
-        let model = if c.model.low == c.model.high {
+        let model = if c.model.counted {
             format!("{:.2} (counters)", c.model.low)
         } else {
             format!("{:.2} / {:.2}", c.model.low, c.model.high)

@@ -30,6 +30,7 @@
 //! DRAM), and the overlap of consecutive passes.
 
 pub mod profile;
+pub mod sli;
 
 pub use profile::{profiles, GpuModel, GpuProfile, DEFAULT_PROFILE};
 
