@@ -293,13 +293,20 @@ pub fn estimate(gpu: &GpuProfile, passes: &[PassStats]) -> FrameEstimate {
             )
         })
         .collect();
-    FrameEstimate {
-        gpu: gpu.id.clone(),
-        seconds: Seconds {
-            low: passes.iter().map(|p| p.low).sum(),
-            high: passes.iter().map(|p| p.high).sum(),
-        },
-        passes,
+    FrameEstimate::summed(gpu.id.clone(), passes)
+}
+
+impl FrameEstimate {
+    /// The frame of `passes` on the GPU named `gpu`: its seconds the sums over the passes.
+    pub fn summed(gpu: String, passes: Vec<PassEstimate>) -> Self {
+        FrameEstimate {
+            gpu,
+            seconds: Seconds {
+                low: passes.iter().map(|p| p.low).sum(),
+                high: passes.iter().map(|p| p.high).sum(),
+            },
+            passes,
+        }
     }
 }
 

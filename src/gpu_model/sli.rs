@@ -14,7 +14,7 @@
 //! Neither mode prices what the model leaves out for one GPU (the CPU, the driver, the bus),
 //! nor the inter-GPU transfer of SFR's bands or AFR's render-to-texture dependencies.
 
-use super::{estimate_pass, profiles, FrameEstimate, GpuProfile, PassEstimate, PassWork, Seconds};
+use super::{estimate_pass, profiles, FrameEstimate, GpuProfile, PassEstimate, PassWork};
 use crate::pass::PassStats;
 
 /// How `gpus` GPUs share a frame (module doc).
@@ -73,14 +73,7 @@ pub fn estimate_sli(
             }
         })
         .collect();
-    FrameEstimate {
-        gpu: format!("{} ×{k} ({mode:?})", gpu.id),
-        seconds: Seconds {
-            low: passes.iter().map(|p| p.low).sum(),
-            high: passes.iter().map(|p| p.high).sum(),
-        },
-        passes,
-    }
+    FrameEstimate::summed(format!("{} ×{k} ({mode:?})", gpu.id), passes)
 }
 
 #[cfg(test)]
