@@ -408,21 +408,8 @@ impl<'s> Frame<'s> {
     /// too: [`Scene::mesh_bounds`]' and [`Scene::bounds`]' points without the meshes that
     /// change no pixel. With no point, the first light's center.
     pub fn influence_bounds(&self, lights: bool) -> (Vec3, Vec3) {
-        let centers = self.scene.lights.iter().map(|l| &l.center);
-        let vertices = self
-            .scene
-            .meshes
-            .iter()
-            .enumerate()
-            .filter(|(k, _)| self.within_light_influence(*k))
-            .flat_map(|(_, m)| m.positions.iter());
-        let mut points: Box<dyn Iterator<Item = &Vec3>> = if lights {
-            Box::new(centers.chain(vertices))
-        } else {
-            Box::new(vertices)
-        };
-        let first = points.next().copied().unwrap_or(self.scene.light().center);
-        points.fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
+        self.scene
+            .bounds_of(lights, |k| self.within_light_influence(k))
     }
 
     /// This frame for `scene`, a scene that differs from this frame's only in its lights

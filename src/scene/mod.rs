@@ -335,30 +335,28 @@ impl Scene {
     /// occluder, the scale of their rounding errors (a light far away does not change it).
     /// A scene without meshes (refused by validation) gives the light center's point.
     pub fn mesh_bounds(&self) -> (Vec3, Vec3) {
-        let points = self.meshes.iter().flat_map(|m| m.positions.iter());
-        let first = points
-            .clone()
-            .next()
-            .copied()
-            .unwrap_or(self.light().center);
-        points.fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
+        self.bounds_of(false, |_| true)
     }
 
     /// Axis-aligned bounds (min, max) of all mesh vertices and every light center.
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        let mut lo = self.light().center;
-        let mut hi = lo;
-        for l in &self.lights {
-            lo = lo.min(l.center);
-            hi = hi.max(l.center);
-        }
-        for m in &self.meshes {
-            for p in &m.positions {
-                lo = lo.min(*p);
-                hi = hi.max(*p);
-            }
-        }
-        (lo, hi)
+        self.bounds_of(true, |_| true)
+    }
+
+    /// Axis-aligned bounds (min, max) of the vertices of the meshes `mesh` accepts (by index)
+    /// and, with `lights`, of every light center; the first light's center where there is no
+    /// point.
+    pub fn bounds_of(&self, lights: bool, mesh: impl Fn(usize) -> bool) -> (Vec3, Vec3) {
+        let centers = self.lights.iter().map(|l| &l.center).filter(|_| lights);
+        let vertices = self
+            .meshes
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| mesh(*k))
+            .flat_map(|(_, m)| m.positions.iter());
+        let mut points = centers.chain(vertices);
+        let first = points.next().copied().unwrap_or(self.light().center);
+        points.fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
     }
 }
 
