@@ -114,6 +114,11 @@ enum ExperimentCmd {
         /// Timed runs per configuration (their median, min and max are reported).
         #[arg(long, default_value_t = penumbra::experiment::accuracy_time::TIMING_RUNS)]
         runs: usize,
+        /// Also model each configuration's time on GPU profile NAME (repeatable; default the
+        /// default profile): a modeled-time column, Pareto front and plot per profile
+        /// (docs/gpu-model.md; `penumbra list --gpus` lists them).
+        #[arg(long = "gpu", value_name = "NAME")]
+        gpus: Vec<String>,
     },
     /// Issue 11: error added by each shader precision and buffer format, overflow of each
     /// buffer format over stacks of N = 1…512 quads, the papers' precision claims checked
@@ -489,7 +494,31 @@ fn experiment(cmd: ExperimentCmd) -> Result<(), Box<dyn std::error::Error>> {
             size,
             shard,
             runs,
+            gpus,
         } => {
+            let gpus = if gpus.is_empty() {
+                vec![penumbra::gpu_model::GpuModel::default()]
+            } else {
+                gpus.iter()
+                    .map(|g| {
+                        penumbra::gpu_model::GpuModel::named(g).ok_or_else(|| {
+                            InputError::at(
+                                "--gpu",
+                                g,
+                                format!(
+                                    "unknown GPU profile; one of: {}",
+                                    penumbra::gpu_model::profiles()
+                                        .gpu
+                                        .iter()
+                                        .map(|p| p.id.as_str())
+                                        .collect::<Vec<_>>()
+                                        .join(", ")
+                                ),
+                            )
+                        })
+                    })
+                    .collect::<Result<Vec<_>, _>>()?
+            };
             let shard = match shard {
                 Some(spec) => accuracy_time::Shard::parse(&spec)?,
                 None => accuracy_time::Shard::WHOLE,
@@ -513,7 +542,13 @@ fn experiment(cmd: ExperimentCmd) -> Result<(), Box<dyn std::error::Error>> {
                 }
                 loaded.push(scene);
             }
-            let sweep = accuracy_time::run(&loaded, &accuracy_time::configurations(), runs, shard)?;
+            let sweep = accuracy_time::run(
+                &loaded,
+                &accuracy_time::configurations(),
+                runs,
+                shard,
+                &gpus,
+            )?;
             accuracy_time::write(&sweep, &out)?;
             print!("{}", accuracy_time::summary(&sweep));
             print_accuracy_outputs(&sweep, &out);
@@ -560,7 +595,7 @@ fn print_accuracy_outputs(
 ) {
     use penumbra::experiment::accuracy_time::{CSV_FILE, JSON_FILE, SUMMARY_FILE};
     let plots = if sweep.shard == penumbra::experiment::accuracy_time::Shard::WHOLE {
-        ", SCENE-pareto.png, SCENE-pareto.svg"
+        ", SCENE-pareto.{png,svg}, SCENE-pareto-gpu-ID.{png,svg}"
     } else {
         " (a shard: plots come from `experiment merge`)"
     };

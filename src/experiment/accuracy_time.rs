@@ -28,6 +28,16 @@
 //! methods, is rendered once per scene and excluded. Renders are deterministic, so every
 //! column but the times is the same on every run and machine.
 //!
+//! **Modeled GPU time** (issue 29 item 4; [`crate::gpu_model`], `docs/gpu-model.md`): the
+//! untimed render's passes priced on each profile of the run's list (`--gpu NAME`,
+//! repeatable; default [`crate::gpu_model::DEFAULT_PROFILE`]) — the whole frame on that GPU,
+//! the scene pass included, since a GPU renders it too; low, middle and high estimates
+//! ([`Modeled`]). It is deterministic, so it is the same on every run and in every shard. A
+//! method with no GPU pass besides the scene pass (`raycast`, a CPU ray tracer) is not
+//! modeled: pricing only its scene pass would put it at the fast end of every front. Each
+//! profile gets its own Pareto front on (middle estimate, RMSE) and its own plot, beside the
+//! CPU-time one.
+//!
 //! **Shards.** `--shard I/N` (1-based: `1/4` … `4/4`) measures item `k` of the list when
 //! `k mod N = I − 1` — round-robin slices, so that the costly configurations (e.g. `nsample`
 //! with 1024 samples) spread over the shards. Every shard builds the whole list (a scene pass
@@ -39,13 +49,15 @@
 //! configuration), `summary.md` (the table and the Pareto-optimal configurations per scene,
 //! also printed), and per scene `SCENE-pareto.png` and `.svg`: RMSE against median time,
 //! log–log, one colour per method, one numbered marker per knob setting, the Pareto front as
-//! a step line ([`pareto_front`]).
+//! a step line ([`pareto_front`]); and per profile `SCENE-pareto-gpu-ID.png` and `.svg`: RMSE
+//! against modeled time, the low–high range of each estimate as a bar.
 
 pub mod plot;
 
 use super::configured;
 use crate::error::InputError;
 use crate::frame::Frame;
+use crate::gpu_model::{GpuModel, Seconds};
 use crate::methods;
 use crate::metrics::error_report::error_report;
 use crate::metrics::horizon::{receiver_classes, HorizonSplit};
@@ -208,6 +220,18 @@ pub struct Reference {
     pub noise_floor: ErrorStats,
 }
 
+/// The modeled time of one item on one GPU profile (module doc).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Modeled {
+    /// The profile's id.
+    pub gpu: String,
+    /// The whole frame's modeled seconds; `None` for a method with no GPU pass besides the
+    /// scene pass.
+    pub seconds: Option<Seconds>,
+    /// Whether it is on its scene's Pareto front of (middle estimate, RMSE) on this profile.
+    pub pareto: bool,
+}
+
 /// The measurement of one item.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Row {
@@ -233,6 +257,9 @@ pub struct Row {
     /// Whether it is on its scene's Pareto front of (median time, RMSE) ([`pareto_front`];
     /// depends on the times).
     pub pareto: bool,
+    /// Its modeled time on each profile of [`Sweep::gpus`], in that order.
+    #[serde(default)]
+    pub modeled: Vec<Modeled>,
 }
 
 /// What a run (or a merge) produced; `accuracy-time.json` holds it.
@@ -242,6 +269,9 @@ pub struct Sweep {
     pub shard: Shard,
     /// The reference configuration, `method knobs`.
     pub reference: String,
+    /// The GPU profiles every row's time is modeled on ([`Modeled`]).
+    #[serde(default)]
+    pub gpus: Vec<String>,
     /// The whole (scene × configuration) list, whatever the shard.
     pub items: Vec<Item>,
     /// Configurations the methods refused, per scene.
@@ -292,23 +322,85 @@ pub fn pareto_front(points: &[(f64, f64)]) -> Vec<usize> {
     front
 }
 
-/// Sets [`Row::pareto`] of every row, per scene, on (median time, RMSE).
-fn mark_pareto(rows: &mut [Row]) {
-    let mut scenes: Vec<String> = rows.iter().map(|r| r.item.scene.clone()).collect();
-    scenes.dedup();
-    for scene in scenes {
-        let idx: Vec<usize> = (0..rows.len())
-            .filter(|&i| rows[i].item.scene == scene)
-            .collect();
-        let points: Vec<(f64, f64)> = idx
-            .iter()
-            .map(|&i| (rows[i].median_seconds, rows[i].error.rmse))
-            .collect();
-        let front = pareto_front(&points);
-        for (j, &i) in idx.iter().enumerate() {
-            rows[i].pareto = front.contains(&j);
+/// A time axis of the sweep: the measured CPU time, or the modeled time on the `k`-th profile
+/// of [`Sweep::gpus`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TimeAxis {
+    /// Median wall seconds of the timed renders.
+    Cpu,
+    /// The middle modeled estimate on profile `k`.
+    Gpu(usize),
+}
+
+impl TimeAxis {
+    /// The time of `row` on this axis (NaN for a row not modeled, which is never on a front).
+    pub fn seconds(self, row: &Row) -> f64 {
+        match self {
+            TimeAxis::Cpu => row.median_seconds,
+            TimeAxis::Gpu(k) => row
+                .modeled
+                .get(k)
+                .and_then(|m| m.seconds)
+                .map_or(f64::NAN, |s| s.mid),
         }
     }
+
+    /// Whether `row` is on its scene's front on this axis.
+    pub fn pareto(self, row: &Row) -> bool {
+        match self {
+            TimeAxis::Cpu => row.pareto,
+            TimeAxis::Gpu(k) => row.modeled.get(k).is_some_and(|m| m.pareto),
+        }
+    }
+
+    fn set_pareto(self, row: &mut Row, on: bool) {
+        match self {
+            TimeAxis::Cpu => row.pareto = on,
+            TimeAxis::Gpu(k) => {
+                if let Some(m) = row.modeled.get_mut(k) {
+                    m.pareto = on;
+                }
+            }
+        }
+    }
+
+    /// Every axis of `sweep`: CPU time, then each profile.
+    pub fn all(sweep: &Sweep) -> Vec<TimeAxis> {
+        std::iter::once(TimeAxis::Cpu)
+            .chain((0..sweep.gpus.len()).map(TimeAxis::Gpu))
+            .collect()
+    }
+}
+
+/// Sets the Pareto flags of every row, per scene, on (time, RMSE) for each of the `gpus + 1`
+/// time axes.
+fn mark_pareto(rows: &mut [Row], gpus: usize) {
+    let mut scenes: Vec<String> = rows.iter().map(|r| r.item.scene.clone()).collect();
+    scenes.dedup();
+    let axes = std::iter::once(TimeAxis::Cpu).chain((0..gpus).map(TimeAxis::Gpu));
+    for axis in axes {
+        for scene in &scenes {
+            let idx: Vec<usize> = (0..rows.len())
+                .filter(|&i| &rows[i].item.scene == scene)
+                .collect();
+            let points: Vec<(f64, f64)> = idx
+                .iter()
+                .map(|&i| (axis.seconds(&rows[i]), rows[i].error.rmse))
+                .collect();
+            let front = pareto_front(&points);
+            for (j, &i) in idx.iter().enumerate() {
+                axis.set_pareto(&mut rows[i], front.contains(&j));
+            }
+        }
+    }
+}
+
+/// The modeled time of a method's output on `gpu`: `None` when no pass besides the first (the
+/// frame's scene pass) has GPU work.
+fn modeled_seconds(gpu: GpuModel, out: &methods::output::MethodOutput) -> Option<Seconds> {
+    let e = crate::gpu_model::estimate(gpu.profile(), &out.stats.passes);
+    let on_gpu = e.passes.iter().skip(1).any(|p| p.high > 0.0);
+    on_gpu.then_some(e.seconds)
 }
 
 /// Median, min and max of `samples` (at least one; the median of an even count is the upper
@@ -323,14 +415,25 @@ fn spread(mut samples: Vec<f64>) -> (f64, f64, f64) {
 }
 
 /// Measures the `shard` of the list of `scenes` × `configurations` (module doc) with `runs`
-/// timed renders per item (at least 1). Scenes are rendered at their own size; their plot
-/// names ([`plot_stem`]) must differ.
+/// timed renders per item (at least 1), each item's time also modeled on every profile of
+/// `gpus` (distinct). Scenes are rendered at their own size; their plot names
+/// ([`plot_stem`]) must differ.
 pub fn run(
     scenes: &[Scene],
     configurations: &[Configuration],
     runs: usize,
     shard: Shard,
+    gpus: &[GpuModel],
 ) -> Result<Sweep, InputError> {
+    for (i, g) in gpus.iter().enumerate() {
+        if gpus[..i].contains(g) {
+            return Err(InputError::at(
+                "--gpu",
+                &g.profile().id,
+                "given twice: each profile is modeled once",
+            ));
+        }
+    }
     if runs == 0 {
         return Err(InputError::at(
             "--runs",
@@ -421,6 +524,7 @@ pub fn run(
         .map(|f| receiver_classes(&f.scene.lights, f.receivers()))
         .collect();
     let mut errors = Vec::new();
+    let mut modeled = Vec::new();
     for (j, &k) in mine.iter().enumerate() {
         let (si, method, _) = &item_scenes[k];
         let out = methods::run(method, &item_frames[j])?;
@@ -431,6 +535,15 @@ pub fn run(
             REFERENCE.0,
             &classes[*si],
         ));
+        modeled.push(
+            gpus.iter()
+                .map(|&g| Modeled {
+                    gpu: g.profile().id.clone(),
+                    seconds: modeled_seconds(g, &out),
+                    pareto: false,
+                })
+                .collect::<Vec<_>>(),
+        );
     }
     // The timed renders, interleaved.
     let mut times: Vec<Vec<f64>> = vec![Vec::with_capacity(runs); mine.len()];
@@ -445,7 +558,8 @@ pub fn run(
         .iter()
         .zip(errors)
         .zip(times)
-        .map(|((&k, e), t)| {
+        .zip(modeled)
+        .map(|(((&k, e), t), modeled)| {
             let (median_seconds, min_seconds, max_seconds) = spread(t);
             Row {
                 index: k,
@@ -458,13 +572,15 @@ pub fn run(
                 penumbra: e.penumbra_only,
                 horizon: e.horizon_split,
                 pareto: false,
+                modeled,
             }
         })
         .collect();
-    mark_pareto(&mut rows);
+    mark_pareto(&mut rows, gpus.len());
     Ok(Sweep {
         shard,
         reference: format!("{} {}", REFERENCE.0, knobs_label(REFERENCE.1)),
+        gpus: gpus.iter().map(|g| g.profile().id.clone()).collect(),
         items,
         skipped,
         references,
@@ -493,12 +609,16 @@ pub fn merge(shards: &[(String, Sweep)]) -> Result<Sweep, InputError> {
     let count = first.shard.count;
     let mut seen: Vec<Option<&str>> = vec![None; count];
     for (name, s) in shards {
-        if s.items != first.items || s.skipped != first.skipped || s.reference != first.reference {
+        if s.items != first.items
+            || s.skipped != first.skipped
+            || s.reference != first.reference
+            || s.gpus != first.gpus
+        {
             return Err(InputError::new(
                 name,
                 format!(
                     "not a slice of the same sweep as {first_name}: the (scene × configuration) \
-                     list differs"
+                     list or the GPU profiles differ"
                 ),
             ));
         }
@@ -543,7 +663,7 @@ pub fn merge(shards: &[(String, Sweep)]) -> Result<Sweep, InputError> {
         .flat_map(|(_, s)| s.rows.iter().cloned())
         .collect();
     rows.sort_by_key(|r| r.index);
-    mark_pareto(&mut rows);
+    mark_pareto(&mut rows, first.gpus.len());
     let mut references: Vec<Reference> = Vec::new();
     for item in &first.items {
         if references.iter().any(|r| r.scene == item.scene) {
@@ -566,6 +686,7 @@ pub fn merge(shards: &[(String, Sweep)]) -> Result<Sweep, InputError> {
     Ok(Sweep {
         shard: Shard::WHOLE,
         reference: first.reference.clone(),
+        gpus: first.gpus.clone(),
         items: first.items.clone(),
         skipped: first.skipped.clone(),
         references,
@@ -582,17 +703,28 @@ fn csv_field(s: &str) -> String {
     }
 }
 
-/// The header of `accuracy-time.csv`.
+/// The header of `accuracy-time.csv` up to its modeled-time columns ([`csv_header`]).
 pub const CSV_HEADER: &str = "scene,width,height,method,knobs,median_seconds,min_seconds,\
 max_seconds,runs,rmse,mean_abs,max_abs,pct_over_1_255,pct_over_4_255,pixels,penumbra_rmse,\
 penumbra_mean_abs,penumbra_max_abs,penumbra_pct_over_1_255,penumbra_pct_over_4_255,\
 penumbra_pixels,whole_light_mean_abs,whole_light_pixels,horizon_mean_abs,horizon_pixels,\
 horizon_pct,horizon_share,pareto";
 
-/// `accuracy-time.csv`: [`CSV_HEADER`], then one line per row (floats written exactly, as
+/// The header of `accuracy-time.csv` for the profiles `gpus`: [`CSV_HEADER`], then per
+/// profile `gpu_ID_low`, `gpu_ID_mid`, `gpu_ID_high` (modeled seconds, empty for a row not
+/// modeled) and `gpu_ID_pareto`.
+pub fn csv_header(gpus: &[String]) -> String {
+    let mut h = CSV_HEADER.to_string();
+    for g in gpus {
+        let _ = write!(h, ",gpu_{g}_low,gpu_{g}_mid,gpu_{g}_high,gpu_{g}_pareto");
+    }
+    h
+}
+
+/// `accuracy-time.csv`: [`csv_header`], then one line per row (floats written exactly, as
 /// Rust's shortest round-trip form).
 pub fn csv(sweep: &Sweep) -> String {
-    let mut s = format!("{CSV_HEADER}\n");
+    let mut s = format!("{}\n", csv_header(&sweep.gpus));
     for r in &sweep.rows {
         let e = |st: &ErrorStats| {
             format!(
@@ -600,7 +732,7 @@ pub fn csv(sweep: &Sweep) -> String {
                 st.rmse, st.mean_abs, st.max_abs, st.pct_over_1_255, st.pct_over_4_255, st.pixels
             )
         };
-        let _ = writeln!(
+        let _ = write!(
             s,
             "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             csv_field(&r.item.scene),
@@ -622,6 +754,13 @@ pub fn csv(sweep: &Sweep) -> String {
             r.horizon.horizon_share,
             r.pareto
         );
+        for m in &r.modeled {
+            let _ = match m.seconds {
+                Some(t) => write!(s, ",{},{},{},{}", t.low, t.mid, t.high, m.pareto),
+                None => write!(s, ",,,,{}", m.pareto),
+            };
+        }
+        s.push('\n');
     }
     s
 }
@@ -637,25 +776,50 @@ fn row_scenes(sweep: &Sweep) -> Vec<&str> {
     scenes
 }
 
-/// The Pareto-optimal rows of `scene`, fastest first, each with its number in the scene's
-/// table (1-based, the number of its marker in the plot).
-pub fn pareto_rows<'a>(sweep: &'a Sweep, scene: &str) -> Vec<(usize, &'a Row)> {
+/// The Pareto-optimal rows of `scene` on `axis`, fastest first, each with its number in the
+/// scene's table (1-based, the number of its marker in the plot).
+pub fn pareto_rows<'a>(sweep: &'a Sweep, scene: &str, axis: TimeAxis) -> Vec<(usize, &'a Row)> {
     let mut front: Vec<(usize, &Row)> = sweep
         .rows
         .iter()
         .filter(|r| r.item.scene == scene)
         .enumerate()
-        .filter(|(_, r)| r.pareto)
+        .filter(|(_, r)| axis.pareto(r))
         .map(|(n, r)| (n + 1, r))
         .collect();
-    front.sort_by(|a, b| a.1.median_seconds.total_cmp(&b.1.median_seconds));
+    front.sort_by(|a, b| axis.seconds(a.1).total_cmp(&axis.seconds(b.1)));
     front
 }
 
-/// The file names of `scene`'s Pareto plot, PNG and SVG ([`plot_stem`]).
-pub fn plot_files(scene: &str) -> [String; 2] {
-    let stem = plot_stem(scene);
-    [format!("{stem}-pareto.png"), format!("{stem}-pareto.svg")]
+/// The file names of `scene`'s Pareto plot on `axis`, PNG and SVG ([`plot_stem`]):
+/// `STEM-pareto` for CPU time, `STEM-pareto-gpu-ID` for a profile's modeled time.
+pub fn plot_files(sweep: &Sweep, scene: &str, axis: TimeAxis) -> [String; 2] {
+    let stem = match axis {
+        TimeAxis::Cpu => format!("{}-pareto", plot_stem(scene)),
+        TimeAxis::Gpu(k) => format!("{}-pareto-gpu-{}", plot_stem(scene), sweep.gpus[k]),
+    };
+    [format!("{stem}.png"), format!("{stem}.svg")]
+}
+
+/// How `axis` is named in tables and plots.
+pub fn axis_label(sweep: &Sweep, axis: TimeAxis) -> String {
+    match axis {
+        TimeAxis::Cpu => "CPU time (measured)".into(),
+        TimeAxis::Gpu(k) => format!("modeled time on {} (a model)", sweep.gpus[k]),
+    }
+}
+
+/// A row's modeled time on profile `k` for a table: `mid (low–high)` in ms, or `—`.
+fn modeled_ms(row: &Row, k: usize) -> String {
+    match row.modeled.get(k).and_then(|m| m.seconds) {
+        Some(t) => format!(
+            "{} ({}–{})",
+            fmt_g(1e3 * t.mid),
+            fmt_g(1e3 * t.low),
+            fmt_g(1e3 * t.high)
+        ),
+        None => "—".into(),
+    }
 }
 
 /// The table and the Pareto-optimal configurations of every scene (what the command prints
@@ -687,18 +851,37 @@ pub fn summary(sweep: &Sweep) -> String {
                 r.noise_floor.pct_over_1_255
             );
         }
+        let gpu_heads: String = sweep
+            .gpus
+            .iter()
+            .map(|g| format!(" {g} model [ms] | Pareto |"))
+            .collect();
         let _ = writeln!(
             s,
             "| # | method | knobs | median [ms] | min–max [ms] | RMSE | max \\|e\\| | % > 1/255 | \
              penumbra RMSE | whole-light mean \\|e\\| | horizon mean \\|e\\| | horizon share | \
-             Pareto |"
+             Pareto |{gpu_heads}"
         );
-        let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+        let _ = writeln!(
+            s,
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|{}",
+            "---|---|".repeat(sweep.gpus.len())
+        );
         for (n, r) in rows.iter().enumerate() {
+            let gpu_cells: String = (0..sweep.gpus.len())
+                .map(|k| {
+                    let star = if TimeAxis::Gpu(k).pareto(r) {
+                        "★"
+                    } else {
+                        ""
+                    };
+                    format!(" {} | {star} |", modeled_ms(r, k))
+                })
+                .collect();
             let _ = writeln!(
                 s,
                 "| {} | {} | {} | {} | {}–{} | {:.5} | {:.4} | {:.2} | {:.5} | {:.5} | {:.5} | {:.3} \
-                 | {} |",
+                 | {} |{gpu_cells}",
                 n + 1,
                 r.item.method,
                 r.item.knobs,
@@ -715,16 +898,30 @@ pub fn summary(sweep: &Sweep) -> String {
                 if r.pareto { "★" } else { "" }
             );
         }
-        let _ = writeln!(s, "\nPareto-optimal on {scene}, fastest first:");
-        for (n, r) in pareto_rows(sweep, scene) {
+        for axis in TimeAxis::all(sweep) {
             let _ = writeln!(
                 s,
-                "- #{} {} {}: {} ms, RMSE {:.5}",
-                n,
-                r.item.method,
-                r.item.knobs,
-                fmt_g(1e3 * r.median_seconds),
-                r.error.rmse
+                "\nPareto-optimal on {scene} in {}, fastest first:",
+                axis_label(sweep, axis)
+            );
+            for (n, r) in pareto_rows(sweep, scene, axis) {
+                let _ = writeln!(
+                    s,
+                    "- #{} {} {}: {} ms, RMSE {:.5}",
+                    n,
+                    r.item.method,
+                    r.item.knobs,
+                    fmt_g(1e3 * axis.seconds(r)),
+                    r.error.rmse
+                );
+            }
+        }
+        if !sweep.gpus.is_empty() {
+            let _ = writeln!(
+                s,
+                "\nModeled times are the whole frame (scene pass included) priced by the GPU \
+                 cost model (docs/gpu-model.md), middle estimate (low–high); — = a CPU-only \
+                 method the model does not price."
             );
         }
     }
@@ -754,7 +951,7 @@ pub fn fmt_g(x: f64) -> String {
 }
 
 /// Writes `sweep`'s outputs into `out` (module doc): the CSV, the JSON and `summary.md`, and
-/// for a whole sweep ([`Shard::WHOLE`]) the Pareto plots of every scene — all or nothing
+/// for a whole sweep ([`Shard::WHOLE`]) the Pareto plots of every scene and time axis — all or nothing
 /// ([`crate::output::write_files_all_or_nothing`]).
 pub fn write(sweep: &Sweep, out: &Path) -> std::io::Result<()> {
     let json = serde_json::to_string_pretty(sweep).map_err(std::io::Error::other)?;
@@ -765,10 +962,13 @@ pub fn write(sweep: &Sweep, out: &Path) -> std::io::Result<()> {
     ];
     if sweep.shard == Shard::WHOLE {
         for scene in row_scenes(sweep) {
-            let (png, svg) = plot::pareto_plot(sweep, scene).map_err(std::io::Error::other)?;
-            let [png_file, svg_file] = plot_files(scene);
-            files.push((png_file, png));
-            files.push((svg_file, svg.into_bytes()));
+            for axis in TimeAxis::all(sweep) {
+                let (png, svg) =
+                    plot::pareto_plot(sweep, scene, axis).map_err(std::io::Error::other)?;
+                let [png_file, svg_file] = plot_files(sweep, scene, axis);
+                files.push((png_file, png));
+                files.push((svg_file, svg.into_bytes()));
+            }
         }
     }
     crate::output::write_files_all_or_nothing(out, &files)

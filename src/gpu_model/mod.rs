@@ -185,10 +185,13 @@ fn seconds(g: &GpuProfile, a: &Assumptions, w: &PassWork, end: End) -> f64 {
 }
 
 /// A low and a high estimate, seconds.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Seconds {
     /// Every figure at its fast end.
     pub low: f64,
+    /// Every figure at the geometric middle of its range: the point estimate the modeled
+    /// accuracy–time Pareto fronts use.
+    pub mid: f64,
     /// Every figure at its slow end.
     pub high: f64,
 }
@@ -200,6 +203,8 @@ pub struct PassEstimate {
     pub name: String,
     /// Every figure at its fast end, seconds.
     pub low: f64,
+    /// Every figure at the geometric middle of its range, seconds.
+    pub mid: f64,
     /// Every figure at its slow end, seconds.
     pub high: f64,
     /// The term that bounds it with every figure at the middle of its range.
@@ -258,6 +263,7 @@ pub fn estimate_pass(g: &GpuProfile, a: &Assumptions, name: &str, w: &PassWork) 
         return PassEstimate {
             name: name.into(),
             low: 0.0,
+            mid: 0.0,
             high: 0.0,
             bound: Term::Cpu,
             program: None,
@@ -270,6 +276,7 @@ pub fn estimate_pass(g: &GpuProfile, a: &Assumptions, name: &str, w: &PassWork) 
     PassEstimate {
         name: name.into(),
         low: seconds(g, a, w, End::Fast),
+        mid: seconds(g, a, w, End::Middle),
         high: seconds(g, a, w, End::Slow),
         bound: TERMS[k],
         program: None,
@@ -303,6 +310,7 @@ impl FrameEstimate {
             gpu,
             seconds: Seconds {
                 low: passes.iter().map(|p| p.low).sum(),
+                mid: passes.iter().map(|p| p.mid).sum(),
                 high: passes.iter().map(|p| p.high).sum(),
             },
             passes,
@@ -366,11 +374,19 @@ mod tests {
                     let mut w = base;
                     bump(&mut w);
                     let e = estimate_pass(g, a(), "p", &w);
-                    assert!(e.low >= e0.low && e.high >= e0.high, "{}: {what}", g.id);
+                    assert!(
+                        e.low >= e0.low && e.mid >= e0.mid && e.high >= e0.high,
+                        "{}: {what}",
+                        g.id
+                    );
                 }
             }
             let e = estimate_pass(g, a(), "p", &work());
-            assert!(0.0 < e.low && e.low <= e.high, "{}: {e:?}", g.id);
+            assert!(
+                0.0 < e.low && e.low <= e.mid && e.mid <= e.high,
+                "{}: {e:?}",
+                g.id
+            );
         }
     }
 

@@ -66,6 +66,7 @@ pub fn estimate_sli(
             match mode {
                 SliMode::AlternateFrame => PassEstimate {
                     low: e.low / k as f64,
+                    mid: e.mid / k as f64,
                     high: e.high / k as f64,
                     ..e
                 },

@@ -9,7 +9,9 @@
 //! precision plots once at the end.
 
 use super::html::{url, Html};
-use crate::experiment::accuracy_time::{self, fmt_g, pareto_rows, plot_files, Sweep};
+use crate::experiment::accuracy_time::{
+    self, axis_label, fmt_g, pareto_rows, plot_files, Sweep, TimeAxis,
+};
 use crate::experiment::{precision, tile_size};
 use std::path::{Path, PathBuf};
 
@@ -69,13 +71,13 @@ impl Found {
     }
 
     /// The accuracy–time part of the section of scene `source` (the scene's name as the
-    /// sweep records it), if the sweep measured that scene: the Pareto plot (PNG, linking to
-    /// the SVG) and the Pareto-optimal configurations, fastest first.
+    /// sweep records it), if the sweep measured that scene: per time axis (CPU time, then each
+    /// GPU profile's modeled time) the Pareto plot (PNG, linking to the SVG) and the
+    /// Pareto-optimal configurations, fastest first.
     pub fn accuracy_time(&self, h: &mut Html, source: &str) {
         let Some((rel, sweep)) = &self.accuracy else {
             return;
         };
-        let front = pareto_rows(sweep, source);
         let Some(first) = sweep.rows.iter().find(|r| r.item.scene == source) else {
             return;
         };
@@ -99,38 +101,43 @@ impl Found {
             h.element("a", &[("href", &url(&summary))], "Its full table.");
         }
         h.close();
-        let [png, svg] = plot_files(source).map(|f| rel.join(f));
-        let exists = |p: &PathBuf| self.root.join(p).is_file();
-        let shown = [&png, &svg].into_iter().find(|p| exists(p));
-        let linked = [&svg, &png].into_iter().find(|p| exists(p));
-        if let (Some(shown), Some(linked)) = (shown, linked) {
-            h.open("div", &[("class", "pareto")]);
-            h.open("a", &[("href", &url(linked))]);
-            let alt = format!("RMSE against time on {source}, log–log, with the Pareto front");
-            h.void("img", &[("src", &url(shown)), ("alt", &alt)]);
-            h.close().close();
-        }
-        h.element(
-            "p",
-            &[],
-            "Pareto-optimal (no other configuration is both at least as fast and at least as \
-             accurate), fastest first, numbered as in the plot:",
-        );
-        h.open("ol", &[("class", "front")]);
-        for (n, r) in front {
+        for axis in TimeAxis::all(sweep) {
+            let label = axis_label(sweep, axis);
+            h.element("h4", &[], &format!("Against {label}"));
+            let [png, svg] = plot_files(sweep, source, axis).map(|f| rel.join(f));
+            let exists = |p: &PathBuf| self.root.join(p).is_file();
+            let shown = [&png, &svg].into_iter().find(|p| exists(p));
+            let linked = [&svg, &png].into_iter().find(|p| exists(p));
+            if let (Some(shown), Some(linked)) = (shown, linked) {
+                h.open("div", &[("class", "pareto")]);
+                h.open("a", &[("href", &url(linked))]);
+                let alt =
+                    format!("RMSE against {label} on {source}, log–log, with the Pareto front");
+                h.void("img", &[("src", &url(shown)), ("alt", &alt)]);
+                h.close().close();
+            }
             h.element(
-                "li",
+                "p",
                 &[],
-                &format!(
-                    "#{n} {} {}: {} ms, RMSE {:.5}",
-                    r.item.method,
-                    r.item.knobs,
-                    fmt_g(1e3 * r.median_seconds),
-                    r.error.rmse
-                ),
+                "Pareto-optimal (no other configuration is both at least as fast and at least \
+                 as accurate), fastest first, numbered as in the plot:",
             );
+            h.open("ol", &[("class", "front")]);
+            for (n, r) in pareto_rows(sweep, source, axis) {
+                h.element(
+                    "li",
+                    &[],
+                    &format!(
+                        "#{n} {} {}: {} ms, RMSE {:.5}",
+                        r.item.method,
+                        r.item.knobs,
+                        fmt_g(1e3 * axis.seconds(r)),
+                        r.error.rmse
+                    ),
+                );
+            }
+            h.close();
         }
-        h.close();
     }
 
     /// The tile-size section, if its results were found.

@@ -7,6 +7,7 @@
 use penumbra::experiment::accuracy_time::{self, merge, pareto_front, Configuration, Shard, Sweep};
 use penumbra::experiment::{configured, sized};
 use penumbra::frame::Frame;
+use penumbra::gpu_model::GpuModel;
 use penumbra::scene::{builtin, Scene};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -51,9 +52,11 @@ fn without_times(mut sweep: Sweep) -> Sweep {
     sweep
 }
 
-/// The CSV without its timing columns (median, min, max seconds) and the Pareto flag.
+/// The CSV without its timing columns (median, min, max seconds) and the Pareto flag (the
+/// modeled times and their fronts stay: they depend on no clock).
 fn csv_without_times(csv: &str) -> Vec<String> {
-    let header: Vec<&str> = accuracy_time::CSV_HEADER.split(',').collect();
+    let first = csv.lines().next().unwrap_or_default().to_string();
+    let header: Vec<&str> = first.split(',').collect();
     let timing = |name: &str| name.ends_with("_seconds") || name == "pareto";
     csv.lines()
         .map(|line| {
@@ -70,7 +73,7 @@ fn csv_without_times(csv: &str) -> Vec<String> {
 #[test]
 fn four_shards_merged_equal_the_unsharded_sweep() {
     let scenes = [scene("single-quad", 32), scene("cylinder", 32)];
-    let whole = accuracy_time::run(&scenes, TINY, 1, Shard::WHOLE).unwrap();
+    let whole = accuracy_time::run(&scenes, TINY, 1, Shard::WHOLE, &[GpuModel::default()]).unwrap();
     // The list: rect-light methods on single-quad, sphere-light ones on cylinder, the light
     // split refused on the sphere.
     let on = |s: &str| whole.items.iter().filter(|i| i.scene == s).count();
@@ -89,7 +92,7 @@ fn four_shards_merged_equal_the_unsharded_sweep() {
     let mut shards = Vec::new();
     for i in 1..=4 {
         let shard = Shard { index: i, count: 4 };
-        let part = accuracy_time::run(&scenes, TINY, 1, shard).unwrap();
+        let part = accuracy_time::run(&scenes, TINY, 1, shard, &[GpuModel::default()]).unwrap();
         assert!(part.rows.iter().all(|r| shard.holds(r.index)));
         let dir = fresh_dir(&format!("shard{i}"));
         accuracy_time::write(&part, &dir).unwrap();
@@ -104,6 +107,31 @@ fn four_shards_merged_equal_the_unsharded_sweep() {
     let merged = merge(&shards).unwrap();
     assert_eq!(without_times(merged.clone()), without_times(whole.clone()));
 
+    // Modeled times: every row on the default profile; only the CPU ray tracer is not
+    // modeled, and the profile's front holds only modeled rows.
+    assert_eq!(
+        whole.gpus,
+        vec![penumbra::gpu_model::DEFAULT_PROFILE.to_string()]
+    );
+    for r in &whole.rows {
+        assert_eq!(r.modeled.len(), 1);
+        match r.modeled[0].seconds {
+            None => assert_eq!(r.item.method, "raycast", "{r:?}"),
+            Some(t) => {
+                assert_ne!(r.item.method, "raycast");
+                assert!(0.0 < t.low && t.low <= t.mid && t.mid <= t.high, "{r:?}");
+            }
+        }
+        assert!(!r.modeled[0].pareto || r.modeled[0].seconds.is_some());
+    }
+    for s in ["single-quad", "cylinder"] {
+        let axis = accuracy_time::TimeAxis::Gpu(0);
+        assert!(
+            !accuracy_time::pareto_rows(&whole, s, axis).is_empty(),
+            "{s}"
+        );
+    }
+
     // The written outputs agree too, but for the timing columns; plots for both scenes.
     let (a, b) = (fresh_dir("whole"), fresh_dir("merged"));
     accuracy_time::write(&whole, &a).unwrap();
@@ -117,6 +145,10 @@ fn four_shards_merged_equal_the_unsharded_sweep() {
             assert_eq!(&png[1..4], b"PNG");
             let svg = std::fs::read_to_string(dir.join(format!("{stem}-pareto.svg"))).unwrap();
             assert!(svg.starts_with("<svg") && svg.contains("Pareto front"));
+            let gpu = penumbra::gpu_model::DEFAULT_PROFILE;
+            let svg = dir.join(format!("{stem}-pareto-gpu-{gpu}.svg"));
+            let svg = std::fs::read_to_string(svg).unwrap();
+            assert!(svg.contains("modeled GPU time") && svg.contains("not modeled"));
         }
     }
 
@@ -127,7 +159,11 @@ fn four_shards_merged_equal_the_unsharded_sweep() {
     assert!(err(&shards[..3]).contains("shards missing: 4/4"));
     let mut other = shards.clone();
     other[2].1.items.pop();
-    assert!(err(&other).contains("list differs"), "{}", err(&other));
+    assert!(
+        err(&other).contains("GPU profiles differ"),
+        "{}",
+        err(&other)
+    );
 }
 
 #[test]
@@ -164,7 +200,7 @@ fn the_reference_differs_from_itself_only_by_its_seed() {
         accuracy_time::REFERENCE,
         ("raycast", &[("samples", "1024"), ("seed", "1")]),
     ];
-    let sweep = accuracy_time::run(&scenes, cfg, 1, Shard::WHOLE).unwrap();
+    let sweep = accuracy_time::run(&scenes, cfg, 1, Shard::WHOLE, &[GpuModel::default()]).unwrap();
     let row = &sweep.rows[0];
     assert_eq!(
         (row.item.method.as_str(), row.item.knobs.as_str()),
@@ -199,7 +235,7 @@ fn nsample_converges_on_single_quad() {
         ("nsample", &[("n", "64")]),
         ("nsample", &[("n", "256")]),
     ];
-    let sweep = accuracy_time::run(&scenes, cfg, 1, Shard::WHOLE).unwrap();
+    let sweep = accuracy_time::run(&scenes, cfg, 1, Shard::WHOLE, &[GpuModel::default()]).unwrap();
     let mut previous: Option<f64> = None;
     for (row, n) in sweep.rows.iter().zip([4.0f64, 16.0, 64.0, 256.0]) {
         let k = n.sqrt();
@@ -319,11 +355,47 @@ fn bad_shard_specs_and_merges_exit_2() {
         ]);
         assert_exit_2(&output, &["--shard", spec, "1 ≤ I ≤ N"], &out);
     }
+    // GPU profiles: an unknown one, one given twice.
+    for (gpus, words) in [
+        (
+            &["voodoo2"][..],
+            &["--gpu", "voodoo2", "unknown GPU profile", "radeon-9700-pro"][..],
+        ),
+        (
+            &["geforce3", "geforce3"][..],
+            &["--gpu", "geforce3", "given twice"][..],
+        ),
+    ] {
+        let out = fresh_dir("cli-bad-gpu");
+        let o = out.to_str().unwrap();
+        let mut args = vec![
+            "experiment",
+            "accuracy-time",
+            "single-quad",
+            "--size",
+            "16",
+            "--runs",
+            "1",
+            "--out",
+            o,
+        ];
+        for g in gpus {
+            args.extend(["--gpu", g]);
+        }
+        assert_exit_2(&penumbra(&args), words, &out);
+    }
     // Merging: a shard given twice; a directory without results.
     let scenes = [scene("single-quad", 16)];
     let cfg: &[Configuration] = &[("hard-sv", &[]), ("ssv", &[])];
     let dir = fresh_dir("cli-shard");
-    let part = accuracy_time::run(&scenes, cfg, 1, Shard { index: 1, count: 2 }).unwrap();
+    let part = accuracy_time::run(
+        &scenes,
+        cfg,
+        1,
+        Shard { index: 1, count: 2 },
+        &[GpuModel::default()],
+    )
+    .unwrap();
     accuracy_time::write(&part, &dir).unwrap();
     let d = dir.to_str().unwrap();
     let out = fresh_dir("cli-merge");

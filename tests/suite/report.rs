@@ -129,7 +129,14 @@ fn a_report_of_two_scenes_links_existing_files_and_shows_every_method() {
         sized(builtin::load("single-quad").unwrap(), 32),
         sized(file::resolve(weird_arg).unwrap(), 32),
     ];
-    let sweep = accuracy_time::run(&scenes, TINY, 1, Shard::WHOLE).unwrap();
+    let sweep = accuracy_time::run(
+        &scenes,
+        TINY,
+        1,
+        Shard::WHOLE,
+        &[penumbra::gpu_model::GpuModel::default()],
+    )
+    .unwrap();
     accuracy_time::write(&sweep, &out.join("experiment/accuracy-time")).unwrap();
     let pw = sized(builtin::load("pw-2002").unwrap(), 32);
     let summary = tile_size::run(&pw, &out.join("experiment")).unwrap();
@@ -209,13 +216,19 @@ fn a_report_of_two_scenes_links_existing_files_and_shows_every_method() {
     assert!(srcs.contains(&"single-quad/ssv/error.png"), "{srcs:?}");
     assert!(hrefs.contains(&"single-quad/hard-sv/stencil.png"));
     assert!(hrefs.contains(&"single-quad/hard-sv/stats.json"));
-    // The accuracy–time results of both scenes, the tile-size plot once.
+    // The accuracy–time results of both scenes, on CPU time and modeled GPU time; the
+    // tile-size plot once.
     let fronts = doc
         .descendants()
         .filter(|n| n.has_tag_name("ol") && has_class(n, "front"))
         .count();
-    assert_eq!(fronts, 2);
+    assert_eq!(fronts, 4);
     assert!(srcs.contains(&"experiment/accuracy-time/single-quad-pareto.png"));
+    let gpu_plot = format!(
+        "experiment/accuracy-time/single-quad-pareto-gpu-{}.png",
+        penumbra::gpu_model::DEFAULT_PROFILE
+    );
+    assert!(srcs.contains(&gpu_plot.as_str()), "{srcs:?}");
     assert!(srcs.contains(&"experiment/tile_size.svg"));
     // The frame plans, collapsed.
     assert_eq!(

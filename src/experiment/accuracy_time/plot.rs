@@ -1,14 +1,17 @@
-//! The Pareto plot of one scene ([`pareto_plot`]): RMSE against median time per frame, both
-//! axes logarithmic. Each method has one colour ([`method_colour`]), each knob setting of a
+//! The Pareto plot of one scene on one time axis ([`pareto_plot`]): RMSE against median CPU
+//! time per frame, or against a GPU profile's modeled time (the middle estimate, with its
+//! low–high range as a horizontal bar), both axes logarithmic. Each method has one colour ([`method_colour`]), each knob setting of a
 //! method one marker shape, and every point carries its row number (`#` of the summary
 //! table), which the panel on the right spells out; the Pareto front is the step line through
 //! the Pareto-optimal configurations (after each one, the best error attainable until the
 //! next is as fast), and the reference's own noise is a dashed line. A configuration whose
-//! RMSE is 0 (the reference itself, when listed) is drawn on the bottom edge.
+//! RMSE is 0 (the reference itself, when listed) is drawn on the bottom edge; one without a
+//! time on the axis (a CPU-only method, not modeled) is left out of the chart and marked
+//! "not modeled" in the key.
 //!
 //! Drawn with `plotters` once per backend ([`crate::experiment::plotting`]).
 
-use super::{pareto_front, Row, Sweep};
+use super::{axis_label, pareto_front, Row, Sweep, TimeAxis};
 use crate::experiment::plotting::{png_and_svg, Plot, PALETTE};
 use crate::methods;
 use plotters::coord::Shift;
@@ -76,6 +79,7 @@ fn draw<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     sweep: &Sweep,
     scene: &str,
+    axis: TimeAxis,
 ) -> Result<(), String> {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     let rows: Vec<&Row> = sweep
@@ -114,9 +118,19 @@ fn draw<DB: DrawingBackend>(
     } else {
         (y_lo, y_hi.max(10.0 * y_lo))
     };
+    // The time range of every point, for the axis limits: its bar where it has one.
+    let bar = |r: &Row| match axis {
+        TimeAxis::Cpu => (r.median_seconds, r.median_seconds),
+        TimeAxis::Gpu(k) => r
+            .modeled
+            .get(k)
+            .and_then(|m| m.seconds)
+            .map_or((f64::NAN, f64::NAN), |t| (t.low, t.high)),
+    };
     let times: Vec<f64> = rows
         .iter()
-        .filter_map(|r| positive(r.median_seconds))
+        .flat_map(|r| [bar(r).0, bar(r).1])
+        .filter_map(positive)
         .collect();
     let t_lo = times.iter().copied().fold(f64::INFINITY, f64::min) / 1.5;
     let t_hi = times.iter().copied().fold(0.0, f64::max) * 1.5;
@@ -125,14 +139,15 @@ fn draw<DB: DrawingBackend>(
     } else {
         (t_lo, t_hi.max(10.0 * t_lo))
     };
-    let at = |r: &Row| (r.median_seconds.max(t_lo), r.error.rmse.max(y_lo));
+    let at = |r: &Row| (axis.seconds(r).max(t_lo), r.error.rmse.max(y_lo));
+    let drawn = |r: &Row| positive(axis.seconds(r)).is_some();
 
     root.fill(&WHITE).map_err(err)?;
     let (left, right) = root.split_horizontally(CHART_WIDTH);
     let (w, h) = (rows[0].item.width, rows[0].item.height);
     let mut chart = ChartBuilder::on(&left)
         .caption(
-            format!("{scene} {w}×{h}: error vs time"),
+            format!("{scene} {w}×{h}: error vs {}", axis_label(sweep, axis)),
             ("sans-serif", 24),
         )
         .margin(16)
@@ -143,10 +158,16 @@ fn draw<DB: DrawingBackend>(
     let tick = |v: &f64| format!("{v:.0e}");
     chart
         .configure_mesh()
-        .x_desc(format!(
-            "time per frame [s], median of {} runs (log)",
-            rows[0].runs
-        ))
+        .x_desc(match axis {
+            TimeAxis::Cpu => format!(
+                "CPU time per frame [s], median of {} runs (log)",
+                rows[0].runs
+            ),
+            TimeAxis::Gpu(k) => format!(
+                "modeled GPU time per frame on {} [s], middle (bar: low–high), a model (log)",
+                sweep.gpus[k]
+            ),
+        })
         .y_desc(format!("RMSE vs {} (log)", sweep.reference))
         .x_label_formatter(&tick)
         .y_label_formatter(&tick)
@@ -166,7 +187,7 @@ fn draw<DB: DrawingBackend>(
     }
     let coords: Vec<(f64, f64)> = rows
         .iter()
-        .map(|r| (r.median_seconds, r.error.rmse))
+        .map(|r| (axis.seconds(r), r.error.rmse))
         .collect();
     let front = pareto_front(&coords);
     let mut step = Vec::new();
@@ -182,8 +203,17 @@ fn draw<DB: DrawingBackend>(
         .map_err(err)?;
     // Markers and numbers in pixels of `root` (the chart maps a point to backend pixels, and
     // `root` starts at the backend's origin).
-    for p in &points {
+    for p in points.iter().filter(|p| drawn(p.row)) {
         let colour = method_colour(&p.row.item.method);
+        let (lo, hi) = bar(p.row);
+        if lo < hi {
+            chart
+                .draw_series(LineSeries::new(
+                    [(lo, at(p.row).1), (hi, at(p.row).1)],
+                    colour.stroke_width(1),
+                ))
+                .map_err(err)?;
+        }
         let (x, y) = chart.backend_coord(&at(p.row));
         marker(root, (x, y), p.kind, colour).map_err(err)?;
         root.draw(&Text::new(
@@ -208,7 +238,13 @@ fn draw<DB: DrawingBackend>(
         let y = 48 + KEY_LINE * n as i32;
         let colour = method_colour(&p.row.item.method);
         marker(&right, (18, y), p.kind, colour).map_err(err)?;
-        let star = if p.row.pareto { " ★" } else { "" };
+        let star = if !drawn(p.row) {
+            " (not modeled)"
+        } else if axis.pareto(p.row) {
+            " ★"
+        } else {
+            ""
+        };
         right
             .draw(&text(
                 format!(
@@ -256,23 +292,28 @@ fn height(lines: usize) -> u32 {
     MIN_HEIGHT.max(48 + KEY_LINE as u32 * (lines as u32 + 4))
 }
 
-/// The Pareto plot of `scene` (module doc) as PNG bytes and SVG text.
-pub fn pareto_plot(sweep: &Sweep, scene: &str) -> Result<(Vec<u8>, String), String> {
+/// The Pareto plot of `scene` on `axis` (module doc) as PNG bytes and SVG text.
+pub fn pareto_plot(
+    sweep: &Sweep,
+    scene: &str,
+    axis: TimeAxis,
+) -> Result<(Vec<u8>, String), String> {
     let lines = sweep.rows.iter().filter(|r| r.item.scene == scene).count();
     if lines == 0 {
         return Err(format!("no rows of scene {scene} to plot"));
     }
-    png_and_svg(&ParetoPlot { sweep, scene }, (WIDTH, height(lines)))
+    png_and_svg(&ParetoPlot { sweep, scene, axis }, (WIDTH, height(lines)))
 }
 
 /// [`draw`] as a [`Plot`].
 struct ParetoPlot<'a> {
     sweep: &'a Sweep,
     scene: &'a str,
+    axis: TimeAxis,
 }
 
 impl Plot for ParetoPlot<'_> {
     fn draw<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<(), String> {
-        draw(area, self.sweep, self.scene)
+        draw(area, self.sweep, self.scene, self.axis)
     }
 }
