@@ -123,7 +123,7 @@ fn main() {
                 coverage,
                 vbuffer,
                 test: ShadowTest::ZPass,
-                integrate: false,
+                horizon: penumbra::methods::horizon_clip::Horizon::Off,
             };
             // Warm the coverage-texture cache so the time is the render's (§3.3: the texture
             // is computed once per light shape).

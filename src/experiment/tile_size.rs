@@ -89,9 +89,8 @@ pub fn sweep(scene: &Scene) -> Result<Vec<Row>, InputError> {
             ..GpuSettings::default()
         };
         let frame = Frame::render(scene, gpu)?;
-        let wedge = PwRestructuredOptions::read(scene)?
-            .wedges
-            .settings(&frame)?;
+        let o = PwRestructuredOptions::read(scene)?;
+        let wedge = o.wedges.settings(&frame, o.horizon)?;
         let set = frame_wedges(&frame, &wedge)?;
         let pts = representative_light_points(scene);
         let test = if eye_in_shadow(scene, frame.proj.near, &pts) {

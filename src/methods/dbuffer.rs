@@ -158,7 +158,7 @@
 
 use super::dump::{color_values, row_major, BufferDump, DumpValues, ElementFormat};
 use super::dump::{EventKind, EventMap};
-use super::horizon_clip::{clip_to_horizon, HorizonKeys};
+use super::horizon_clip::{clip_to_horizon, Horizon, HorizonKeys};
 use super::output::MethodOutput;
 use super::penumbra_map::ShadowMapKeys;
 use crate::error::InputError;
@@ -237,6 +237,10 @@ pub struct DBufferSettings {
     pub fan_segments: u32,
     /// How fragments get their distances.
     pub distances: Distances,
+    /// The receiver's own horizon (`horizon`, [`super::horizon_clip`]), read with the other
+    /// options; `stats.json` shows it under its own `"horizon"`.
+    #[serde(skip)]
+    pub horizon: Horizon,
 }
 
 option_names!(Eq3 {
@@ -280,6 +284,7 @@ pub fn read_settings(frame: &Frame) -> Result<DBufferSettings, InputError> {
         eq3: o.eq3,
         fan_segments: o.fan_segments,
         distances: o.distances,
+        horizon: o.horizon.into(),
     })
 }
 
@@ -1144,8 +1149,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         }
     }
     rec.dump_all(|| dbuffer_dumps(frame, &r, &s));
-    let keys = DBufferOptions::read(frame.scene)?.horizon;
-    let (visibility, horizon) = clip_to_horizon(&mut rec, keys, r.visibility);
+    let (visibility, horizon) = clip_to_horizon(&mut rec, s.horizon, r.visibility);
     let settings = serde_json::json!({
         "horizon": horizon,
         "settings": s,
@@ -1470,6 +1474,7 @@ mod tests {
             eq3: Eq3::Corrected,
             fan_segments: 32,
             distances: Distances::Interpolated,
+            horizon: Horizon::Off,
         };
         // (|cx|, texel, region, V range): nothing nearer and no penumbra volume, before the
         // penumbra volume, beyond it; behind an occluder before the umbra volume's end, without

@@ -78,11 +78,21 @@ option_table! {
     }
 }
 
-/// Read and check `[options.nsample]`: the light samples, the stencil settings and the
-/// `mode` as written.
-pub fn options(
-    frame: &Frame,
-) -> Result<(Vec<LightSample>, StencilShadowSettings, CountMode), InputError> {
+/// `nsample`'s options, read and checked once ([`options`]).
+#[derive(Debug, Clone)]
+pub struct NsampleSettings {
+    /// The light samples.
+    pub samples: Vec<LightSample>,
+    /// The stencil settings of each sample's hard shadow-volume pass.
+    pub stencil: StencilShadowSettings,
+    /// The `mode` as written.
+    pub mode: CountMode,
+    /// The receiver's own horizon (`horizon`, [`super::horizon_clip`]).
+    pub horizon: Horizon,
+}
+
+/// Read and check `[options.nsample]`.
+pub fn options(frame: &Frame) -> Result<NsampleSettings, InputError> {
     let scene = frame.scene;
     let o = NsampleOptions::read(scene)?;
     let settings = o
@@ -95,7 +105,12 @@ pub fn options(
         sphere_disk_target(frame),
     )
     .map_err(|e| scene.option_error(NsampleOptions::NAME, "n", e))?;
-    Ok((samples, settings, o.shadow.mode))
+    Ok(NsampleSettings {
+        samples,
+        stencil: settings,
+        mode: o.shadow.mode,
+        horizon: o.horizon.into(),
+    })
 }
 
 /// `horizon = integrate`'s receiver planes in tile order: per tile and sample, the receiver's
@@ -225,10 +240,14 @@ impl AccumulateWork {
 pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let mut rec = PassRecorder::new(frame, "nsample");
     let scene = frame.scene;
-    let (samples, settings, mode) = options(frame)?;
-    let horizon = NsampleOptions::read(scene)?.horizon;
+    let NsampleSettings {
+        samples,
+        stencil: settings,
+        mode,
+        horizon,
+    } = options(frame)?;
     let colored = matches!(scene.light().shape, LightShape::TexturedRect { .. });
-    let planes = (Horizon::from(horizon) == Horizon::Integrate).then(|| {
+    let planes = (horizon == Horizon::Integrate).then(|| {
         uses_receiver_normals(&mut rec);
         receiver_planes(frame)
     });

@@ -114,7 +114,7 @@
 use super::dump::{
     color_values, depth_values, row_major, BufferDump, ElementFormat, EventKind, EventMap,
 };
-use super::horizon_clip::{clip_to_horizon, HorizonKeys};
+use super::horizon_clip::{clip_to_horizon, Horizon, HorizonKeys};
 use super::output::MethodOutput;
 use crate::error::InputError;
 use crate::frame::Frame;
@@ -187,6 +187,10 @@ pub struct PenumbraMapSettings {
     pub storage: ColorFormat,
     /// Filter of the penumbra-map lookup in the screen pass.
     pub filter: Filter,
+    /// The receiver's own horizon (`horizon`, [`super::horizon_clip`]), read with the other
+    /// options; `stats.json` shows it under its own `"horizon"`.
+    #[serde(skip)]
+    pub horizon: Horizon,
 }
 
 option_names!(BiasStage {
@@ -262,6 +266,7 @@ pub fn read_settings(frame: &Frame) -> Result<PenumbraMapSettings, InputError> {
         falloff: o.falloff,
         storage: o.storage,
         filter: o.filter,
+        horizon: o.horizon.into(),
     })
 }
 
@@ -836,8 +841,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     }
     let r = render_with(&mut rec, &s)?;
     rec.dump_all(|| map_dumps(&r, &s));
-    let horizon = PenumbraMapOptions::read(frame.scene)?.horizon;
-    let (visibility, horizon) = clip_to_horizon(&mut rec, horizon, r.visibility);
+    let (visibility, horizon) = clip_to_horizon(&mut rec, s.horizon, r.visibility);
     let settings = serde_json::json!({
         "settings": s,
         "light_view": {

@@ -46,7 +46,7 @@
 //! its wraps or saturations per pixel and the pixels the resolve clamps ([`li_dump`]).
 
 use super::dump::{li_values, row_major, BufferDump, ElementFormat, EventKind, EventMap};
-use super::horizon_clip::{clip_to_horizon, HorizonKeys};
+use super::horizon_clip::{clip_to_horizon, Horizon, HorizonKeys};
 use super::output::MethodOutput;
 use super::Falloff;
 use crate::error::InputError;
@@ -119,6 +119,10 @@ pub struct WedgeSettings {
     /// Wedge construction options of the first light; [`frame_wedges`] builds every light's
     /// wedges with these flags and that light's center, radius and far distance.
     pub wedge: WedgeOptions,
+    /// The receiver's own horizon (`horizon`, [`super::horizon_clip`]), applied after the
+    /// resolve; shown in `stats.json` under its own `"horizon"`, not here.
+    #[serde(skip)]
+    pub horizon: Horizon,
 }
 
 option_names!(LiFormat {
@@ -161,8 +165,13 @@ option_table! {
 }
 
 impl WedgeKeys {
-    /// The wedge settings these keys ask for on `frame` (every light must be a sphere).
-    pub fn settings(&self, frame: &Frame) -> Result<WedgeSettings, InputError> {
+    /// The wedge settings these keys and the method's `horizon` keys ask for on `frame` (every
+    /// light must be a sphere).
+    pub fn settings(
+        &self,
+        frame: &Frame,
+        horizon: HorizonKeys,
+    ) -> Result<WedgeSettings, InputError> {
         let lights = sphere_lights(frame.scene)?;
         Ok(WedgeSettings {
             li: self.li,
@@ -177,6 +186,7 @@ impl WedgeKeys {
                 parallel_rule: self.parallel_rule.is_on(),
                 ..lights[0]
             },
+            horizon: horizon.into(),
         })
     }
 }
@@ -469,7 +479,7 @@ pub fn options(frame: &Frame) -> Result<WedgeSettings, InputError> {
     Ok(WedgeSettings {
         side_planes: o.side_planes,
         hiz_culling: o.hiz.is_on() && frame.gpu.hiz,
-        ..o.wedges.settings(frame)?
+        ..o.wedges.settings(frame, o.horizon)?
     })
 }
 
@@ -582,8 +592,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         rec.warn(w);
     }
     rec.dump(|| li_dump(frame, &s, &tiles, &li, clamped, "Paper I §4"));
-    let keys = Pw2002Options::read(frame.scene)?.horizon;
-    let (visibility, horizon) = clip_to_horizon(&mut rec, keys, visibility);
+    let (visibility, horizon) = clip_to_horizon(&mut rec, s.horizon, visibility);
     Ok(rec.finish(
         visibility,
         serde_json::json!({

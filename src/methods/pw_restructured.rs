@@ -185,7 +185,7 @@ pub fn read_settings(frame: &Frame) -> Result<(RestructuredSettings, CountMode),
     };
     Ok((
         RestructuredSettings {
-            wedge: o.wedges.settings(frame)?,
+            wedge: o.wedges.settings(frame, o.horizon)?,
             test,
             passes: o.passes,
             // The hierarchical-Z unit off (`[options.gpu] hiz`), there is no zmin/zmax to read.
@@ -751,8 +751,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         rec.warn(w);
     }
     rec.dump(|| li_dump(frame, &s.wedge, &tiles, &li, clamped, "Paper II §3, §6"));
-    let keys = PwRestructuredOptions::read(frame.scene)?.horizon;
-    let (visibility, horizon) = clip_to_horizon(&mut rec, keys, visibility);
+    let (visibility, horizon) = clip_to_horizon(&mut rec, s.wedge.horizon, visibility);
     Ok(rec.finish(
         visibility,
         serde_json::json!({

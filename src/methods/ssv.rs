@@ -140,9 +140,11 @@ pub struct SsvSettings {
     pub vbuffer: VBufferFormat,
     /// z-pass or z-fail for pass 1.
     pub test: ShadowTest,
-    /// `horizon = integrate` (module doc, "The receiver's horizon"): the visibility
-    /// integrated over the light clipped by the receiver's tangent plane.
-    pub integrate: bool,
+    /// The receiver's own horizon (module doc, "The receiver's horizon"); with `integrate`
+    /// the visibility is integrated over the light clipped by the receiver's tangent plane.
+    /// `stats.json` shows it under its own `"horizon"`.
+    #[serde(skip)]
+    pub horizon: Horizon,
 }
 
 option_names! {
@@ -237,8 +239,8 @@ pub fn read_settings(frame: &Frame) -> Result<(SsvSettings, CountMode), InputErr
             "textured lights need the RGB f32 V-buffer (vbuffer = \"f32\"); f16 and 8bit are grey",
         ));
     }
-    let integrate = Horizon::from(o.horizon) == Horizon::Integrate;
-    if integrate {
+    let horizon = Horizon::from(o.horizon);
+    if horizon == Horizon::Integrate {
         let refused = if matches!(scene.light().shape, LightShape::Sphere { .. }) {
             Some(
                 "is not implemented for sphere lights: the clipped light would be a circular \
@@ -278,7 +280,7 @@ pub fn read_settings(frame: &Frame) -> Result<(SsvSettings, CountMode), InputErr
             coverage,
             vbuffer,
             test: shadow_test(o.mode, frame, &[scene.light().center]),
-            integrate,
+            horizon,
         },
         o.mode,
     ))
@@ -452,7 +454,7 @@ fn render_with<V: VBufferDump, T: ShaderFloat>(
     };
 
     // `horizon = integrate`: pass 1's count weighted by the fraction in front.
-    let fractions = settings.integrate.then(|| {
+    let fractions = (settings.horizon == Horizon::Integrate).then(|| {
         let scale = scale.expect("read_settings refuses integrate without a grey float V-buffer");
         horizon_scale_pass::<V, T>(rec, &mut vbuf, scale)
     });
@@ -1087,8 +1089,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
     let mut rec = PassRecorder::new(frame, "ssv");
     let (settings, mode) = read_settings(frame)?;
     let r = render(&mut rec, &settings);
-    let horizon = SsvOptions::read(frame.scene)?.horizon;
-    let (visibility, horizon) = clip_to_horizon(&mut rec, horizon, r.visibility);
+    let (visibility, horizon) = clip_to_horizon(&mut rec, settings.horizon, r.visibility);
     Ok(rec.finish(
         visibility,
         serde_json::json!({

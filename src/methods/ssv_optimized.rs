@@ -99,7 +99,7 @@
 use super::dump::{
     receiver_pixels, row_major, BufferDump, DumpValues, ElementFormat, EventKind, EventMap,
 };
-use super::horizon_clip::{clip_to_horizon, HorizonKeys};
+use super::horizon_clip::{clip_to_horizon, Horizon, HorizonKeys};
 use super::output::MethodOutput;
 use crate::error::InputError;
 use crate::frame::{Frame, BACKGROUND};
@@ -174,6 +174,10 @@ pub struct Settings {
     pub sphere_sides: usize,
     /// Where the wedge shaders read the receiver point from (module doc, "Shader precision").
     pub position: PositionBuffer,
+    /// The receiver's own horizon (`horizon`, [`super::horizon_clip`]), read with the other
+    /// options; `stats.json` shows it under its own `"horizon"`.
+    #[serde(skip)]
+    pub horizon: Horizon,
 }
 
 /// A light (or a piece of one) as the shaders see it.
@@ -480,6 +484,7 @@ pub fn options(frame: &Frame) -> Result<Settings, InputError> {
         tight_wedges,
         sphere_sides: o.sphere_sides as usize,
         position: o.position,
+        horizon: o.horizon.into(),
     })
 }
 
@@ -1234,8 +1239,7 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         );
         Ok::<_, InputError>(vis)
     })?;
-    let horizon = SsvOptimizedOptions::read(frame.scene)?.horizon;
-    let (visibility, horizon) = clip_to_horizon(&mut rec, horizon, Visibility::Gray(vis));
+    let (visibility, horizon) = clip_to_horizon(&mut rec, s.horizon, Visibility::Gray(vis));
     Ok(rec.finish(
         visibility,
         serde_json::json!({ "resolved": s, "horizon": horizon, "gpu": frame.gpu }),

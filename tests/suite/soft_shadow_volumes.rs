@@ -55,7 +55,7 @@ fn exact_f32() -> SsvSettings {
         coverage: CoverageMode::Exact,
         vbuffer: VBufferFormat::F32,
         test: ShadowTest::ZPass,
-        integrate: false,
+        horizon: penumbra::methods::horizon_clip::Horizon::Off,
     }
 }
 

@@ -64,7 +64,7 @@ fn exact(vbuffer: VBufferFormat) -> SsvSettings {
         coverage: CoverageMode::Exact,
         vbuffer,
         test: ShadowTest::ZPass,
-        integrate: false,
+        horizon: penumbra::methods::horizon_clip::Horizon::Off,
     }
 }
 

@@ -134,7 +134,7 @@ pub mod vbuffer;
 
 use super::dump::{row_major, BufferDump, DumpValues, ElementFormat, EventKind, EventMap};
 use super::hard_sv::{shadow_test, volume_stencil_state, ShadowTest, StencilOverflow};
-use super::horizon_clip::{clip_to_horizon, HorizonKeys};
+use super::horizon_clip::{clip_to_horizon, Horizon, HorizonKeys};
 use super::output::MethodOutput;
 use crate::error::InputError;
 use crate::frame::{setup_all, Frame, FULL_SCREEN};
@@ -205,6 +205,10 @@ pub struct Settings {
     pub grouping: Grouping,
     /// z-pass or z-fail for the shadow-volume passes.
     pub test: ShadowTest,
+    /// The receiver's own horizon (`horizon`, [`crate::methods::horizon_clip`]), read with the other
+    /// options; `stats.json` shows it under its own `"horizon"`.
+    #[serde(skip)]
+    pub horizon: Horizon,
 }
 
 option_names!(Packing {
@@ -292,6 +296,7 @@ pub fn options(frame: &Frame) -> Result<(Settings, CountMode), InputError> {
             reverse: o.order == Order::Reverse,
             grouping: o.silhouettes,
             test: shadow_test(o.mode, frame, &[scene.light().center]),
+            horizon: o.horizon.into(),
         },
         o.mode,
     ))
@@ -1448,8 +1453,8 @@ pub fn run(frame: &Frame) -> Result<MethodOutput, InputError> {
         DumpValues::U8(r.penumbrae),
     ));
     r.dumps.into_iter().for_each(|d| rec.output(d));
-    let keys = WedgeBlendingOptions::read(frame.scene)?.horizon;
-    let (visibility, horizon) = clip_to_horizon(&mut rec, keys, Visibility::Gray(r.visibility));
+    let (visibility, horizon) =
+        clip_to_horizon(&mut rec, s.horizon, Visibility::Gray(r.visibility));
     Ok(rec.finish(
         visibility,
         serde_json::json!({
