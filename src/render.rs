@@ -351,17 +351,10 @@ pub fn table_notes(scene: &Scene, runs: &[MethodRun]) -> Vec<String> {
             ));
         }
     }
-    let sphere = scene
-        .lights
-        .iter()
-        .any(|l| matches!(l.shape, crate::scene::LightShape::Sphere { .. }));
-    if sphere && runs.iter().any(|r| r.method == "nsample") {
-        notes.push(
-            "note: a sphere light is the disk facing each receiver for raycast (unless \
-             raycast.sphere = fixed-disk) and the wedge methods, but one disk facing the \
-             center of the bounds of the meshes within the light's influence for nsample"
-                .into(),
-        );
+    for m in crate::methods::ALL {
+        if runs.iter().any(|r| r.method == m.name) {
+            notes.extend((m.table_note)(scene).map(String::from));
+        }
     }
     notes
 }

@@ -1113,6 +1113,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     bytes_per_pixel: 384,
     default_run: crate::methods::DefaultRun::EveryScene,
     sums_per_silhouette_edge: false,
+    table_note: |_| None,
     check: |frame| read_settings(frame).map(drop),
     run,
     goldens: GOLDENS,

@@ -357,6 +357,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     bytes_per_pixel: 72,
     default_run: crate::methods::DefaultRun::EveryScene,
     sums_per_silhouette_edge: false,
+    table_note: |_| None,
     check: |frame| HardSvOptions::read(frame.scene).map(drop),
     run,
     goldens: GOLDENS,

@@ -73,6 +73,9 @@ pub struct Method {
     /// `docs/mesh-repair.md`), whose every silhouette edge has a twin on the other sheet, is
     /// counted twice: [`run`] then warns.
     pub sums_per_silhouette_edge: bool,
+    /// A note under the render table when it ran on `scene` (what a reader of its row must
+    /// know about the scene), or `None`.
+    pub table_note: fn(&Scene) -> Option<&'static str>,
     /// Check its options against a rendered frame without running it (what needs the frame:
     /// a sample count the light's shape cannot take, an option that cannot act with the
     /// others, …): for one light, or for every light with [`SeveralLights::OnePass`].

@@ -190,6 +190,14 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     bytes_per_pixel: 208,
     default_run: crate::methods::DefaultRun::FirstSceneOnly,
     sums_per_silhouette_edge: false,
+    table_note: |scene| {
+        let sphere = |l: &crate::scene::Light| matches!(l.shape, LightShape::Sphere { .. });
+        scene.lights.iter().any(sphere).then_some(
+            "note: a sphere light is the disk facing each receiver for raycast (unless \
+             raycast.sphere = fixed-disk) and the wedge methods, but one disk facing the \
+             center of the bounds of the meshes within the light's influence for nsample",
+        )
+    },
     check: |frame| options(frame).map(drop),
     run,
     goldens: GOLDENS,

@@ -728,6 +728,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     bytes_per_pixel: 96,
     default_run: crate::methods::DefaultRun::EveryScene,
     sums_per_silhouette_edge: true,
+    table_note: |_| None,
     check: |frame| read_settings(frame).map(drop),
     run,
     goldens: GOLDENS,

@@ -1012,6 +1012,7 @@ pub const METHOD: super::Method = super::Method {
     bytes_per_pixel: 72,
     default_run: super::DefaultRun::EveryScene,
     sums_per_silhouette_edge: false,
+    table_note: |_| None,
     check: |frame| raycast_options(frame).map(drop),
     run,
     goldens: GOLDENS,

@@ -1378,6 +1378,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     bytes_per_pixel: 384,
     default_run: crate::methods::DefaultRun::EveryScene,
     sums_per_silhouette_edge: true,
+    table_note: |_| None,
     check: |frame| options(frame).map(drop),
     run,
     goldens: GOLDENS,
