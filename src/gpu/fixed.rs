@@ -66,6 +66,29 @@ mod tests {
         assert_eq!(Fixed8(3 * 256).flip_y(4), Fixed8(0));
     }
 
+    /// The first pixel whose sample `i·256` is ≥ the coordinate, and the last one ≤ it, on
+    /// both sides of every sample and of 0 (`div_euclid`, not truncation, below 0).
+    #[test]
+    fn pixel_ranges_on_both_sides_of_each_sample() {
+        for i in -3i64..=3 {
+            let sample = Fixed8(i * 256);
+            assert_eq!(sample.ceil_pixel(), i);
+            assert_eq!(sample.floor_pixel(), i);
+            assert_eq!(Fixed8(i * 256 + 1).ceil_pixel(), i + 1);
+            assert_eq!(Fixed8(i * 256 + 1).floor_pixel(), i);
+            assert_eq!(Fixed8(i * 256 - 1).ceil_pixel(), i);
+            assert_eq!(Fixed8(i * 256 - 1).floor_pixel(), i - 1);
+        }
+    }
+
+    /// The value in pixels, exactly: 24.8 fixed point over 256.
+    #[test]
+    fn to_f64_is_the_value_over_256() {
+        assert_eq!(Fixed8(384).to_f64(), 1.5);
+        assert_eq!(Fixed8(-1).to_f64(), -1.0 / 256.0);
+        assert_eq!(Fixed8(0).to_f64(), 0.0);
+    }
+
     #[test]
     fn pixel_ranges() {
         assert_eq!(Fixed8(1).ceil_pixel(), 1);

@@ -225,6 +225,51 @@ mod tests {
         assert_eq!(e.altered, 1);
     }
 
+    /// Every store counts the written pattern's class, infinities included; flushing keeps a
+    /// denormal's sign; events add field by field.
+    #[test]
+    fn stores_count_every_class_and_events_add_up() {
+        let mut e = StoreEvents::default();
+        let negative_denormal = 0x8000_0001;
+        assert_eq!(
+            FloatTarget::FlushDenormals.store(negative_denormal, &mut e),
+            0x8000_0000
+        );
+        for bits in [0x7F80_0000, 0xFF80_0000, 0x7FC0_0001, 0x3F80_0000] {
+            assert_eq!(FloatTarget::FlushDenormals.store(bits, &mut e), bits);
+        }
+        assert_eq!(
+            e,
+            StoreEvents {
+                denormal: 1,
+                nan: 1,
+                infinite: 2,
+                altered: 1
+            }
+        );
+        let mut sum = StoreEvents {
+            denormal: 1,
+            nan: 2,
+            infinite: 3,
+            altered: 4,
+        };
+        sum += StoreEvents {
+            denormal: 10,
+            nan: 20,
+            infinite: 30,
+            altered: 40,
+        };
+        assert_eq!(
+            sum,
+            StoreEvents {
+                denormal: 11,
+                nan: 22,
+                infinite: 33,
+                altered: 44
+            }
+        );
+    }
+
     proptest! {
         #[test]
         fn whole_words_round_trip(bits in any::<u32>()) {

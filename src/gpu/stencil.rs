@@ -192,6 +192,117 @@ mod tests {
         assert_eq!(f.update(0xA0, true, true), Some((0xAF, false)));
     }
 
+    const OPS: [StencilOp; 8] = [
+        StencilOp::Keep,
+        StencilOp::Zero,
+        StencilOp::Replace,
+        StencilOp::Incr,
+        StencilOp::Decr,
+        StencilOp::IncrWrap,
+        StencilOp::DecrWrap,
+        StencilOp::Invert,
+    ];
+
+    /// Every op on every stored value, against the GL specification's definitions written
+    /// in i32 arithmetic (OpenGL 4.6 §17.3.5, Table 17.3): the value and the overflow flag.
+    #[test]
+    fn every_op_on_every_value_is_the_specification() {
+        for op in OPS {
+            for stored in 0..=255i32 {
+                let reference = 0x5Ai32;
+                let (value, overflow) = match op {
+                    StencilOp::Keep => (stored, false),
+                    StencilOp::Zero => (0, false),
+                    StencilOp::Replace => (reference, false),
+                    StencilOp::Incr => ((stored + 1).min(255), stored == 255),
+                    StencilOp::Decr => ((stored - 1).max(0), stored == 0),
+                    StencilOp::IncrWrap => ((stored + 1).rem_euclid(256), stored == 255),
+                    StencilOp::DecrWrap => ((stored - 1).rem_euclid(256), stored == 0),
+                    StencilOp::Invert => (255 - stored, false),
+                };
+                assert_eq!(
+                    op.apply(stored as u8, reference as u8),
+                    (value as u8, overflow),
+                    "{op:?} on {stored}"
+                );
+            }
+            assert_eq!(
+                op.wraps(),
+                matches!(op, StencilOp::IncrWrap | StencilOp::DecrWrap),
+                "{op:?}"
+            );
+        }
+    }
+
+    /// Every function on every (reference, stored) pair under three masks, against the
+    /// comparison of the masked values as integers.
+    #[test]
+    fn every_func_compares_the_masked_values() {
+        type Spec = fn(i32, i32) -> bool;
+        let funcs: [(StencilFunc, Spec); 8] = [
+            (StencilFunc::Never, |_, _| false),
+            (StencilFunc::Less, |r, s| r < s),
+            (StencilFunc::LEqual, |r, s| r <= s),
+            (StencilFunc::Greater, |r, s| r > s),
+            (StencilFunc::GEqual, |r, s| r >= s),
+            (StencilFunc::Equal, |r, s| r == s),
+            (StencilFunc::NotEqual, |r, s| r != s),
+            (StencilFunc::Always, |_, _| true),
+        ];
+        for (func, spec) in funcs {
+            for mask in [0xFFu8, 0x0F, 0x00] {
+                for r in 0..=255u8 {
+                    for st in (0..=255u8).step_by(7) {
+                        let want = spec(i32::from(r & mask), i32::from(st & mask));
+                        assert_eq!(func.test(r, st, mask), want, "{func:?} {r} {st} {mask:#x}");
+                    }
+                }
+            }
+        }
+    }
+
+    /// The op chosen for each outcome of the two tests (glStencilOp's sfail, dpfail, dppass),
+    /// and what `update` writes: nothing for KEEP or a zero write mask.
+    #[test]
+    fn the_outcomes_choose_the_op_and_update_writes_through_the_mask() {
+        let f = StencilFace {
+            func: StencilFunc::Always,
+            reference: 7,
+            read_mask: 0xFF,
+            write_mask: 0xFF,
+            stencil_fail: StencilOp::Zero,
+            depth_fail: StencilOp::Incr,
+            depth_pass: StencilOp::Invert,
+        };
+        assert_eq!(f.op(false, false), StencilOp::Zero);
+        assert_eq!(f.op(false, true), StencilOp::Zero);
+        assert_eq!(f.op(true, false), StencilOp::Incr);
+        assert_eq!(f.op(true, true), StencilOp::Invert);
+        assert_eq!(f.update(9, false, true), Some((0, false)));
+        assert_eq!(f.update(9, true, false), Some((10, false)));
+        assert_eq!(f.update(255, true, false), Some((255, true)));
+        assert_eq!(f.update(0x0F, true, true), Some((0xF0, false)));
+        let masked = StencilFace { write_mask: 0, ..f };
+        assert_eq!(masked.update(9, true, true), None);
+        let keep = StencilFace::always(StencilOp::Keep, StencilOp::Keep);
+        assert_eq!(keep.update(9, true, true), None);
+        assert_eq!(
+            (
+                keep.func,
+                keep.read_mask,
+                keep.write_mask,
+                keep.stencil_fail
+            ),
+            (StencilFunc::Always, 0xFF, 0xFF, StencilOp::Keep)
+        );
+        let two_sided = StencilState {
+            front: f,
+            back: keep,
+        };
+        assert_eq!(*two_sided.face(true), f);
+        assert_eq!(*two_sided.face(false), keep);
+    }
+
     #[test]
     fn func_uses_read_mask() {
         assert!(StencilFunc::Equal.test(0x12, 0x32, 0x0F));

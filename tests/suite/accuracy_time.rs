@@ -335,54 +335,40 @@ fn assert_exit_2(output: &std::process::Output, words: &[&str], out: &Path) {
     assert!(!out.exists(), "wrote {}", out.display());
 }
 
+/// Runs a 16² one-run sweep of `single-quad` into `out` with the arguments `extra`.
+fn tiny_sweep(extra: &[&str], out: &Path) -> std::process::Output {
+    let o = out.to_str().unwrap();
+    let mut args = vec![
+        "experiment",
+        "accuracy-time",
+        "single-quad",
+        "--size",
+        "16",
+        "--runs",
+        "1",
+        "--out",
+        o,
+    ];
+    args.extend(extra);
+    penumbra(&args)
+}
+
 #[test]
 fn bad_shard_specs_and_merges_exit_2() {
     for spec in ["5/4", "0/4", "1/0", "x/4", "3"] {
         let out = fresh_dir("cli-bad-shard");
-        let o = out.to_str().unwrap();
-        let output = penumbra(&[
-            "experiment",
-            "accuracy-time",
-            "single-quad",
-            "--size",
-            "16",
-            "--runs",
-            "1",
-            "--shard",
-            spec,
-            "--out",
-            o,
-        ]);
+        let output = tiny_sweep(&["--shard", spec], &out);
         assert_exit_2(&output, &["--shard", spec, "1 ≤ I ≤ N"], &out);
     }
     // GPU profiles: an unknown one, one given twice.
-    for (gpus, words) in [
-        (
-            &["voodoo2"][..],
-            &["--gpu", "voodoo2", "unknown GPU profile", "radeon-9700-pro"][..],
-        ),
-        (
-            &["geforce3", "geforce3"][..],
-            &["--gpu", "geforce3", "given twice"][..],
-        ),
+    let unknown = ["--gpu", "voodoo2", "unknown GPU profile", "radeon-9700-pro"];
+    let twice = ["--gpu", "geforce3", "given twice"];
+    for (args, words) in [
+        (&["--gpu", "voodoo2"][..], &unknown[..]),
+        (&["--gpu", "geforce3", "--gpu", "geforce3"][..], &twice[..]),
     ] {
         let out = fresh_dir("cli-bad-gpu");
-        let o = out.to_str().unwrap();
-        let mut args = vec![
-            "experiment",
-            "accuracy-time",
-            "single-quad",
-            "--size",
-            "16",
-            "--runs",
-            "1",
-            "--out",
-            o,
-        ];
-        for g in gpus {
-            args.extend(["--gpu", g]);
-        }
-        assert_exit_2(&penumbra(&args), words, &out);
+        assert_exit_2(&tiny_sweep(args, &out), words, &out);
     }
     // Merging: a shard given twice; a directory without results.
     let scenes = [scene("single-quad", 16)];
