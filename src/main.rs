@@ -501,20 +501,11 @@ fn experiment(cmd: ExperimentCmd) -> Result<(), Box<dyn std::error::Error>> {
             } else {
                 gpus.iter()
                     .map(|g| {
-                        penumbra::gpu_model::GpuModel::named(g).ok_or_else(|| {
-                            InputError::at(
-                                "--gpu",
-                                g,
-                                format!(
-                                    "unknown GPU profile; one of: {}",
-                                    penumbra::gpu_model::profiles()
-                                        .gpu
-                                        .iter()
-                                        .map(|p| p.id.as_str())
-                                        .collect::<Vec<_>>()
-                                        .join(", ")
-                                ),
-                            )
+                        use penumbra::options::OptionType;
+                        type Gpu = penumbra::gpu_model::GpuModel;
+                        Gpu::named(g).ok_or_else(|| {
+                            let expected = Gpu::accepted(&Gpu::everything()).expected();
+                            InputError::at("--gpu", g, format!("unknown GPU profile; {expected}"))
                         })
                     })
                     .collect::<Result<Vec<_>, _>>()?

@@ -366,8 +366,13 @@ impl TimeAxis {
 
     /// Every axis of `sweep`: CPU time, then each profile.
     pub fn all(sweep: &Sweep) -> Vec<TimeAxis> {
+        Self::of(sweep.gpus.len())
+    }
+
+    /// CPU time, then the modeled time on each of `gpus` profiles.
+    fn of(gpus: usize) -> Vec<TimeAxis> {
         std::iter::once(TimeAxis::Cpu)
-            .chain((0..sweep.gpus.len()).map(TimeAxis::Gpu))
+            .chain((0..gpus).map(TimeAxis::Gpu))
             .collect()
     }
 }
@@ -377,8 +382,7 @@ impl TimeAxis {
 fn mark_pareto(rows: &mut [Row], gpus: usize) {
     let mut scenes: Vec<String> = rows.iter().map(|r| r.item.scene.clone()).collect();
     scenes.dedup();
-    let axes = std::iter::once(TimeAxis::Cpu).chain((0..gpus).map(TimeAxis::Gpu));
-    for axis in axes {
+    for axis in TimeAxis::of(gpus) {
         for scene in &scenes {
             let idx: Vec<usize> = (0..rows.len())
                 .filter(|&i| &rows[i].item.scene == scene)
