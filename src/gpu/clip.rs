@@ -209,4 +209,74 @@ mod tests {
         assert_eq!(common.len(), 2, "{p1:?} {p2:?}");
         assert!(common.contains(&&b));
     }
+
+    /// The six signed distances of one vertex, worked out by hand from the planes of the
+    /// module doc (G = 4): near z + w, far w − z, guard bands x + G·w, G·w − x, y + G·w,
+    /// G·w − y.
+    #[test]
+    fn each_plane_distance_is_its_plane() {
+        assert_eq!(GUARD_BAND, 4.0);
+        let v = [1.0, 2.0, 3.0, 5.0];
+        let d: Vec<f64> = (0..6).map(|p| plane_distance(p, &v)).collect();
+        assert_eq!(d, [8.0, 2.0, 21.0, 19.0, 22.0, 18.0]);
+    }
+
+    /// A vertex on every plane at once is the degenerate direction w = 0: not inside (w must
+    /// be positive), and a triangle that keeps it is dropped; one vertex past a guard band
+    /// makes the triangle not fully inside.
+    #[test]
+    fn a_vertex_with_w_zero_is_never_inside_and_drops_its_triangle() {
+        let t = [
+            ClipVertex([0.0, 0.0, 0.0, 0.0]),
+            ClipVertex([0.5, 0.0, 0.0, 1.0]),
+            ClipVertex([0.0, 0.5, 0.0, 1.0]),
+        ];
+        assert!(!fully_inside(&t));
+        assert!(clip_triangle(&t).is_empty());
+        let past = [t[1], t[2], ClipVertex([4.5, 0.0, 0.0, 1.0])];
+        assert!(!fully_inside(&past));
+        assert!(fully_inside(&[
+            t[1],
+            t[2],
+            ClipVertex([4.0, 0.0, 0.0, 1.0])
+        ]));
+    }
+
+    /// A new vertex is computed from the edge's inside vertex (module doc, "Watertightness"):
+    /// `a + t·(b − a)`, `t = d_a / (d_a − d_b)`, in f64 and rounded once. The sweep uses edges
+    /// whose x nearly cancels where they cross the near plane (x_b ≈ x_a·(1 − n), t = 1/n), so
+    /// that the f64 rounding of `t` survives the rounding to f32 and, on a third of them, the
+    /// same point computed from the outside vertex differs in its bits: the rule is observable.
+    #[test]
+    fn new_vertices_are_computed_from_the_inside_vertex() {
+        let from = |p: ClipVertex, q: ClipVertex| {
+            let (p, q) = (to_f64(p), to_f64(q));
+            let (dp, dq) = (plane_distance(0, &p), plane_distance(0, &q));
+            let t = dp / (dp - dq);
+            ClipVertex(std::array::from_fn(|i| (p[i] + t * (q[i] - p[i])) as f32))
+        };
+        let (mut edges, mut differ) = (0, 0);
+        for n in 2..=40 {
+            for s in [0.1f64, 0.3, 0.7, 1.3] {
+                let xb = s * (1.0 - n as f64);
+                if xb.abs() > GUARD_BAND {
+                    continue;
+                }
+                let a = ClipVertex([s as f32, 0.25, 0.0, 1.0]);
+                let b = ClipVertex([xb as f32, 0.25, -(n as f32), 1.0]);
+                let c = ClipVertex([0.5, 0.9, 0.5, 1.0]);
+                // a and c are inside, b is behind the near plane: the new vertices lie on a–b
+                // and b–c, each from its inside end.
+                let poly = clip_triangle(&[a, b, c]);
+                assert_eq!(poly, vec![a, from(a, b), from(c, b), c], "n {n} s {s}");
+                edges += 1;
+                differ += usize::from(from(a, b) != from(b, a));
+            }
+        }
+        assert_eq!(edges, 60);
+        assert!(
+            differ >= 10,
+            "{differ} of {edges} edges tell the two ends apart"
+        );
+    }
 }

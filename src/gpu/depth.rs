@@ -53,6 +53,14 @@ impl DepthFormat {
     /// of quantizing it per tile ([`super::buffers::HizBounds::depth_outcome`]). A binary
     /// search over the bit patterns between the window depths of `q − 1` and `q` (the whole
     /// of [0, 1] where rounding put either on the wrong side): a few steps, not thirty.
+    ///
+    /// Why that bracket always holds, `quantize(window(q − 1)) < q ≤ quantize(window(q))`
+    /// with `window(c)` the f32 nearest `c / M`: for the unorm formats the f32 is within half
+    /// an ulp, at most 2⁻²⁵ in [½, 1) and less below, so `window(c)·M` is within
+    /// 2⁻²⁵·(2²⁴ − 1) < ½ of `c`, and the f32 product (exact integers above 2²³, a grid of ½
+    /// or finer below, with the error shrinking as fast) rounds back to `c`; for D32F
+    /// `window(c)` is `c`'s own bits. The test
+    /// `every_code_is_bracketed_by_its_own_window_depths` checks every D16 and D24 code.
     pub fn first_quantized_at_least(self, q: u32) -> f32 {
         let at = |bits: u32| self.quantize(f32::from_bits(bits));
         let one = 1.0f32.to_bits();
@@ -65,12 +73,6 @@ impl DepthFormat {
         // q ≥ 1 here. Invariant: at(lo) < q ≤ at(hi).
         let near = |code: u32| (self.to_window(code) as f32).to_bits().min(one);
         let (mut lo, mut hi) = (near(q - 1), near(q));
-        if at(lo) >= q {
-            lo = 0;
-        }
-        if at(hi) < q {
-            hi = one;
-        }
         while hi - lo > 1 {
             let mid = lo + (hi - lo) / 2;
             if at(mid) >= q {
@@ -254,6 +256,32 @@ mod tests {
                     let below = f32::from_bits(t.to_bits() - 1);
                     assert!(format.quantize(below) < q, "{format:?} {q}: {below:e}");
                 }
+            }
+        }
+    }
+
+    /// The search bracket of [`DepthFormat::first_quantized_at_least`] holds for every code:
+    /// the window depth of `q − 1` quantizes below `q` and that of `q` to `q` itself (the
+    /// rounding argument of its doc), every D16 and every D24 code, and D32F around 0, ½ and 1.
+    #[test]
+    fn every_code_is_bracketed_by_its_own_window_depths() {
+        let window = |format: DepthFormat, code: u32| format.to_window(code) as f32;
+        let d32: Vec<u32> = [0.0f32, 0.5, 1.0]
+            .iter()
+            .flat_map(|z| {
+                let b = z.to_bits();
+                b.saturating_sub(1000).max(1)..=(b + 1000).min(1.0f32.to_bits())
+            })
+            .collect();
+        let codes = [
+            (DepthFormat::D16, (1..=D16_MAX).collect::<Vec<_>>()),
+            (DepthFormat::D24, (1..=D24_MAX).collect()),
+            (DepthFormat::D32F, d32),
+        ];
+        for (format, codes) in codes {
+            for q in codes {
+                assert!(format.quantize(window(format, q - 1)) < q, "{format:?} {q}");
+                assert_eq!(format.quantize(window(format, q)), q, "{format:?} {q}");
             }
         }
     }

@@ -224,4 +224,35 @@ mod tests {
         assert_eq!(li_visibility(-5), 0.0);
         assert_eq!(li_visibility(300), 1.0);
     }
+
+    /// Bytes per sample are the storage bits rounded up to whole bytes (a 12-bit LI value
+    /// lives in a 16-bit word), and a tile's traffic counts them per read and write.
+    #[test]
+    fn each_format_counts_its_bytes() {
+        for format in [LiFormat::Li16, LiFormat::Li12, LiFormat::Li8] {
+            assert_eq!(
+                format.bytes(),
+                u64::from(format.bits().div_ceil(8)),
+                "{format:?}"
+            );
+            let mut t = LiTile::cleared(format, LiOverflow::Wrap, 2);
+            let mut c = Counters::default();
+            t.add(0, -1, &mut c);
+            assert_eq!(c.color_read_bytes, format.bytes());
+            assert_eq!(c.color_write_bytes, format.bytes());
+        }
+        assert_eq!(LiFormat::Li16.bytes(), 2);
+    }
+
+    /// The resolve clamps exactly the values outside [0, 255] (Paper I §4), and
+    /// [`li_clamped`] says so for each of them.
+    #[test]
+    fn clamped_is_outside_the_resolve_range() {
+        for li in [-40000, -256, -1, 0, 1, 128, 254, 255, 256, 511, 40000] {
+            let unclamped = li as f32 / 255.0;
+            let clamped = li_visibility(li) != unclamped;
+            assert_eq!(li_clamped(li), clamped, "{li}");
+            assert_eq!(li_clamped(li), !(0..=255).contains(&li), "{li}");
+        }
+    }
 }
