@@ -133,6 +133,39 @@ enum ExperimentCmd {
         #[arg(long, default_value_t = penumbra::experiment::precision::DEFAULT_SIZE)]
         size: u32,
     },
+    /// Issue 32: every method's time and peak memory against the occluder's triangle count
+    /// (bumpy spheres, and the meshes of --mesh) and against the image size, and the memory
+    /// estimate against the measured peak (docs/performance.md "How cost grows").
+    CostGrowth {
+        /// Target triangle counts of the bumpy spheres, comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = penumbra::experiment::cost_growth::DEFAULT_TRIANGLES)]
+        triangles: Vec<u32>,
+        /// A mesh file (OBJ, PLY, STL, glTF) to measure too (repeatable).
+        #[arg(long = "mesh", value_name = "FILE")]
+        meshes: Vec<PathBuf>,
+        /// Image side of the triangle series.
+        #[arg(long, default_value_t = penumbra::experiment::cost_growth::DEFAULT_SIZE)]
+        size: u32,
+        /// Image sides of the size series (on the first workload), comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = penumbra::experiment::cost_growth::DEFAULT_SIZES)]
+        sizes: Vec<u32>,
+        /// Comma-separated methods (default: every method).
+        #[arg(long, value_delimiter = ',')]
+        methods: Option<Vec<String>>,
+        /// Processes per point (the median time, the largest peak).
+        #[arg(long, default_value_t = 3)]
+        runs: usize,
+        /// Threads of each render (default: all cores).
+        #[arg(long = "render-threads")]
+        render_threads: Option<usize>,
+        /// A method option for its renders, METHOD.KEY=VALUE (repeatable), e.g.
+        /// raycast.samples=16.
+        #[arg(long = "opt", value_name = "METHOD.KEY=VALUE")]
+        opts: Vec<String>,
+        /// Output directory.
+        #[arg(long, default_value = penumbra::experiment::cost_growth::DEFAULT_OUT)]
+        out: PathBuf,
+    },
     /// Join the outputs of accuracy-time shards into what an unsharded run writes.
     Merge {
         /// The shards' output directories.
@@ -241,17 +274,9 @@ fn apply_overrides(scene: &mut Scene, a: &SceneOverrides) -> Result<(), InputErr
     penumbra::methods::check_option_tables(scene)
 }
 
-/// The scene argument `arg` with the overrides applied, validated, and checked against the
-/// memory limit (with its buffer dumps when `dump_buffers`); prints the f32-rounding warning
-/// if it applies. Nothing is rendered yet.
-fn prepare(
-    arg: &str,
-    a: &SceneOverrides,
-    dump_buffers: bool,
-) -> Result<Scene, Box<dyn std::error::Error>> {
-    let mut scene = file::resolve(arg)?;
-    apply_overrides(&mut scene, a)?;
-    let (limit, origin) = match &a.max_memory {
+/// The memory limit `a` sets (`--max-memory`, else the default) and where it comes from.
+fn memory_limit(a: &SceneOverrides) -> Result<(Option<u64>, &'static str), InputError> {
+    Ok(match &a.max_memory {
         Some(text) => (
             Some(
                 memory::parse_size(text)
@@ -263,7 +288,20 @@ fn prepare(
             memory::default_limit(),
             "the default, half of the machine's memory; set it with --max-memory",
         ),
-    };
+    })
+}
+
+/// The scene argument `arg` with the overrides applied, validated, and checked against the
+/// memory limit (with its buffer dumps when `dump_buffers`); prints the f32-rounding warning
+/// if it applies. Nothing is rendered yet.
+fn prepare(
+    arg: &str,
+    a: &SceneOverrides,
+    dump_buffers: bool,
+) -> Result<Scene, Box<dyn std::error::Error>> {
+    let mut scene = file::resolve(arg)?;
+    apply_overrides(&mut scene, a)?;
+    let (limit, origin) = memory_limit(a)?;
     let methods = penumbra::methods::selected(&scene)?;
     memory::check_fits(&scene, (&methods, dump_buffers), limit, origin)?;
     if let Some(w) = validate::f32_rounding_warning(&scene) {
@@ -331,7 +369,19 @@ fn render(a: &RenderArgs, dump_buffers: bool) -> Result<Rendered, Box<dyn std::e
         Path::new(penumbra::render::DEFAULT_OUT).join(scene_dir_name(&scene.source))
     });
     let runs = render_scene(&scene, dump_buffers)?;
-    write_and_print(&out, scene, runs, dump_buffers)
+    let methods = penumbra::methods::selected(&scene)?;
+    let estimate_bytes = memory::estimate_dumping(&scene, &methods, dump_buffers);
+    let rendered = write_and_print(&out, scene, runs, dump_buffers)?;
+    let record = memory::MemoryRecord {
+        estimate_bytes,
+        limit_bytes: memory_limit(&a.overrides)?.0,
+        peak_resident_bytes: memory::peak_resident_bytes(),
+    };
+    std::fs::write(
+        out.join(memory::RECORD_FILE),
+        serde_json::to_string_pretty(&record)? + "\n",
+    )?;
+    Ok(rendered)
 }
 
 /// Writes the report page for `rendered` scenes, whose method folders are `dirs` (relative to
@@ -563,6 +613,68 @@ fn experiment(cmd: ExperimentCmd) -> Result<(), Box<dyn std::error::Error>> {
                 precision::SUMMARY_FILE,
                 precision::SHADER_PNG,
                 precision::OVERFLOW_PNG
+            );
+        }
+        ExperimentCmd::CostGrowth {
+            triangles,
+            meshes,
+            size,
+            sizes,
+            methods,
+            runs,
+            render_threads,
+            opts,
+            out,
+        } => {
+            use penumbra::experiment::cost_growth;
+            for &t in &triangles {
+                if !(24..=20_000_000).contains(&t) {
+                    return Err(InputError::at(
+                        "--triangles",
+                        t.to_string(),
+                        "expected 24…20000000",
+                    )
+                    .into());
+                }
+            }
+            if runs == 0 {
+                return Err(InputError::at("--runs", "0", "expected at least 1").into());
+            }
+            let threads = render_threads
+                .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+            if !(1..=MAX_THREADS).contains(&threads) {
+                return Err(InputError::at(
+                    "--render-threads",
+                    threads.to_string(),
+                    format!("expected 1…{MAX_THREADS}"),
+                )
+                .into());
+            }
+            let plan = cost_growth::Plan {
+                triangles,
+                meshes,
+                size: size_range(size)?,
+                sizes: sizes
+                    .into_iter()
+                    .map(size_range)
+                    .collect::<Result<_, _>>()?,
+                methods: methods
+                    .unwrap_or_else(|| penumbra::methods::names().map(String::from).collect()),
+                runs,
+                threads,
+                opts,
+            };
+            let exe = std::env::current_exe()?;
+            let points = cost_growth::run(&plan, &exe, &out, |p| eprintln!("cost-growth: {p}"))?;
+            cost_growth::write(&plan, &points, &out)?;
+            print!("{}", cost_growth::summary(&plan, &points));
+            println!(
+                "outputs: {0}/{{{1}, {2}, {3}}}, {0}/{{{4}}}.{{png,svg}}",
+                out.display(),
+                cost_growth::CSV_FILE,
+                cost_growth::JSON_FILE,
+                cost_growth::SUMMARY_FILE,
+                cost_growth::PLOTS.join(", ")
             );
         }
         ExperimentCmd::Merge { dirs, out } => {

@@ -7,10 +7,18 @@
 //! finished method keeps until the outputs are written (its visibility, shaded image and raw
 //! images). The per-method peaks were measured (peak resident memory at 512² and 1024², the
 //! difference per pixel, then rounded up by at least 10%), so the estimate is an upper
-//! estimate for the built-in scenes, not a bound for every scene: meshes add their own
-//! memory, which does not grow with the image.
+//! estimate for the built-in scenes, not a bound for every scene. Meshes add their own
+//! memory, which does not grow with the image: loading (the file's vertices before welding,
+//! repairs, adjacency), silhouettes, volumes and wedges, a ray-cast BVH. That is a figure per
+//! triangle and method, measured by `experiment cost-growth` as the difference of the peaks of
+//! bumpy spheres of 0.33 M and 1.3 M triangles at 512² (from 150 bytes a triangle for `ssv`
+//! to 482 for `raycast`, whose BVH and triangle copies dominate) and rounded up by at least
+//! 25 %, since a scanned mesh can have more silhouette edges per triangle than the spheres;
+//! without it the estimate was below the measured peak at 16 of 30 points of that run
+//! (`docs/performance.md` "How cost grows").
 
 use crate::error::InputError;
+use crate::methods::Method;
 use crate::scene::Scene;
 
 /// Memory a render needs whatever its size: the program, the built-in scenes, thread stacks.
@@ -31,18 +39,26 @@ pub const PER_LIGHT_BYTES_PER_PIXEL: u64 = 16;
 /// their default size, the image's larger side squared.
 pub const DUMP_BYTES_PER_PIXEL: u64 = 48;
 
-/// A method's peak memory per pixel while it runs (module doc: measured, rounded up), as its
-/// registry entry gives it ([`crate::methods::Method::bytes_per_pixel`]); an unknown name
-/// (names are checked before) counts as the largest.
-pub fn method_bytes_per_pixel(method: &str) -> u64 {
+/// A method's figure of its registry entry (`figure`: [`Method::bytes_per_pixel`] or
+/// [`Method::bytes_per_triangle`]); an unknown name (names are checked before) counts as the
+/// largest of any method.
+fn method_figure(method: &str, figure: fn(&Method) -> u64) -> u64 {
     match crate::methods::find(method) {
-        Some(m) => m.bytes_per_pixel,
-        None => crate::methods::ALL
-            .iter()
-            .map(|m| m.bytes_per_pixel)
-            .max()
-            .unwrap_or(0),
+        Some(m) => figure(m),
+        None => crate::methods::ALL.iter().map(figure).max().unwrap_or(0),
     }
+}
+
+/// A method's peak memory per pixel while it runs (module doc: measured, rounded up), as its
+/// registry entry gives it ([`Method::bytes_per_pixel`]).
+pub fn method_bytes_per_pixel(method: &str) -> u64 {
+    method_figure(method, |m| m.bytes_per_pixel)
+}
+
+/// A method's peak memory per triangle of the scene (module doc), as its registry entry gives
+/// it ([`Method::bytes_per_triangle`]).
+pub fn method_bytes_per_triangle(method: &str) -> u64 {
+    method_figure(method, |m| m.bytes_per_triangle)
 }
 
 /// Estimated bytes to render `scene` with `methods` and, with `dump_buffers`, keep their
@@ -67,7 +83,42 @@ pub fn estimate(scene: &Scene, methods: &[String]) -> u64 {
         .max()
         .unwrap_or(0);
     let kept = KEPT_BYTES_PER_PIXEL * methods.len() as u64;
-    FIXED_BYTES + pixels * (peak + kept)
+    let triangles: u64 = scene.meshes.iter().map(|m| m.triangles.len() as u64).sum();
+    let per_triangle = methods
+        .iter()
+        .map(|m| method_bytes_per_triangle(m))
+        .max()
+        .unwrap_or(0);
+    FIXED_BYTES + pixels * (peak + kept) + triangles * per_triangle
+}
+
+/// The file `render` writes beside the method folders: what the render was estimated to need
+/// and what it took ([`MemoryRecord`]).
+pub const RECORD_FILE: &str = "memory.json";
+
+/// A render's memory, as `render` writes it to [`RECORD_FILE`] after its outputs: the
+/// estimate it was checked against, the limit, and the process's measured peak, so that the
+/// estimate can be checked against the truth (`experiment cost-growth`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MemoryRecord {
+    /// [`estimate_dumping`] of the scene as rendered.
+    pub estimate_bytes: u64,
+    /// The limit it was checked against; `None` for no limit.
+    pub limit_bytes: Option<u64>,
+    /// The process's peak resident memory when the outputs were written
+    /// ([`peak_resident_bytes`]); `None` where it cannot be read.
+    pub peak_resident_bytes: Option<u64>,
+}
+
+/// This process's peak resident memory so far: `VmHWM` of `/proc/self/status` (the high-water
+/// mark of this program's own address space: a fresh one from `exec`, so the parent that
+/// started it does not count, as it does in `wait4`'s `ru_maxrss`). `None` where it cannot be
+/// read (systems other than Linux).
+pub fn peak_resident_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let kib = status.lines().find_map(|l| l.strip_prefix("VmHWM:"))?;
+    let kib: u64 = kib.trim().trim_end_matches("kB").trim().parse().ok()?;
+    Some(kib * 1024)
 }
 
 /// The machine's memory in bytes as this process may use it: the smaller of the physical
@@ -190,9 +241,34 @@ mod tests {
         s.width = 1024;
         s.height = 1024;
         let one = vec!["hard-sv".to_string()];
-        assert_eq!(estimate(&s, &one), FIXED_BYTES + (1 << 20) * (72 + 32));
+        let triangles: u64 = s.meshes.iter().map(|m| m.triangles.len() as u64).sum();
+        assert!(triangles > 0);
+        let meshes = |bytes: u64| triangles * bytes;
+        assert_eq!(
+            estimate(&s, &one),
+            FIXED_BYTES + (1 << 20) * (72 + 32) + meshes(208)
+        );
         let two = vec!["hard-sv".to_string(), "ssv".to_string()];
-        assert_eq!(estimate(&s, &two), FIXED_BYTES + (1 << 20) * (160 + 64));
+        assert_eq!(
+            estimate(&s, &two),
+            // hard-sv's 208 bytes a triangle, the larger of the two (ssv: 192).
+            FIXED_BYTES + (1 << 20) * (160 + 64) + meshes(208)
+        );
+        // A mesh's memory grows with its triangles, by the largest figure of the methods.
+        let mut big = s.clone();
+        big.meshes.push(crate::scene::procedural::bumpy_sphere(
+            "b",
+            (101, 202),
+            (6, 0.1),
+            [1.0; 3],
+        ));
+        let more = 4 * 101 * 100;
+        assert_eq!(estimate(&big, &two) - estimate(&s, &two), more * 208);
+        let raycast = vec!["raycast".to_string()];
+        assert_eq!(
+            estimate(&big, &raycast) - estimate(&s, &raycast),
+            more * 608
+        );
         let e = check_fits(&s, (&one, false), Some(100 << 20), "--max-memory")
             .unwrap_err()
             .to_string();

@@ -2,6 +2,7 @@
 //! "Experiments and reports": sweeps, CSV, summaries, plots).
 
 pub mod accuracy_time;
+pub mod cost_growth;
 pub mod panels;
 pub mod plotting;
 pub mod precision;

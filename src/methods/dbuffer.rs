@@ -1111,6 +1111,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     options: crate::methods::OptionTableSpec::of::<DBufferOptions>(),
     // Not measured: the largest method's figure (wedge-blending's).
     bytes_per_pixel: 384,
+    bytes_per_triangle: 384,
     default_run: crate::methods::DefaultRun::EveryScene,
     sums_per_silhouette_edge: false,
     table_note: |_| None,

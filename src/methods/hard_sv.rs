@@ -355,6 +355,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     lights: crate::methods::SeveralLights::PerLight,
     options: crate::methods::OptionTableSpec::of::<HardSvOptions>(),
     bytes_per_pixel: 72,
+    bytes_per_triangle: 208,
     default_run: crate::methods::DefaultRun::EveryScene,
     sums_per_silhouette_edge: false,
     table_note: |_| None,

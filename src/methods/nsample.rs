@@ -188,6 +188,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     // scratch: 92 bytes per pixel on one thread, 185 on eight (n = 16, `cube-of-spheres`,
     // 512² and 1024²).
     bytes_per_pixel: 208,
+    bytes_per_triangle: 240,
     default_run: crate::methods::DefaultRun::FirstSceneOnly,
     sums_per_silhouette_edge: false,
     table_note: |scene| {

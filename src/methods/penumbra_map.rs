@@ -805,6 +805,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     options: crate::methods::OptionTableSpec::of::<PenumbraMapOptions>(),
     // Not measured: the largest method's figure (wedge-blending's).
     bytes_per_pixel: 384,
+    bytes_per_triangle: 240,
     default_run: crate::methods::DefaultRun::EveryScene,
     sums_per_silhouette_edge: false,
     table_note: |_| None,

@@ -1075,6 +1075,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     lights: crate::methods::SeveralLights::PerLight,
     options: crate::methods::OptionTableSpec::of::<SsvOptions>(),
     bytes_per_pixel: 160,
+    bytes_per_triangle: 192,
     default_run: crate::methods::DefaultRun::EveryScene,
     sums_per_silhouette_edge: true,
     table_note: |_| None,

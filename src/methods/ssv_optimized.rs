@@ -1133,6 +1133,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     lights: crate::methods::SeveralLights::PerLight,
     options: crate::methods::OptionTableSpec::of::<SsvOptimizedOptions>(),
     bytes_per_pixel: 96,
+    bytes_per_triangle: 208,
     default_run: crate::methods::DefaultRun::EveryScene,
     sums_per_silhouette_edge: true,
     table_note: |_| None,

@@ -28,24 +28,59 @@ pub fn uv_sphere(
     slices: u32,
     color: [f32; 3],
 ) -> Mesh {
+    let r = f64::from(radius);
+    star_sphere(name, center, (stacks, slices), |_, _| r, color)
+}
+
+/// A bumpy sphere around the origin: [`uv_sphere`]'s mesh with the radius `1 + amplitude·sin(b·φ)·cos(b·θ)`
+/// at polar angle φ and azimuth θ, `b = bumps`: a closed, star-shaped mesh whose every bump
+/// has its own silhouette loop, so that silhouettes grow with the triangle count (the
+/// workload of `experiment cost-growth`). `amplitude` < 1 keeps it star-shaped.
+///
+/// # Panics
+/// As [`uv_sphere`], or if `amplitude` is not in [0, 1).
+pub fn bumpy_sphere(
+    name: &str,
+    (stacks, slices): (u32, u32),
+    (bumps, amplitude): (u32, f64),
+    color: [f32; 3],
+) -> Mesh {
+    assert!(
+        (0.0..1.0).contains(&amplitude),
+        "bumpy_sphere needs amplitude in [0, 1)"
+    );
+    let b = f64::from(bumps);
+    let radius = |phi: f64, theta: f64| 1.0 + amplitude * libm::sin(b * phi) * libm::cos(b * theta);
+    star_sphere(name, Vec3::ZERO, (stacks, slices), radius, color)
+}
+
+/// The mesh of [`uv_sphere`] with the radius a function of the polar angle φ and the azimuth θ
+/// (the poles at θ = 0).
+fn star_sphere(
+    name: &str,
+    center: Vec3,
+    (stacks, slices): (u32, u32),
+    radius: impl Fn(f64, f64) -> f64,
+    color: [f32; 3],
+) -> Mesh {
     assert!(
         stacks >= 2 && slices >= 3,
         "uv_sphere needs stacks ≥ 2 and slices ≥ 3"
     );
     let c = center.as_dvec3();
-    let r = f64::from(radius);
-    let mut positions = vec![f32v(c + DVec3::new(0.0, r, 0.0))];
+    let mut positions = vec![f32v(c + DVec3::new(0.0, radius(0.0, 0.0), 0.0))];
     for i in 1..stacks {
         let phi = PI * f64::from(i) / f64::from(stacks);
         let (sp, cp) = libm::sincos(phi);
         for j in 0..slices {
             let theta = 2.0 * PI * f64::from(j) / f64::from(slices);
             let (st, ct) = libm::sincos(theta);
+            let r = radius(phi, theta);
             positions.push(f32v(c + r * DVec3::new(sp * ct, cp, -sp * st)));
         }
     }
     let south = positions.len() as u32;
-    positions.push(f32v(c - DVec3::new(0.0, r, 0.0)));
+    positions.push(f32v(c - DVec3::new(0.0, radius(PI, 0.0), 0.0)));
 
     // Ring i (1-based) vertex j is 1 + (i−1)·slices + j. θ runs counter-clockwise seen from +y.
     let ring = |i: u32, j: u32| 1 + (i - 1) * slices + (j % slices);
@@ -341,6 +376,18 @@ mod tests {
         // The smallest sphere: a triangular bipyramid, volume 2 · (1/3) · (3√3/4) · 1.
         let tiny = uv_sphere("s2", Vec3::ZERO, 1.0, 2, 3, C);
         check_closed_outward(&tiny, 3f64.sqrt() / 2.0, 1e-6);
+    }
+
+    /// The bumpy sphere is closed and outward, with the volume of its radius function:
+    /// (2π/3)·(2 + (3a²/2)·(1 + 1/(4b² − 1))) (the odd powers of cos(bθ) integrate to 0),
+    /// within the inscribed mesh's 1 %.
+    #[test]
+    fn bumpy_sphere_closed_outward() {
+        let (a, b) = (0.1, 6.0);
+        let m = bumpy_sphere("bumpy", (96, 192), (6, a), C);
+        assert_eq!(m.triangles.len(), 2 * 192 * 95);
+        let volume = 2.0 * PI / 3.0 * (2.0 + 1.5 * a * a * (1.0 + 1.0 / (4.0 * b * b - 1.0)));
+        check_closed_outward(&m, volume, 0.01);
     }
 
     #[test]

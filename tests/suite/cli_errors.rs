@@ -588,6 +588,24 @@ fn small_render_writes_every_documented_output() {
         }
         assert!(p["counters"].is_object(), "{p}");
     }
+    // Beside the method folders: the memory the render was estimated to need and what it
+    // took (the process's own high-water mark, read on Linux), which must not exceed it.
+    let record: penumbra::memory::MemoryRecord =
+        serde_json::from_slice(&std::fs::read(out.join(penumbra::memory::RECORD_FILE)).unwrap())
+            .unwrap();
+    let scene = penumbra::scene::builtin::load("single-quad").unwrap();
+    let scene = penumbra::experiment::sized(scene, 32);
+    assert_eq!(
+        record.estimate_bytes,
+        penumbra::memory::estimate(&scene, &["hard-sv".to_string()])
+    );
+    if cfg!(target_os = "linux") {
+        let peak = record.peak_resident_bytes.expect("VmHWM is read on Linux");
+        assert!(
+            peak > 1 << 20 && peak <= record.estimate_bytes,
+            "{record:?}"
+        );
+    }
     std::fs::remove_dir_all(&out).unwrap();
 }
 

@@ -23,6 +23,7 @@ mod sphere_hard_cases;
 mod accuracy_time;
 mod buffer_dumps;
 mod cli_errors;
+mod cost_growth;
 mod dbuffer;
 mod doc_references;
 mod effects_plan;

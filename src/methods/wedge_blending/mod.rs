@@ -1376,6 +1376,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     options: crate::methods::OptionTableSpec::of::<WedgeBlendingOptions>(),
     // Sized for packing = f32 (two RGBA32F targets per vBuffer; 8bit needs about a third).
     bytes_per_pixel: 384,
+    bytes_per_triangle: 224,
     default_run: crate::methods::DefaultRun::EveryScene,
     sums_per_silhouette_edge: true,
     table_note: |_| None,
