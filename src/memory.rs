@@ -10,11 +10,14 @@
 //! estimate for the built-in scenes, not a bound for every scene. Meshes add their own
 //! memory, which does not grow with the image: loading (the file's vertices before welding,
 //! repairs, adjacency), silhouettes, volumes and wedges, a ray-cast BVH. That is a figure per
-//! triangle and method, measured by `experiment cost-growth` as the difference of the peaks of
-//! bumpy spheres of 0.33 M and 1.3 M triangles at 512² (from 150 bytes a triangle for `ssv`
-//! to 482 for `raycast`, whose BVH and triangle copies dominate) and rounded up by at least
-//! 25 %, since a scanned mesh can have more silhouette edges per triangle than the spheres;
-//! without it the estimate was below the measured peak at 16 of 30 points of that run
+//! triangle and method, measured by `experiment cost-growth` at 512²: what the peak held beyond
+//! the per-pixel figures, the largest over bumpy spheres of 0.33 M and 1.3 M triangles and the
+//! scanned `ogre` and `nefertiti`, rounded up by at least 25 %. It ranges from 192 bytes a
+//! triangle for `ssv` to 608 for `raycast` (its BVH and triangle copies) and 848 for
+//! `pw-restructured`, whose wedges follow the silhouette edges, which a scan has far more of
+//! per triangle than the spheres (671 bytes a triangle on `ogre` against 238 on the 1.3 M
+//! sphere). Without it the estimate was below the measured peak at 16 of 30 points of the
+//! first run, with the sphere-only figures at 4 of 100 of the second
 //! (`docs/performance.md` "How cost grows").
 
 use crate::error::InputError;

@@ -30,8 +30,9 @@ use crate::error::InputError;
 use crate::experiment::plotting::{chart_on, draw_legend, png_and_svg, Plot, PALETTE};
 use crate::memory::{MemoryRecord, RECORD_FILE};
 use crate::methods;
+use crate::scene::mesh_io::read_mesh;
 use crate::scene::procedural::{box_mesh, bumpy_sphere};
-use crate::scene::{file, LightShape, Mesh};
+use crate::scene::{LightShape, Mesh};
 use glam::Vec3;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -92,6 +93,8 @@ pub struct Point {
     pub bumpy: bool,
     /// The occluder's triangles as rendered (after repairs).
     pub triangles: usize,
+    /// What the repairs made of the occluder (`stats.json`'s `meshes[].became`).
+    pub became: String,
     /// Image side (square images).
     pub size: u32,
     /// The method.
@@ -247,38 +250,19 @@ struct Workload {
     triangles: usize,
 }
 
-/// Loads `mesh` once through a scene file (so that it is read and repaired as every render
-/// will) and places it: its bounding box's largest side scaled to 1.6, centred over the
-/// origin, its lowest point 0.2 above the floor.
-fn place(
-    (name, bumpy): (String, bool),
-    mesh: PathBuf,
-    floor: &Path,
-    dir: &Path,
-) -> Result<Workload, InputError> {
-    let probe = dir.join(format!("{name}-probe.toml"));
-    let text = scene_toml(&mesh, floor, "rect", (1.0, Vec3::ZERO), 64);
-    std::fs::write(&probe, text)
-        .map_err(|e| InputError::new(probe.display().to_string(), e.to_string()))?;
-    let scene = file::resolve(&probe.display().to_string())?;
-    let _ = std::fs::remove_file(&probe);
-    let m = scene
-        .meshes
-        .iter()
-        .find(|m| !m.receiver_only)
-        .ok_or_else(|| {
-            InputError::new(mesh.display().to_string(), "no occluder mesh in the file")
-        })?;
-    let (lo, hi) = m.positions.iter().fold(
+/// Reads `mesh` and places it: its bounding box's largest side scaled to 1.6, centred over
+/// the origin, its lowest point 0.2 above the floor. Its triangle count is the file's until a
+/// render says how many it rendered (after repairs).
+fn place((name, bumpy): (String, bool), mesh: PathBuf) -> Result<Workload, InputError> {
+    let display = mesh.display().to_string();
+    let raw = read_mesh(&mesh, &display)?;
+    let (lo, hi) = raw.positions.iter().fold(
         (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
         |(lo, hi), p| (lo.min(*p), hi.max(*p)),
     );
     let side = (hi - lo).max_element();
     if !(side > 0.0 && side.is_finite()) {
-        return Err(InputError::new(
-            mesh.display().to_string(),
-            "the mesh has no extent",
-        ));
+        return Err(InputError::new(display, "the mesh has no extent"));
     }
     let scale = 1.6 / side;
     let centre = (lo + hi) * 0.5 * scale;
@@ -288,17 +272,30 @@ fn place(
         bumpy,
         mesh,
         placement: (scale, translate),
-        triangles: m.triangles.len(),
+        triangles: raw.triangles.len(),
     })
 }
 
-/// One render process; returns (method seconds, process seconds, its memory record).
+/// What one render process measured.
+struct Measured {
+    /// The method's passes, seconds.
+    seconds: f64,
+    /// The whole process, seconds.
+    process: f64,
+    /// Its memory record.
+    record: MemoryRecord,
+    /// The occluder's triangles as rendered, and what its repairs made of it (`stats.json`'s
+    /// `meshes`).
+    occluder: (usize, String),
+}
+
+/// One render process.
 fn render_once(
     (exe, plan): (&Path, &Plan),
     scene: &Path,
     method: &str,
     out: &Path,
-) -> Result<(f64, f64, MemoryRecord), InputError> {
+) -> Result<Measured, InputError> {
     let _ = std::fs::remove_dir_all(out);
     let start = std::time::Instant::now();
     let threads = plan.threads.to_string();
@@ -344,7 +341,20 @@ fn render_once(
         .unwrap_or(f64::NAN);
     let record: MemoryRecord = serde_json::from_value(read(out.join(RECORD_FILE))?)
         .map_err(|e| InputError::new(out.join(RECORD_FILE).display().to_string(), e.to_string()))?;
-    Ok((seconds, process, record))
+    let occluder =
+        stats["meshes"]
+            .as_array()
+            .and_then(|ms| ms.get(1))
+            .map_or((0, String::new()), |m| {
+                let triangles = m["triangles"].as_u64().unwrap_or(0) as usize;
+                (triangles, m["became"].as_str().unwrap_or("").to_string())
+            });
+    Ok(Measured {
+        seconds,
+        process,
+        record,
+        occluder,
+    })
 }
 
 /// Median, min and max of `v` (not empty).
@@ -402,14 +412,14 @@ pub fn run(
         let path = work.join(format!("{name}.obj"));
         write_obj(&mesh, &path).map_err(|e| io(&path, e))?;
         drop(mesh);
-        workloads.push(place((name, true), path, &floor, &work)?);
+        workloads.push(place((name, true), path)?);
     }
     for mesh in &plan.meshes {
         let stem = mesh
             .file_stem()
             .map_or("mesh".into(), |s| s.to_string_lossy().into_owned());
         let mesh = std::path::absolute(mesh).map_err(|e| io(mesh, e))?;
-        workloads.push(place((stem, false), mesh, &floor, &work)?);
+        workloads.push(place((stem, false), mesh)?);
     }
     let mut jobs: Vec<(usize, u32)> = (0..workloads.len()).map(|w| (w, plan.size)).collect();
     if !workloads.is_empty() {
@@ -436,20 +446,20 @@ pub fn run(
             let mut processes = Vec::new();
             let mut peak: Option<u64> = None;
             let mut estimate = 0;
+            let mut occluder = (wl.triangles, String::new());
             for _ in 0..plan.runs.max(1) {
-                let (t, p, record) = render_once((exe, plan), &scene, method, &dir)?;
-                times.push(t);
-                processes.push(p);
-                peak = match (peak, record.peak_resident_bytes) {
-                    (a, None) | (None, a) => a.or(peak),
-                    (Some(a), Some(b)) => Some(a.max(b)),
-                };
-                estimate = record.estimate_bytes;
+                let m = render_once((exe, plan), &scene, method, &dir)?;
+                times.push(m.seconds);
+                processes.push(m.process);
+                peak = peak.max(m.record.peak_resident_bytes);
+                estimate = m.record.estimate_bytes;
+                occluder = m.occluder;
             }
             points.push(Point {
                 workload: wl.name.clone(),
                 bumpy: wl.bumpy,
-                triangles: wl.triangles,
+                triangles: occluder.0,
+                became: occluder.1,
                 size,
                 method: method.clone(),
                 light,
@@ -540,7 +550,8 @@ fn series<'a>(plan: &Plan, points: &'a [Point], by_pixels: bool) -> Vec<(&'a str
 }
 
 /// The summary: both series as tables (time and peak per point, the growth exponent of the
-/// time from the first to the last point), then the estimate against the peak.
+/// time from the first to the last point — of the bumpy spheres, against triangles), then the
+/// estimate against the peak.
 pub fn summary(plan: &Plan, points: &[Point]) -> String {
     let mut s = String::from("# How cost grows with the work\n\n");
     let _ = writeln!(
@@ -567,7 +578,12 @@ pub fn summary(plan: &Plan, points: &[Point]) -> String {
                 if by_pixels {
                     format!("{}²", p.size)
                 } else {
-                    format!("{} ({} tris)", p.workload, p.triangles)
+                    let repaired = if p.became.is_empty() || p.became == "closed" {
+                        String::new()
+                    } else {
+                        format!(", {}", p.became)
+                    };
+                    format!("{} ({} tris{repaired})", p.workload, p.triangles)
                 }
             })
             .collect();
@@ -588,7 +604,13 @@ pub fn summary(plan: &Plan, points: &[Point]) -> String {
                     p.triangles as f64
                 }
             };
-            let exponent = match (ps.first(), ps.last()) {
+            // Against triangles, the exponent runs over the bumpy spheres only (one family).
+            let fit: Vec<&Point> = ps
+                .iter()
+                .copied()
+                .filter(|p| by_pixels || p.bumpy)
+                .collect();
+            let exponent = match (fit.first(), fit.last()) {
                 (Some(a), Some(b)) => {
                     growth_exponent((work(a), a.seconds[0]), (work(b), b.seconds[0]))
                         .map_or("–".into(), |k| format!("{k:.2}"))

@@ -67,8 +67,9 @@ pub struct Method {
     /// rounded up by at least 10 %).
     pub bytes_per_pixel: u64,
     /// Its peak memory per triangle of the scene, loading included, in bytes
-    /// ([`crate::memory`]: measured on bumpy spheres of 0.33 M and 1.3 M triangles, then
-    /// rounded up by at least 25 %).
+    /// ([`crate::memory`]: the largest of what bumpy spheres of 0.33 M and 1.3 M triangles
+    /// and the scanned `ogre` (124 k) and `nefertiti` (100 k) took beyond the per-pixel
+    /// figures, rounded up by at least 25 %).
     pub bytes_per_triangle: u64,
     /// Which of the default run's scenes it renders.
     pub default_run: DefaultRun,

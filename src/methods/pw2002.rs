@@ -551,7 +551,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     lights: crate::methods::SeveralLights::OnePass,
     options: crate::methods::OptionTableSpec::of::<Pw2002Options>(),
     bytes_per_pixel: 88,
-    bytes_per_triangle: 288,
+    bytes_per_triangle: 656,
     default_run: crate::methods::DefaultRun::EveryScene,
     sums_per_silhouette_edge: true,
     table_note: |_| None,

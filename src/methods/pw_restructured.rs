@@ -726,7 +726,7 @@ pub const METHOD: crate::methods::Method = crate::methods::Method {
     lights: crate::methods::SeveralLights::OnePass,
     options: crate::methods::OptionTableSpec::of::<PwRestructuredOptions>(),
     bytes_per_pixel: 96,
-    bytes_per_triangle: 304,
+    bytes_per_triangle: 848,
     default_run: crate::methods::DefaultRun::EveryScene,
     sums_per_silhouette_edge: true,
     table_note: |_| None,

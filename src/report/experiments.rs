@@ -1,18 +1,19 @@
 //! The experiments' results that lie next to the page: an accuracy–time sweep
 //! ([`crate::experiment::accuracy_time`]: `accuracy-time.json` and the scenes' Pareto plots),
-//! a tile-size sweep ([`crate::experiment::tile_size`]: its plot and CSV) and the precision
-//! experiment ([`crate::experiment::precision`]: its two plots and summary). Each is looked
-//! for in the report's directory itself and where its command writes by default relative to
-//! the default output directory (`experiment/accuracy-time/`, `experiment/` and `experiment/precision/`, so that the
-//! default run's `out/index.html` finds `out/experiment/…`). The page shows a scene's Pareto
-//! plot and Pareto-optimal configurations in the scene's section, the tile-size plot and the
-//! precision plots once at the end.
+//! a tile-size sweep ([`crate::experiment::tile_size`]: its plot and CSV), the precision
+//! experiment ([`crate::experiment::precision`]: its two plots and summary) and the cost-growth
+//! experiment ([`crate::experiment::cost_growth`]: its three plots, summary and CSV). Each is
+//! looked for in the report's directory itself and where its command writes by default
+//! relative to the default output directory (`experiment/accuracy-time/`, `experiment/`,
+//! `experiment/precision/` and `cost-growth/`, so that the default run's `out/index.html`
+//! finds them). The page shows a scene's Pareto plot and Pareto-optimal configurations in the
+//! scene's section, the tile-size, precision and cost-growth plots once at the end.
 
 use super::html::{url, Html};
 use crate::experiment::accuracy_time::{
     self, axis_label, fmt_g, pareto_rows, plot_files, Sweep, TimeAxis,
 };
-use crate::experiment::{precision, tile_size};
+use crate::experiment::{cost_growth, precision, tile_size};
 use std::path::{Path, PathBuf};
 
 /// The folders, relative to the report's directory, where an experiment writing by default
@@ -37,6 +38,8 @@ pub struct Found {
     pub tile_size: Option<PathBuf>,
     /// The precision experiment's folder relative to the report's directory.
     pub precision: Option<PathBuf>,
+    /// The cost-growth experiment's folder relative to the report's directory.
+    pub cost_growth: Option<PathBuf>,
     /// Results found but unreadable, one sentence each (shown at the top of the page).
     pub problems: Vec<String>,
 }
@@ -49,6 +52,7 @@ impl Found {
             accuracy: None,
             tile_size: None,
             precision: None,
+            cost_growth: None,
             problems: Vec::new(),
         };
         for rel in candidates(accuracy_time::DEFAULT_OUT) {
@@ -67,6 +71,9 @@ impl Found {
         found.precision = candidates(precision::DEFAULT_OUT)
             .into_iter()
             .find(|rel| dir.join(rel).join(precision::SUMMARY_FILE).is_file());
+        found.cost_growth = candidates(cost_growth::DEFAULT_OUT)
+            .into_iter()
+            .find(|rel| dir.join(rel).join(cost_growth::JSON_FILE).is_file());
         found
     }
 
@@ -203,6 +210,47 @@ impl Found {
             let at = rel.join(file);
             if self.root.join(&at).is_file() {
                 h.void("img", &[("src", &url(&at)), ("alt", alt)]);
+            }
+        }
+        h.close();
+    }
+
+    /// The cost-growth section, if its results were found: a link to its tables and its three
+    /// plots (time against triangles, time against pixels, peak against the estimate).
+    pub fn cost_growth(&self, h: &mut Html) {
+        let Some(rel) = &self.cost_growth else {
+            return;
+        };
+        h.open("section", &[("id", "cost-growth")]);
+        h.element(
+            "h2",
+            &[],
+            "Cost growth: time and peak memory against triangles and image size",
+        );
+        h.open("p", &[]);
+        h.text("From experiment cost-growth: ");
+        let summary = rel.join(cost_growth::SUMMARY_FILE);
+        if self.root.join(&summary).is_file() {
+            h.element("a", &[("href", &url(&summary))], cost_growth::SUMMARY_FILE);
+            h.text(" has the tables and every point where the peak exceeded the estimate; ");
+        }
+        let csv = rel.join(cost_growth::CSV_FILE);
+        if self.root.join(&csv).is_file() {
+            h.element("a", &[("href", &url(&csv))], cost_growth::CSV_FILE);
+            h.text(" every point.");
+        }
+        h.close();
+        let alts = [
+            "method time against the occluder's triangles, log–log, one line per method",
+            "method time against the image's pixels, log–log, one line per method",
+            "measured peak memory against the estimate, log–log, with the diagonal",
+        ];
+        for (stem, alt) in cost_growth::PLOTS.iter().zip(alts) {
+            let png = rel.join(format!("{stem}.png"));
+            if self.root.join(&png).is_file() {
+                h.open("div", &[("class", "pareto")]);
+                h.void("img", &[("src", &url(&png)), ("alt", alt)]);
+                h.close();
             }
         }
         h.close();

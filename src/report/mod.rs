@@ -134,6 +134,11 @@ pub fn page(dir: &Path, scenes: &[SceneRuns]) -> String {
         h.element("a", &[("href", "#precision")], "precision experiment");
         h.close();
     }
+    if found.cost_growth.is_some() {
+        h.open("li", &[]);
+        h.element("a", &[("href", "#cost-growth")], "cost-growth experiment");
+        h.close();
+    }
     for (i, (rel, _)) in peer_results.iter().enumerate() {
         h.open("li", &[]);
         let text = format!("peers ({})", rel.join(peers::JSON_FILE).display());
@@ -155,6 +160,7 @@ pub fn page(dir: &Path, scenes: &[SceneRuns]) -> String {
     }
     found.tile_size(&mut h);
     found.precision(&mut h);
+    found.cost_growth(&mut h);
     for (i, (rel, p)) in peer_results.iter().enumerate() {
         peers::section(&mut h, dir, rel, p, &format!("peers-{}", i + 1));
     }

@@ -7,7 +7,7 @@
 //! Small frames (32²), three methods, `raycast.samples=16`.
 
 use penumbra::experiment::accuracy_time::{self, Configuration, Shard};
-use penumbra::experiment::{sized, tile_size};
+use penumbra::experiment::{cost_growth, sized, tile_size};
 use penumbra::scene::{builtin, file};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -144,6 +144,33 @@ fn a_report_of_two_scenes_links_existing_files_and_shows_every_method() {
     let written = std::fs::read_to_string(out.join("experiment").join(tile_size::SUMMARY_FILE));
     assert_eq!(written.unwrap(), summary);
     assert!(out.join("experiment").join(tile_size::PNG_FILE).is_file());
+    // A cost-growth result (two points written as the experiment writes them; the experiment
+    // itself is run by tests/suite/cost_growth.rs).
+    let plan = cost_growth::Plan {
+        triangles: vec![288, 1088],
+        meshes: Vec::new(),
+        size: 32,
+        sizes: vec![32],
+        methods: vec!["hard-sv".into()],
+        runs: 1,
+        threads: 1,
+        opts: Vec::new(),
+    };
+    let point = |triangles: usize, seconds: f64| cost_growth::Point {
+        workload: format!("bumpy-{triangles}"),
+        bumpy: true,
+        triangles,
+        became: "closed".into(),
+        size: 32,
+        method: "hard-sv".into(),
+        light: "rect",
+        seconds: [seconds; 3],
+        process_seconds: 2.0 * seconds,
+        peak_bytes: Some(20 << 20),
+        estimate_bytes: 70 << 20,
+    };
+    let points = [point(288, 0.01), point(1088, 0.02)];
+    cost_growth::write(&plan, &points, &out.join("cost-growth")).unwrap();
 
     let o = penumbra(&[
         "report",
@@ -230,6 +257,11 @@ fn a_report_of_two_scenes_links_existing_files_and_shows_every_method() {
     );
     assert!(srcs.contains(&gpu_plot.as_str()), "{srcs:?}");
     assert!(srcs.contains(&"experiment/tile_size.svg"));
+    for stem in cost_growth::PLOTS {
+        let png = format!("cost-growth/{stem}.png");
+        assert!(srcs.contains(&png.as_str()), "{srcs:?}");
+    }
+    assert!(hrefs.contains(&"cost-growth/summary.md"), "{hrefs:?}");
     // The frame plans, collapsed.
     assert_eq!(
         doc.descendants()
