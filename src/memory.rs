@@ -115,7 +115,8 @@ pub struct MemoryRecord {
 
 /// This process's peak resident memory so far: `VmHWM` of `/proc/self/status` (the high-water
 /// mark of this program's own address space: a fresh one from `exec`, so the parent that
-/// started it does not count, as it does in `wait4`'s `ru_maxrss`). `None` where it cannot be
+/// started it does not count, as it can in `wait4`'s `ru_maxrss`, which keeps the high-water
+/// mark of the address space replaced by `exec`). `None` where it cannot be
 /// read (systems other than Linux).
 pub fn peak_resident_bytes() -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
