@@ -55,6 +55,7 @@
 pub mod plot;
 
 use super::configured;
+use super::spread;
 use crate::error::InputError;
 use crate::frame::Frame;
 use crate::gpu_model::{GpuModel, Seconds};
@@ -405,17 +406,6 @@ fn modeled_seconds(gpu: GpuModel, out: &methods::output::MethodOutput) -> Option
     let e = crate::gpu_model::estimate(gpu.profile(), &out.stats.passes);
     let on_gpu = e.passes.iter().skip(1).any(|p| p.high > 0.0);
     on_gpu.then_some(e.seconds)
-}
-
-/// Median, min and max of `samples` (at least one; the median of an even count is the upper
-/// middle one).
-fn spread(mut samples: Vec<f64>) -> (f64, f64, f64) {
-    samples.sort_by(f64::total_cmp);
-    (
-        samples[samples.len() / 2],
-        samples[0],
-        samples[samples.len() - 1],
-    )
 }
 
 /// Measures the `shard` of the list of `scenes` × `configurations` (module doc) with `runs`

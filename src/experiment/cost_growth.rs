@@ -28,7 +28,8 @@
 
 use crate::error::InputError;
 use crate::experiment::plotting::{chart_on, draw_legend, png_and_svg, Plot, PALETTE};
-use crate::memory::{MemoryRecord, RECORD_FILE};
+use crate::experiment::spread;
+use crate::memory::{fmt_bytes, MemoryRecord, RECORD_FILE};
 use crate::methods;
 use crate::scene::mesh_io::read_mesh;
 use crate::scene::procedural::{box_mesh, bumpy_sphere};
@@ -357,12 +358,6 @@ fn render_once(
     })
 }
 
-/// Median, min and max of `v` (not empty).
-fn median_min_max(mut v: Vec<f64>) -> [f64; 3] {
-    v.sort_by(f64::total_cmp);
-    [v[v.len() / 2], v[0], v[v.len() - 1]]
-}
-
 /// Runs the plan with the `penumbra` binary `exe`, writing meshes and scenes into
 /// `out/work/`; `progress` is told each point before it runs. An unknown method or an option
 /// for none of the methods is refused before anything is written; a mesh file that cannot be
@@ -463,8 +458,11 @@ pub fn run(
                 size,
                 method: method.clone(),
                 light,
-                seconds: median_min_max(times),
-                process_seconds: median_min_max(processes)[0],
+                seconds: {
+                    let (median, min, max) = spread(times);
+                    [median, min, max]
+                },
+                process_seconds: spread(processes).0,
                 peak_bytes: peak,
                 estimate_bytes: estimate,
             });
@@ -501,11 +499,6 @@ pub fn csv(points: &[Point]) -> String {
 
 /// Bytes in a MiB.
 const MIB: f64 = 1048576.0;
-
-/// Bytes in MiB, one decimal.
-fn mib(b: u64) -> String {
-    format!("{:.1}", b as f64 / MIB)
-}
 
 /// A point's pixels (square images).
 fn pixels(p: &Point) -> f64 {
@@ -593,8 +586,8 @@ pub fn summary(plan: &Plan, points: &[Point]) -> String {
             let cells: Vec<String> = ps
                 .iter()
                 .map(|p| {
-                    let peak = p.peak_bytes.map_or("–".into(), mib);
-                    format!("{:.3} s, {peak} MiB", p.seconds[0])
+                    let peak = p.peak_bytes.map_or("–".into(), fmt_bytes);
+                    format!("{:.3} s, {peak}", p.seconds[0])
                 })
                 .collect();
             let work = |p: &Point| {
@@ -648,7 +641,7 @@ pub fn summary(plan: &Plan, points: &[Point]) -> String {
         );
         let _ = writeln!(
             s,
-            "| workload | triangles | size | method | peak MiB | estimate MiB |"
+            "| workload | triangles | size | method | peak | estimate |"
         );
         let _ = writeln!(s, "|---|---|---|---|---|---|");
         for p in under {
@@ -659,8 +652,8 @@ pub fn summary(plan: &Plan, points: &[Point]) -> String {
                 p.triangles,
                 p.size,
                 p.method,
-                p.peak_bytes.map_or("–".into(), mib),
-                mib(p.estimate_bytes)
+                p.peak_bytes.map_or("–".into(), fmt_bytes),
+                fmt_bytes(p.estimate_bytes)
             );
         }
     }

@@ -31,3 +31,14 @@ pub fn sized(mut scene: Scene, size: u32) -> Scene {
     scene.height = size;
     scene
 }
+
+/// Median, min and max of `samples` (at least one; the median of an even count is the upper
+/// middle one).
+pub fn spread(mut samples: Vec<f64>) -> (f64, f64, f64) {
+    samples.sort_by(f64::total_cmp);
+    (
+        samples[samples.len() / 2],
+        samples[0],
+        samples[samples.len() - 1],
+    )
+}
