@@ -279,6 +279,28 @@ mod tests {
         );
     }
 
+    /// The margin is the documented bound, `8·(u + 2⁻⁵³)·S + 16·min_normal`, no more and no
+    /// less. Binary16 (u = 2⁻¹¹, min_normal = 2⁻¹⁴) with `S = 2`: the normal (1, 1, 0)
+    /// through (0, q, 0) and a one-point box at (−g, q, 0) give `largest = −g` and
+    /// `S = g + 2q`; with `g = 2·(2⁻⁸ + 2⁻⁵⁰) + 2⁻¹⁰` and `2q = 2 − g` (both exact in f64) the
+    /// sum is exactly 0, which does not reject (the test is strict), and a relative change of
+    /// g by ±2⁻³⁰ crosses the bound.
+    #[test]
+    fn the_margin_is_the_documented_bound() {
+        let rounding = InsideTestRounding::new(FP16);
+        let n = DVec3::new(1.0, 1.0, 0.0);
+        let rejects_at = |g: f64| {
+            let q = (2.0 - g) / 2.0;
+            let p = DVec3::new(-g, q, 0.0);
+            plane_rejects_box(n, DVec3::new(0.0, q, 0.0), [p, p], &rounding)
+        };
+        let g = 2.0 * (libm::ldexp(1.0, -8) + libm::ldexp(1.0, -50)) + libm::ldexp(1.0, -10);
+        assert_eq!((2.0 - g) / 2.0 * 2.0 + g, 2.0);
+        assert!(!rejects_at(g), "the bound itself is kept");
+        assert!(!rejects_at(g * (1.0 - libm::ldexp(1.0, -30))));
+        assert!(rejects_at(g * (1.0 + libm::ldexp(1.0, -30))));
+    }
+
     /// Beyond the format's range the program may overflow: never rejected.
     #[test]
     fn boxes_beyond_the_format_range_are_kept() {
@@ -325,6 +347,26 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Each block holds its own 4×4 tiles and no others: with receivers at their pixel's
+    /// (x, y) and the plane y = 40 (inside above it), the tile rows 0–4 (pixels 0–39) are
+    /// rejected, so the first block row (tile rows 0–3) is rejected as a whole and its tiles
+    /// are never read. Reads, by hand, on the 13×9 tiles of 100×72 pixels: 4 blocks at each
+    /// of the tile rows 0, 4 and 8, and the 13 tiles of each of the rows 4–8.
+    #[test]
+    fn a_rejected_block_row_costs_one_read_per_block() {
+        let tiling = Tiling::new(100, 72, 8).unwrap();
+        let b = TileReceiverBounds::new(&tiling, |x, y| Some(DVec3::new(x as f64, y as f64, 0.0)));
+        let rounding = InsideTestRounding::new(FP32);
+        let rejects = |bx| plane_rejects_box(DVec3::Y, DVec3::new(0.0, 40.0, 0.0), bx, &rounding);
+        let mut c = Counters::default();
+        let kept = b.kept_tiles([0, 0, 12, 8], rejects, &mut c);
+        assert_eq!(kept, (5 * 13..9 * 13).collect::<Vec<u32>>());
+        assert_eq!(
+            c.hiz_read_bytes,
+            (3 * 4 + 5 * 13) * TileReceiverBounds::READ_BYTES
+        );
     }
 
     #[test]

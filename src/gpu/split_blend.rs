@@ -237,6 +237,74 @@ mod tests {
         assert_eq!(c.color_read_bytes, 40);
     }
 
+    /// OpenGL's saturating add on an unsigned normalized 8-bit channel, for every pair: the
+    /// sum where it fits in 8 bits (255 included, which does not saturate), 255 and the flag
+    /// above.
+    #[test]
+    fn blend_add_u8_saturates_exactly_above_255() {
+        for dst in 0..=255u8 {
+            for src in 0..=255u8 {
+                let sum = u32::from(dst) + u32::from(src);
+                let want = (sum.min(255) as u8, sum > 255);
+                assert_eq!(blend_add_u8(dst, src), want, "{dst} + {src}");
+            }
+        }
+    }
+
+    /// Each saturated channel is one overflow event, counted and recorded at its sample of its
+    /// buffer; the other sample and the other buffer record nothing. Four bytes are read and
+    /// four written per blend.
+    #[test]
+    fn saturated_channels_are_counted_and_recorded_per_sample_and_buffer() {
+        let mut t = SplitVTile::cleared([250, 0, 250, 0], 2).recording(true);
+        let mut c = Counters::default();
+        let add = t.blend(SplitTarget::Add, 1, [10, 10, 5, 10], &mut c);
+        assert_eq!(add.before, [250, 0, 250, 0]);
+        assert_eq!(add.after, [255, 10, 255, 10]);
+        assert_eq!(add.saturated, 1);
+        assert_eq!(t.add[1], [255, 10, 255, 10]);
+        assert_eq!(t.add[0], [250, 0, 250, 0]);
+        let first = t.blend(SplitTarget::Sub, 0, [255, 0, 0, 1], &mut c);
+        assert_eq!((first.target, first.saturated), (SplitTarget::Sub, 0));
+        let second = t.blend(SplitTarget::Sub, 0, [1, 0, 0, 255], &mut c);
+        assert_eq!(second.after, [255, 0, 0, 255]);
+        assert_eq!(second.saturated, 2);
+        assert_eq!(t.saturations, [vec![0, 1], vec![2, 0]]);
+        assert_eq!(c.overflow_events, 3);
+        assert_eq!((c.color_read_bytes, c.color_write_bytes), (12, 12));
+        // Without recording nothing is kept, and the counter still counts.
+        let mut quiet = SplitVTile::cleared([255; 4], 1);
+        quiet.blend(SplitTarget::Add, 0, [1; 4], &mut c);
+        assert_eq!(quiet.saturations, [Vec::<u32>::new(), Vec::new()]);
+        assert_eq!(c.overflow_events, 7);
+    }
+
+    /// The resolve is `(add − sub) / full` without a clamp: cleared to 1, the subtractive
+    /// buffer at twice full gives exactly −1, and one more unit in the additive one
+    /// (`[7, 7, 7, 8]` = 4096 with 3-bit channels) moves it by 1/4095.
+    #[test]
+    fn resolve_subtracts_the_subtractive_buffer_unclamped() {
+        let f = SplitFormat::default();
+        let mut t = SplitVTile::cleared(f.split(f.full()), 1);
+        let mut c = Counters::default();
+        assert_eq!(t.resolve(f, 0), 1.0);
+        for _ in 0..2 {
+            t.blend(SplitTarget::Sub, 0, f.split(f.full()), &mut c);
+        }
+        assert_eq!(t.resolve(f, 0), -1.0);
+        t.blend(SplitTarget::Add, 0, f.split(1), &mut c);
+        assert_eq!(t.add[0], [7, 7, 7, 8]);
+        assert_eq!(t.resolve(f, 0), (4096.0 - 8190.0) / 4095.0);
+    }
+
+    /// The probe's names of the two buffers, distinct; `ssv-optimized`'s clears, blends and
+    /// resolve all take them from here.
+    #[test]
+    fn each_target_has_its_own_buffer_name() {
+        assert_eq!(SplitBlend::buffer(SplitTarget::Add), "v-add");
+        assert_eq!(SplitBlend::buffer(SplitTarget::Sub), "v-sub");
+    }
+
     #[test]
     fn reserved_bits_out_of_range_are_rejected() {
         assert!(SplitFormat::new(0).is_err());

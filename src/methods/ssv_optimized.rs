@@ -119,7 +119,7 @@ use crate::gpu::setup::setup_all_culled;
 use crate::gpu::setup::{CullMode, RasterTriangle};
 use crate::gpu::shader_float::{ShaderFloat, FP16};
 use crate::gpu::shader_vec::{SVec2, SVec3};
-use crate::gpu::split_blend::{SplitFormat, SplitTarget, SplitVTile};
+use crate::gpu::split_blend::{SplitBlend, SplitFormat, SplitTarget, SplitVTile};
 use crate::gpu::stencil::{StencilFace, StencilFunc, StencilOp, StencilState};
 use crate::gpu::transform::ClipVertex;
 use crate::light::coverage::{self, RectLight};
@@ -583,10 +583,12 @@ fn render_group<T: ShaderFloat>(
         marked: 0,
     });
     frame.probe_record("clear", |tap, _| {
-        tap.event().clear("v-add", Raw::Rgba8(full))
+        tap.event()
+            .clear(SplitBlend::buffer(SplitTarget::Add), Raw::Rgba8(full))
     });
     frame.probe_record("clear", |tap, _| {
-        tap.event().clear("v-sub", Raw::Rgba8([0; 4]))
+        tap.event()
+            .clear(SplitBlend::buffer(SplitTarget::Sub), Raw::Rgba8([0; 4]))
     });
     frame.probe_record("clear", |tap, _| tap.event().clear("stencil", Raw::U8(0)));
     let (lo, hi) = wedge_clip_box(frame.influence_bounds(true));
@@ -876,9 +878,15 @@ fn render_group<T: ShaderFloat>(
     frame.probe_record("resolve-group", |tap, i| {
         let [x, y] = [i as u32 % tiling.width, i as u32 / tiling.width];
         let (tile, local) = (&tiles[tiling.tile_of(x, y)].v, tiling.local(x, y));
-        tap.push(tap.event().read("v-add", Raw::Rgba8(tile.add[local])));
+        tap.push(tap.event().read(
+            SplitBlend::buffer(SplitTarget::Add),
+            Raw::Rgba8(tile.add[local]),
+        ));
         tap.event()
-            .read("v-sub", Raw::Rgba8(tile.sub[local]))
+            .read(
+                SplitBlend::buffer(SplitTarget::Sub),
+                Raw::Rgba8(tile.sub[local]),
+            )
             .value("V", values[i])
             .resolve(&[vis[i]], clamped[i])
             .note("(add − sub)/full, clamped to [0, 1]")
