@@ -236,6 +236,23 @@ impl DepthState {
 mod tests {
     use super::*;
 
+    /// The offsets the early-Z tests try are what their doc promises — none, a positive and a
+    /// negative one in both parts — so that a bound on fragment depths is tried on each side
+    /// (a negative offset moves fragments towards the viewer, where a bound can fail first).
+    #[test]
+    fn the_early_z_test_cases_are_none_a_positive_and_a_negative_offset() {
+        let [none, positive, negative] = PolygonOffset::EARLY_Z_TEST_CASES;
+        assert_eq!(none, PolygonOffset::NONE);
+        assert!(
+            positive.factor > 0.0 && positive.units > 0.0,
+            "{positive:?}"
+        );
+        assert!(
+            negative.factor < 0.0 && negative.units < 0.0,
+            "{negative:?}"
+        );
+    }
+
     /// Each threshold is the first depth of its code: it quantizes to `q` or more and the f32
     /// just below it to less — for every D16 code and every 97th D24 code.
     #[test]
@@ -380,11 +397,33 @@ mod tests {
         assert_eq!(f.to_window(f.quantize(0.75)), 0.75);
     }
 
+    /// Every function on every pair of stored values below, above and equal, and at the
+    /// ends of the range, against the GL specification's table (the fragment's depth compared
+    /// with the stored one): each of the seven tells `<`, `=` and `>` apart as the table says.
     #[test]
-    fn funcs() {
-        assert!(DepthFunc::Less.test(1, 2) && !DepthFunc::Less.test(2, 2));
-        assert!(DepthFunc::LEqual.test(2, 2));
-        assert!(DepthFunc::GEqual.test(2, 2) && !DepthFunc::Greater.test(2, 2));
-        assert!(!DepthFunc::Never.test(0, 1) && DepthFunc::Always.test(5, 1));
+    fn every_func_is_the_specification_on_less_equal_and_greater() {
+        use std::cmp::Ordering::{self, Equal, Greater, Less};
+        type Expected = fn(Ordering) -> bool;
+        let table: [(DepthFunc, Expected); 7] = [
+            (DepthFunc::Never, |_| false),
+            (DepthFunc::Less, |o| o == Less),
+            (DepthFunc::LEqual, |o| o != Greater),
+            (DepthFunc::Equal, |o| o == Equal),
+            (DepthFunc::Greater, |o| o == Greater),
+            (DepthFunc::GEqual, |o| o != Less),
+            (DepthFunc::Always, |_| true),
+        ];
+        let values = [0, 1, 2, 0x00ff_ffff, u32::MAX - 1, u32::MAX];
+        for (func, expected) in table {
+            for fragment in values {
+                for stored in values {
+                    assert_eq!(
+                        func.test(fragment, stored),
+                        expected(fragment.cmp(&stored)),
+                        "{func:?} {fragment} {stored}"
+                    );
+                }
+            }
+        }
     }
 }

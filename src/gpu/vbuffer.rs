@@ -247,8 +247,13 @@ pub struct VBuffer8Tile {
     pub overflows: Vec<u32>,
 }
 
-/// `round(|δ|·63)` as a 6-bit level (module doc).
+/// `round(|δ|·63)` as a 6-bit level (module doc), `|δ|` clamped to 1. A NaN is level 0, as
+/// Direct3D 10's float-to-unorm conversion makes it (OpenGL leaves it undefined): `f32::min`
+/// would have made it a full contribution, 63.
 pub fn quantize6(delta: f32) -> u8 {
+    if delta.is_nan() {
+        return 0;
+    }
     (delta.abs().min(1.0) * VBUFFER8_FULL as f32).round() as u8
 }
 
@@ -299,6 +304,189 @@ impl VBufferTile for VBuffer8Tile {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::gpu::probe::{BufferChange, Probe};
+    use crate::gpu::tiling::Tiling;
+
+    /// The float formats as the module doc states them: cleared to 1.0, each accumulation and
+    /// each scale reading and writing the format's bytes (`VBufferFormat::bytes`), f32 exact,
+    /// binary16 rounded to nearest once per access, RGB per channel.
+    #[test]
+    fn float_formats_clear_to_one_accumulate_and_count_their_bytes() {
+        let mut c = Counters::default();
+        let mut t = VBufferF32Tile::cleared(3);
+        assert_eq!(
+            (0..3).map(|i| t.resolve(i)).collect::<Vec<_>>(),
+            [[1.0; 3]; 3]
+        );
+        t.add(1, [0.25, 9.0, 9.0], &mut c);
+        t.add(1, [-0.75, 9.0, 9.0], &mut c);
+        assert_eq!([t.resolve(0), t.resolve(1)], [[1.0; 3], [0.5; 3]]);
+        t.scale(1, 0.5, &mut c);
+        assert_eq!(t.raw(1), Raw::f32(0.25));
+        let bytes = u64::from(VBufferFormat::F32.bytes());
+        assert_eq!(bytes, 4);
+        assert_eq!(
+            (c.color_read_bytes, c.color_write_bytes),
+            (3 * bytes, 3 * bytes)
+        );
+
+        let mut c = Counters::default();
+        let mut t = VBufferF16Tile::cleared(2);
+        assert_eq!(t.resolve(1), [1.0; 3]);
+        // Half an ulp of binary16 in [1, 2) is 2⁻¹¹ ≈ 0.00049: 0.0007 rounds up to one ulp.
+        t.add(1, [0.5, 0.0, 0.0], &mut c);
+        t.add(1, [0.0007, 0.0, 0.0], &mut c);
+        assert_eq!(t.resolve(1), [1.5 + 1.0 / 1024.0; 3]);
+        assert_eq!(
+            t.raw(1),
+            Raw::F16(f16::from_f32(1.5 + 1.0 / 1024.0).to_bits())
+        );
+        // (1 + 2⁻¹⁰)·(1 − 2⁻¹¹) = 1 + 2⁻¹¹ − 2⁻²¹, just under half-way: rounds down to 1.
+        t.add(0, [1.0 / 1024.0, 0.0, 0.0], &mut c);
+        t.scale(0, 1.0 - 1.0 / 2048.0, &mut c);
+        assert_eq!(t.resolve(0), [1.0; 3]);
+        let bytes = u64::from(VBufferFormat::F16.bytes());
+        assert_eq!(bytes, 2);
+        assert_eq!(
+            (c.color_read_bytes, c.color_write_bytes),
+            (4 * bytes, 4 * bytes)
+        );
+        assert_eq!(c.overflow_events, 0);
+
+        let mut c = Counters::default();
+        let mut t = VBufferRgbTile::cleared(2);
+        t.add(1, [0.25, -0.5, 2.0], &mut c);
+        assert_eq!([t.resolve(0), t.resolve(1)], [[1.0; 3], [1.25, 0.5, 3.0]]);
+        assert_eq!(
+            t.raw(1),
+            Raw::Channels(vec![Raw::f32(1.25), Raw::f32(0.5), Raw::f32(3.0)])
+        );
+        let bytes = u64::from(VBufferFormat::RgbF32.bytes());
+        assert_eq!(bytes, 12);
+        assert_eq!((c.color_read_bytes, c.color_write_bytes), (bytes, bytes));
+        assert!([
+            VBufferFormat::F32,
+            VBufferFormat::F16,
+            VBufferFormat::RgbF32
+        ]
+        .iter()
+        .all(|f| f.overflow() == Overflow::NonFinite));
+        assert_eq!(VBufferFormat::Split8.overflow(), Overflow::Saturate);
+    }
+
+    /// A binary16 result that is not finite is an overflow event, counted always and recorded
+    /// per sample only once [`VBufferTile::record_overflows`] asked for it; the largest finite
+    /// value is not one.
+    #[test]
+    fn f16_counts_and_records_results_that_are_not_finite() {
+        let mut c = Counters::default();
+        let mut t = VBufferF16Tile::cleared(3);
+        t.add(2, [70000.0, 0.0, 0.0], &mut c);
+        assert_eq!(c.overflow_events, 1);
+        assert!(t.overflows().is_empty());
+        t.record_overflows();
+        assert_eq!(t.overflows(), [0, 0, 0]);
+        t.add(0, [65503.0, 0.0, 0.0], &mut c);
+        assert_eq!(t.resolve(0), [65504.0; 3]);
+        t.add(1, [f32::INFINITY, 0.0, 0.0], &mut c);
+        t.add(1, [1.0, 0.0, 0.0], &mut c);
+        assert_eq!(c.overflow_events, 3);
+        assert_eq!(t.overflows(), [0, 2, 0]);
+        assert!(VBufferF32Tile::cleared(1).overflows().is_empty());
+    }
+
+    /// `round(|δ|·63)`: every level from its exact value and ± a quarter level, half-way up,
+    /// both signs, clamped above 1, NaN to 0 (never a full contribution).
+    #[test]
+    fn quantize6_rounds_to_the_nearest_of_64_levels() {
+        for k in 0..=63u8 {
+            let level = f32::from(k) / 63.0;
+            for d in [level, level + 0.24 / 63.0, level - 0.24 / 63.0] {
+                if (0.0..=1.0).contains(&d) {
+                    assert_eq!((quantize6(d), quantize6(-d)), (k, k), "{d}");
+                }
+            }
+        }
+        assert_eq!(quantize6(0.5 / 63.0 + 1e-6), 1);
+        assert_eq!(quantize6(0.5 / 63.0 - 1e-6), 0);
+        assert_eq!(
+            (quantize6(1.5), quantize6(-7.0), quantize6(f32::INFINITY)),
+            (63, 63, 63)
+        );
+        assert_eq!(quantize6(f32::NAN), 0);
+    }
+
+    /// Paper III §4.2's two channels: a positive contribution blends into R, a negative one
+    /// into G, both read and write the RGBA8 pixel (4 bytes), a contribution that quantizes to
+    /// level 0 is no blend at all, and the resolve is `(R − G)/63`. G saturates like R.
+    #[test]
+    fn split8_adds_positive_to_r_negative_to_g_and_resolves_their_difference() {
+        let mut c = Counters::default();
+        let mut t = VBuffer8Tile::cleared(2);
+        assert_eq!(t.resolve(1), [0.0; 3]);
+        t.add(1, [1.0, 0.0, 0.0], &mut c);
+        t.add(1, [1.0, 0.0, 0.0], &mut c);
+        t.add(1, [-0.5, 0.0, 0.0], &mut c);
+        assert_eq!(t.raw(1), Raw::Rg8([126, 32]));
+        assert_eq!(t.resolve(1), [(126.0 - 32.0) / 63.0; 3]);
+        assert_eq!((c.color_read_bytes, c.color_write_bytes), (12, 12));
+        assert_eq!(u64::from(VBufferFormat::Split8.bytes()), 4);
+        t.add(1, [0.007, 0.0, 0.0], &mut c);
+        t.add(1, [-0.007, 0.0, 0.0], &mut c);
+        assert_eq!(t.raw(1), Raw::Rg8([126, 32]));
+        assert_eq!((c.color_read_bytes, c.color_write_bytes), (12, 12));
+        assert_eq!(t.raw(0), Raw::Rg8([0, 0]));
+        t.record_overflows();
+        for _ in 0..5 {
+            t.add(0, [-1.0, 0.0, 0.0], &mut c);
+        }
+        assert_eq!(t.raw(0), Raw::Rg8([0, 255]));
+        assert_eq!(t.resolve(0), [-255.0 / 63.0; 3]);
+        assert_eq!(c.overflow_events, 1);
+        assert_eq!(t.overflows(), [1, 0]);
+    }
+
+    /// [`add_probed`] is [`VBufferTile::add`] with or without a tap, and with one records the
+    /// write at the tap: the stored value before and after and this write's overflow events
+    /// of the format's kind (none when there were none).
+    #[test]
+    fn add_probed_records_the_write_and_its_overflows() {
+        let tiling = Tiling::new(8, 8, 8).unwrap();
+        let probe = Probe::new(3, 2);
+        let pass = probe.pass("p", &tiling);
+        let tap = pass.tap_at(3, 2);
+        let mut c = Counters::default();
+        let mut t = VBuffer8Tile::cleared(64);
+        let i = tiling.local(3, 2);
+        // An untapped pixel saturated first: the tap counts this write's events only.
+        for _ in 0..5 {
+            add_probed(&mut t, 5, [1.0; 3], &mut c, None, |tap| tap.event());
+        }
+        assert_eq!((t.raw(5), c.overflow_events), (Raw::Rg8([255, 0]), 1));
+        assert!(probe.events().is_empty());
+        for _ in 0..5 {
+            add_probed(&mut t, i, [1.0; 3], &mut c, tap, |tap| tap.event());
+        }
+        assert_eq!(c.overflow_events, 2);
+        let writes: Vec<BufferChange> = probe
+            .events()
+            .into_iter()
+            .filter_map(|e| e.buffer)
+            .collect();
+        assert_eq!(writes.len(), 5);
+        let write = |before: [u8; 2], after: [u8; 2], overflow| BufferChange {
+            buffer: "vbuffer".into(),
+            before: Some(Raw::Rg8(before)),
+            after: Raw::Rg8(after),
+            overflow,
+        };
+        assert_eq!(writes[0], write([0, 0], [63, 0], None));
+        assert_eq!(writes[3], write([189, 0], [252, 0], None));
+        assert_eq!(
+            writes[4],
+            write([252, 0], [255, 0], Some((Overflow::Saturate, 1)))
+        );
+    }
 
     #[test]
     fn split8_saturates_on_the_fifth_full_contribution() {

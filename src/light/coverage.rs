@@ -1014,6 +1014,98 @@ mod tests {
         }
     }
 
+    /// The light's affine frame by hand for a skewed rectangle `u = (2, 0, 0)`, `v = (1, 3, 0)`
+    /// at `c = (1, 2, 3)`: `n = (0, 0, 1)`, the dual vectors `v × n / (u·(v × n)) =
+    /// (3, −1, 0)/6` and `n × u / (v·(n × u)) = (0, 2, 0)/6`, the area `4·|u × v| = 24`, the
+    /// corners in their documented order, and `local` the inverse of `world`.
+    #[test]
+    fn the_light_frame_of_a_skewed_rectangle_by_hand() {
+        let c = DVec3::new(1.0, 2.0, 3.0);
+        let (u, v) = (DVec3::new(2.0, 0.0, 0.0), DVec3::new(1.0, 3.0, 0.0));
+        let l = RectLight::new(c, u, v);
+        assert_eq!(l.normal, DVec3::Z);
+        assert_eq!(l.area(), 24.0);
+        let scale = l.local_scale();
+        assert!(
+            (scale - DVec2::new(10f64.sqrt() / 6.0, 1.0 / 3.0)).length() < 1e-15,
+            "{scale}"
+        );
+        assert_eq!(
+            l.corners(),
+            [
+                DVec3::new(-2.0, -1.0, 3.0),
+                DVec3::new(2.0, -1.0, 3.0),
+                DVec3::new(4.0, 5.0, 3.0),
+                DVec3::new(0.0, 5.0, 3.0),
+            ]
+        );
+        let local = DVec3::new(0.25, -0.5, 2.0);
+        // c + 0.25·u − 0.5·v + 2·n.
+        let world = DVec3::new(1.0, 0.5, 5.0);
+        assert_eq!(l.world(local), world);
+        assert!(
+            (l.local(world) - local).length() < 1e-15,
+            "{}",
+            l.local(world)
+        );
+        let rect = Light {
+            center: c.as_vec3(),
+            shape: LightShape::Rect {
+                u: u.as_vec3(),
+                v: v.as_vec3(),
+            },
+        };
+        assert_eq!(RectLight::from_light(&rect), Some(l));
+        let sphere = Light {
+            center: c.as_vec3(),
+            shape: LightShape::Sphere { radius: 1.0 },
+        };
+        assert_eq!(RectLight::from_light(&sphere), None);
+    }
+
+    /// [`projected_edge_near_clipped`] by hand under the unit light from `p = (0.3, −0.2, 4)`:
+    /// an edge from `h = −1` to `h = 3.8` is cut at the light's plane (`h = 0`) and at the near
+    /// plane `(1 − 0.1)·4 = 3.6`, and each cut point `x` projects from `p` to
+    /// `(x·h_p − p·h)/(h_p − h)` in `(s, t)`, in the edge's direction. The same edge mirrored
+    /// below the light (`p` and the edge at −h) projects to the same points. Nothing is left of
+    /// an edge wholly beyond the light's plane, or of one wholly within the near fraction of
+    /// `p`'s level, and a receiver in the light's plane projects nothing.
+    #[test]
+    fn near_clipped_edge_is_cut_at_both_planes_and_projected_by_hand() {
+        let l = unit_light();
+        let p = DVec3::new(0.3, -0.2, 4.0);
+        let (e0, e1) = (DVec3::new(-0.5, 0.4, -1.0), DVec3::new(1.9, -0.8, 3.8));
+        let at_h = |h: f64| e0 + (e1 - e0) * ((h - e0.z) / (e1.z - e0.z));
+        let project = |x: DVec3| ((x * p.z - p * x.z) / (p.z - x.z)).truncate();
+        let (a, b) = (project(at_h(0.0)), project(at_h(3.6)));
+        let mirror = |x: DVec3| DVec3::new(x.x, x.y, -x.z);
+        for (p, e0, e1) in [(p, e0, e1), (mirror(p), mirror(e0), mirror(e1))] {
+            let [qa, qb] = projected_edge_near_clipped(&l, p, e0, e1, 0.1).unwrap();
+            assert!(
+                (qa - a).length() < 1e-12 && (qb - b).length() < 1e-12,
+                "{qa} {qb}"
+            );
+            let [qb, qa] = projected_edge_near_clipped(&l, p, e1, e0, 0.1).unwrap();
+            assert!(
+                (qa - a).length() < 1e-12 && (qb - b).length() < 1e-12,
+                "{qa} {qb}"
+            );
+        }
+        let beyond = (DVec3::new(0.0, 0.0, -1.0), DVec3::new(1.0, 0.0, -0.5));
+        assert_eq!(
+            projected_edge_near_clipped(&l, p, beyond.0, beyond.1, 0.1),
+            None
+        );
+        let near = (DVec3::new(0.0, 0.0, 3.7), DVec3::new(1.0, 0.0, 3.9));
+        assert_eq!(
+            projected_edge_near_clipped(&l, p, near.0, near.1, 0.1),
+            None
+        );
+        assert!(projected_edge_near_clipped(&l, p, near.0, near.1, 0.0).is_some());
+        let level = DVec3::new(0.3, -0.2, 0.0);
+        assert_eq!(projected_edge_near_clipped(&l, level, e0, e1, 0.1), None);
+    }
+
     fn unit_light() -> RectLight {
         RectLight::new(DVec3::ZERO, DVec3::X, DVec3::Y)
     }
@@ -1273,6 +1365,168 @@ mod tests {
             for q in [q0, q1] {
                 assert!(q.abs().max_element() <= 1.0, "{q}");
             }
+        }
+    }
+
+    /// The chord [`clip_to_light_cone`] should give, computed independently: the set of edge
+    /// parameters `t` whose point lies in the slab between `p` and the disk's plane and
+    /// projects from `p` into the disk is an interval (a line meets the convex cone and the slab
+    /// in one), found by sampling `t` for a point inside and bisecting each way on that
+    /// predicate, with the projection done by dividing directly. Returns the projections of
+    /// the interval's ends in the edge's direction and a tolerance: `10⁻⁹` plus the
+    /// projection's slope times the bisection's `10⁻¹⁵`; `None` when no sample is inside.
+    fn chord_by_bisection(
+        c: DVec3,
+        radius: f64,
+        p: DVec3,
+        e0: DVec3,
+        e1: DVec3,
+    ) -> Option<([DVec2; 2], f64)> {
+        let dist = (c - p).length();
+        let z = (c - p) / dist;
+        let x = z.any_orthonormal_vector();
+        let y = z.cross(x);
+        let at = |t: f64| {
+            let w = e0 + (e1 - e0) * t - p;
+            let depth = w.dot(z) / dist;
+            (depth > 0.0 && depth <= 1.0).then(|| DVec2::new(w.dot(x), w.dot(y)) / (radius * depth))
+        };
+        let inside = |t: f64| at(t).is_some_and(|q| q.length_squared() <= 1.0);
+        let seed = (0..=4096).map(|i| i as f64 / 4096.0).find(|&t| inside(t))?;
+        let bisect = |mut good: f64, mut bad: f64| {
+            if inside(bad) {
+                return bad;
+            }
+            while (good - bad).abs() > 1e-15 {
+                let mid = 0.5 * (good + bad);
+                if inside(mid) {
+                    good = mid;
+                } else {
+                    bad = mid;
+                }
+            }
+            good
+        };
+        let (t0, t1) = (bisect(seed, 0.0), bisect(seed, 1.0));
+        let slope = |t: f64| {
+            let h = 1e-7;
+            let (lo, hi) = ((t - h).max(t0), (t + h).min(t1));
+            if hi > lo {
+                Some((at(hi)? - at(lo)?).length() / (hi - lo))
+            } else {
+                Some(0.0)
+            }
+        };
+        let tol = 1e-9 + 1e-15 * (slope(t0)? + slope(t1)?) * 4.0;
+        Some(([at(t0)?, at(t1)?], tol))
+    }
+
+    /// [`clip_to_light_cone`] against [`chord_by_bisection`], compared through what a basis of
+    /// the disk's plane does not change (`|a|`, `|b|`, `a·b`, `a × b`). An edge the sampling
+    /// finds outside everywhere must get no chord or one shorter than its step could see.
+    /// Returns whether there was a chord.
+    fn check_chord(what: &str, c: DVec3, radius: f64, p: DVec3, e0: DVec3, e1: DVec3) -> bool {
+        let chord = clip_to_light_cone(c, radius, p, e0, e1);
+        let Some(([pa, pb], tol)) = chord_by_bisection(c, radius, p, e0, e1) else {
+            if let Some([a, b]) = chord {
+                assert!((a - b).length() < 1e-2, "{what}: chord {a} {b}, none seen");
+            }
+            return false;
+        };
+        let [a, b] = chord.unwrap_or_else(|| panic!("{what}: no chord, {pa} {pb} expected"));
+        for (name, got, want) in [
+            ("|a|", a.length(), pa.length()),
+            ("|b|", b.length(), pb.length()),
+            ("a·b", a.dot(b), pa.dot(pb)),
+            ("a×b", a.perp_dot(b), pa.perp_dot(pb)),
+        ] {
+            assert!(
+                (got - want).abs() <= tol,
+                "{what}: {name} {got} vs {want} (tolerance {tol}; chord {a} {b})"
+            );
+        }
+        true
+    }
+
+    /// The chord of [`clip_to_light_cone`] is the projected edge inside the disk
+    /// ([`check_chord`]) on 3000 random edges around random spheres, at least 1000 of which
+    /// have one.
+    #[test]
+    fn sphere_chord_is_the_projected_edge_inside_the_disk() {
+        let mut k = 0u64;
+        let mut unit = || {
+            k += 1;
+            (crate::light::sampling::splitmix64(k) >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut chords = 0;
+        for case in 0..3000 {
+            let mut vec3 =
+                |scale: f64| DVec3::new(unit() - 0.5, unit() - 0.5, unit() - 0.5) * 2.0 * scale;
+            let c = vec3(2.0);
+            let p = vec3(6.0);
+            let (e0, e1) = (p + (c - p) * vec3(1.0).x.abs() * 1.2, p + (c - p) * 0.7);
+            let (e0, e1) = (e0 + vec3(1.5), e1 + vec3(1.5));
+            let radius = 0.2 + 1.3 * unit();
+            if (c - p).length() <= radius * 1.01 {
+                continue;
+            }
+            chords += usize::from(check_chord(&format!("case {case}"), c, radius, p, e0, e1));
+        }
+        assert!(chords >= 1000, "{chords} edges with a chord");
+    }
+
+    /// The branches of [`clip_to_light_cone`] random edges do not reach, from `p` at the
+    /// origin under the sphere of radius 1 at `(0, 0, 2)` (every light-space coordinate below is
+    /// exact): an edge in the disk's plane (its chord is the edge inside the disk, since the
+    /// slab includes that plane: `|a| = |b| = 1`, `|a × b| = 2·½·√¾`), an edge along the
+    /// direction of a generator of the cone (the quadratic's leading coefficient is exactly 0:
+    /// one root), an edge at `p`'s level (not in the slab), and receivers inside the sphere and
+    /// on it (no chord).
+    #[test]
+    fn sphere_chord_in_the_disks_plane_along_a_generator_and_from_inside() {
+        let (c, r, p) = (DVec3::new(0.0, 0.0, 2.0), 1.0, DVec3::ZERO);
+        let in_plane = (DVec3::new(-3.0, 0.5, 2.0), DVec3::new(3.0, 0.5, 2.0));
+        assert!(check_chord(
+            "in the disk's plane",
+            c,
+            r,
+            p,
+            in_plane.0,
+            in_plane.1
+        ));
+        let [a, b] = clip_to_light_cone(c, r, p, in_plane.0, in_plane.1).unwrap();
+        assert!((a.length() - 1.0).abs() < 1e-15 && (b.length() - 1.0).abs() < 1e-15);
+        assert!(
+            (a.perp_dot(b).abs() - 0.75f64.sqrt()).abs() < 1e-15,
+            "{a} {b}"
+        );
+        // In light space d = (Δ·x, Δ·y, Δ·z/2) for Δ = (3, 4, 10)/8: d_x² + d_y² = d_z².
+        let e0 = DVec3::new(0.25, 0.0, 1.0);
+        let generator = (e0, e0 + DVec3::new(0.375, 0.5, 1.25));
+        assert!(check_chord(
+            "along a generator",
+            c,
+            r,
+            p,
+            generator.0,
+            generator.1
+        ));
+        let back = (generator.1, generator.0);
+        assert!(check_chord(
+            "along a generator, reversed",
+            c,
+            r,
+            p,
+            back.0,
+            back.1
+        ));
+        let level = (DVec3::new(-3.0, 0.5, 0.0), DVec3::new(3.0, 0.5, 0.0));
+        assert_eq!(clip_to_light_cone(c, r, p, level.0, level.1), None);
+        for inside in [DVec3::new(0.5, 0.0, 1.5), DVec3::new(0.0, 0.0, 1.0)] {
+            assert_eq!(
+                clip_to_light_cone(c, r, inside, in_plane.0, in_plane.1),
+                None
+            );
         }
     }
 
