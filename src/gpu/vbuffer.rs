@@ -247,9 +247,9 @@ pub struct VBuffer8Tile {
     pub overflows: Vec<u32>,
 }
 
-/// `round(|δ|·63)` as a 6-bit level (module doc), `|δ|` clamped to 1. A NaN is level 0, as
-/// Direct3D 10's float-to-unorm conversion makes it (OpenGL leaves it undefined): `f32::min`
-/// would have made it a full contribution, 63.
+/// `round(|δ|·63)` as a 6-bit level (module doc), `|δ|` clamped to 1. A NaN is level 0, the
+/// lower bound, as `pack4ub::unorm8` and Direct3D 10's float-to-unorm conversion make it
+/// (OpenGL leaves it undefined): `f32::min` would have made it a full contribution, 63.
 pub fn quantize6(delta: f32) -> u8 {
     if delta.is_nan() {
         return 0;
