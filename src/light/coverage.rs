@@ -347,7 +347,7 @@ pub fn shader_projected_edge_in_light<T: ShaderFloat>(
     e0: DVec3,
     e1: DVec3,
 ) -> Option<[SVec2<T>; 2]> {
-    let (zero, one) = (T::zero(), T::one());
+    let one = T::one();
     let projection = ProjectionFromPoint::<T>::new(light, p)?;
     let seg = [
         light.shader_local::<T>(e0).extend(one),
@@ -368,22 +368,25 @@ pub fn shader_projected_edge_in_light<T: ShaderFloat>(
     for k in 0..LIGHT_BORDERS {
         clip_segment_marking(&mut a, &mut b, |x| light_border(k, x.x), |x| x.on_border(k))?;
     }
-    if a.x.z <= zero || b.x.z <= zero {
-        return None;
-    }
     Some([in_light_square(a)?, in_light_square(b)?])
 }
 
 /// The light coordinates `(S/W, T/W)` of a homogeneous point clipped to the light square: a
 /// coordinate of a point on a border ([`BorderPoint`]) is that border's ±1 exactly, the others
-/// are clamped to `[−1, 1]`; `None` for a point on two opposite borders (a direction at
-/// infinity, `W = 0`). The point lies in the square, but where its `W` is at the rounding of
+/// are clamped to `[−1, 1]`; `None` for a point with `W ≤ 0` (a direction at infinity, left
+/// by a clip to the light square only as the zero vector, or from rounding) and for one on
+/// two opposite borders. A NaN `W` is not `None` but NaN coordinates, so that it shows in the
+/// coverage (one rule for the edge's two ends and the polygon's vertices, which kept a NaN
+/// `W` out of the polygon's area and so hid it). The point lies in the square, but where its `W` is at the rounding of
 /// the coordinates it was interpolated from, dividing puts it anywhere (found by fuzzing: a
 /// receiver 6·10⁻⁹ from an edge lying at its own level, so that the whole projected edge is at
 /// infinity and its clipped ends have `W` ≈ 2·10⁻¹⁶, gave s = −1.118); the clamp and the snap
 /// remove only that rounding, and keep texture coordinates in the texture.
 fn in_light_square<T: ShaderFloat>(x: BorderPoint<T>) -> Option<SVec2<T>> {
     let one = T::one();
+    if x.x.z <= T::zero() {
+        return None;
+    }
     let on = |k: usize| x.on & (1 << k) != 0;
     let snap = |q: T, plus: usize, minus: usize| match (on(plus), on(minus)) {
         (true, true) => None,
@@ -466,7 +469,8 @@ impl<T: ShaderFloat> std::ops::Mul<T> for BorderPoint<T> {
 /// light (Forest et al. 2006 §4.2, Fig. 9, after Lengyel: a point of the edge that does not
 /// lie between `p` and the light plane "cannot be projected onto the area light plane"; the
 /// near plane keeps the projection finite). The endpoints keep the edge's direction. `None`
-/// when nothing of the edge lies in the slab or `p` is in the light plane.
+/// when nothing of the edge lies in the slab, `p` is in the light plane, or an end's
+/// projection is not finite (it overflowed).
 ///
 /// With `near_fraction = 0` this is the projection [`projected_edge_in_light`] clips; a
 /// positive fraction drops the part of the edge within `near_fraction·h_p` of `p`'s level,
@@ -957,12 +961,7 @@ fn clip_to_light_into<T: ShaderFloat>(
         }
         std::mem::swap(&mut src, &mut dst);
     }
-    out.extend(
-        src.iter()
-            .filter(|x| x.x.z > T::zero())
-            .copied()
-            .filter_map(in_light_square),
-    );
+    out.extend(src.iter().copied().filter_map(in_light_square));
 }
 
 /// A clipped polygon of the fragment programs, on the stack in a buffer that never
@@ -1063,6 +1062,72 @@ mod tests {
         assert_eq!(RectLight::from_light(&sphere), None);
     }
 
+    /// [`in_light_square`] by hand: `(S/W, T/W)` inside the square, clamped outside it, a
+    /// coordinate on a marked border exactly that border's ±1 whatever the division gives,
+    /// `None` on two opposite borders and for `W` = 0 (a direction, even marked on one border
+    /// only), −0 and < 0; a NaN `W` gives NaN coordinates, not `None` or a value in the square.
+    #[test]
+    fn in_light_square_divides_clamps_snaps_and_drops_directions() {
+        let at = |s: f64, t: f64, w: f64, on: u8| {
+            in_light_square(BorderPoint {
+                x: SVec3::new(s, t, w),
+                on,
+            })
+            .map(SVec2::to_f64)
+        };
+        let d = |s, t| Some(DVec2::new(s, t));
+        assert_eq!(at(1.0, -3.0, 4.0, 0), d(0.25, -0.75));
+        assert_eq!(at(5.0, -6.0, 4.0, 0), d(1.0, -1.0));
+        assert_eq!(at(-5.0, 6.0, 4.0, 0), d(-1.0, 1.0));
+        // Marked borders: 0 is s = 1, 1 is s = −1, 2 is t = 1, 3 is t = −1.
+        assert_eq!(at(3.9, 1.0, 4.0, 0b0001), d(1.0, 0.25));
+        assert_eq!(at(-3.9, 1.0, 4.0, 0b0010), d(-1.0, 0.25));
+        assert_eq!(at(1.0, 3.9, 4.0, 0b0100), d(0.25, 1.0));
+        assert_eq!(at(1.0, -3.9, 4.0, 0b1000), d(0.25, -1.0));
+        assert_eq!(at(3.9, -3.9, 4.0, 0b1001), d(1.0, -1.0));
+        assert_eq!(at(0.0, 1.0, 4.0, 0b0011), None);
+        assert_eq!(at(1.0, 0.0, 4.0, 0b1100), None);
+        for (s, t, w) in [(1.0, 0.0, 0.0), (0.0, 0.0, -0.0), (-1.0, 0.0, -2.0)] {
+            assert_eq!(at(s, t, w, 0b0001), None, "({s}, {t}, {w})");
+            assert_eq!(at(s, t, w, 0), None, "({s}, {t}, {w})");
+        }
+        let nan = at(1.0, 1.0, f64::NAN, 0).expect("a NaN W is not dropped");
+        assert!(nan.x.is_nan() && nan.y.is_nan(), "{nan}");
+    }
+
+    /// [`quad_side`] is the sign of `det(e0 − c, e1 − c, p − c)`, computed here in integers:
+    /// on 4000 random points of the lattice {−2, …, 2}³, where the determinant is exact in
+    /// f64 and often 0 (both signs and 0 required to occur).
+    #[test]
+    fn quad_side_is_the_sign_of_the_determinant() {
+        let mut k = 0u64;
+        let mut point = || {
+            let mut coord = || {
+                k += 1;
+                (crate::light::sampling::splitmix64(k) % 5) as i64 - 2
+            };
+            [coord(), coord(), coord()]
+        };
+        let det = |a: [i64; 3], b: [i64; 3], d: [i64; 3]| {
+            a[0] * (b[1] * d[2] - b[2] * d[1]) - a[1] * (b[0] * d[2] - b[2] * d[0])
+                + a[2] * (b[0] * d[1] - b[1] * d[0])
+        };
+        let f = |x: [i64; 3]| DVec3::new(x[0] as f64, x[1] as f64, x[2] as f64);
+        let mut seen = [0; 3];
+        for _ in 0..4000 {
+            let (c, e0, e1, p) = (point(), point(), point(), point());
+            let minus = |a: [i64; 3]| [a[0] - c[0], a[1] - c[1], a[2] - c[2]];
+            let want = det(minus(e0), minus(e1), minus(p)).signum();
+            seen[(want + 1) as usize] += 1;
+            assert_eq!(
+                quad_side(f(c), f(p), f(e0), f(e1)),
+                want as f64,
+                "c {c:?} p {p:?} e0 {e0:?} e1 {e1:?}"
+            );
+        }
+        assert!(seen.iter().all(|&n| n > 100), "{seen:?}");
+    }
+
     /// [`projected_edge_near_clipped`] by hand under the unit light from `p = (0.3, −0.2, 4)`:
     /// an edge from `h = −1` to `h = 3.8` is cut at the light's plane (`h = 0`) and at the near
     /// plane `(1 − 0.1)·4 = 3.6`, and each cut point `x` projects from `p` to
@@ -1104,6 +1169,58 @@ mod tests {
         assert!(projected_edge_near_clipped(&l, p, near.0, near.1, 0.0).is_some());
         let level = DVec3::new(0.3, -0.2, 0.0);
         assert_eq!(projected_edge_near_clipped(&l, level, e0, e1, 0.1), None);
+        // An end whose projection overflows (S = 4·10³⁰⁸ = ∞), either way round.
+        let huge = (DVec3::new(1e308, 0.0, 1.0), DVec3::new(0.0, 0.0, 2.0));
+        assert_eq!(
+            projected_edge_near_clipped(&l, p, huge.0, huge.1, 0.1),
+            None
+        );
+        assert_eq!(
+            projected_edge_near_clipped(&l, p, huge.1, huge.0, 0.1),
+            None
+        );
+    }
+
+    /// [`projected_edge_near_clipped`] without a near plane, of edges that cross `p`'s level:
+    /// a point of the edge just below that level projects from `p` far out along the
+    /// direction from `p` to the point (`p + (x − p)·h_p/(h_p − h)`), so the projected end at
+    /// the level lies on that side of `p`'s own projection, never on the other — where a point
+    /// just *above* the level projects, which the clip's rounding leaves with `W < 0` (a
+    /// projection through the receiver's level, dropped). 3000 random edges; the end is
+    /// checked wherever the projection is `Some` (at least 100 times).
+    #[test]
+    fn edge_through_the_receivers_level_projects_out_on_its_own_side() {
+        let l = unit_light();
+        let mut unit = uniform_sequence();
+        let mut checked = 0;
+        for _ in 0..3000 {
+            let p = DVec3::new(2.0 * unit() - 1.0, 2.0 * unit() - 1.0, 1.0 + 4.0 * unit());
+            let (h0, h1) = (p.z * (0.1 + 0.8 * unit()), p.z * (1.1 + unit()));
+            let mut around = |h: f64| DVec3::new(4.0 * unit() - 2.0, 4.0 * unit() - 2.0, h);
+            let (e0, e1) = (around(h0), around(h1));
+            let at_level = e0 + (e1 - e0) * ((p.z - e0.z) / (e1.z - e0.z));
+            let out = (at_level - p).truncate();
+            if out.length() < 1e-3 {
+                continue;
+            }
+            if let Some([_, end]) = projected_edge_near_clipped(&l, p, e0, e1, 0.0) {
+                checked += 1;
+                assert!(
+                    (end - p.truncate()).dot(out) > 0.0,
+                    "p {p} e0 {e0} e1 {e1}: end {end}"
+                );
+            }
+        }
+        assert!(checked >= 100, "{checked}");
+    }
+
+    /// A fixed sequence of uniform numbers in [0, 1): splitmix64 of 1, 2, 3, … to 53 bits.
+    fn uniform_sequence() -> impl FnMut() -> f64 {
+        let mut k = 0u64;
+        move || {
+            k += 1;
+            (crate::light::sampling::splitmix64(k) >> 11) as f64 / (1u64 << 53) as f64
+        }
     }
 
     fn unit_light() -> RectLight {
@@ -1421,8 +1538,7 @@ mod tests {
         Some(([at(t0)?, at(t1)?], tol))
     }
 
-    /// [`clip_to_light_cone`] against [`chord_by_bisection`], compared through what a basis of
-    /// the disk's plane does not change (`|a|`, `|b|`, `a·b`, `a × b`). An edge the sampling
+    /// [`clip_to_light_cone`] against [`chord_by_bisection`] ([`assert_same_chord`]). An edge the sampling
     /// finds outside everywhere must get no chord or one shorter than its step could see.
     /// Returns whether there was a chord.
     fn check_chord(what: &str, c: DVec3, radius: f64, p: DVec3, e0: DVec3, e1: DVec3) -> bool {
@@ -1433,7 +1549,14 @@ mod tests {
             }
             return false;
         };
-        let [a, b] = chord.unwrap_or_else(|| panic!("{what}: no chord, {pa} {pb} expected"));
+        let got = chord.unwrap_or_else(|| panic!("{what}: no chord, {pa} {pb} expected"));
+        assert_same_chord(what, got, [pa, pb], tol);
+        true
+    }
+
+    /// Chord `[a, b]` is `want` to `tol` in what a basis of the disk's plane does not change:
+    /// `|a|`, `|b|`, `a·b`, `a × b`.
+    fn assert_same_chord(what: &str, [a, b]: [DVec2; 2], [pa, pb]: [DVec2; 2], tol: f64) {
         for (name, got, want) in [
             ("|a|", a.length(), pa.length()),
             ("|b|", b.length(), pb.length()),
@@ -1445,7 +1568,28 @@ mod tests {
                 "{what}: {name} {got} vs {want} (tolerance {tol}; chord {a} {b})"
             );
         }
-        true
+    }
+
+    /// The chord of an edge reaching 10⁶ radii from the light is found in binary32 from
+    /// either end, because the parameter starts at the end nearer the light (the fuzzing find
+    /// of [`shader_clip_to_light_cone`]'s comment): started from the far end, the nearest point
+    /// carries an error of ε·10⁶ radii ≈ 0.06. The unit disk at the origin seen from
+    /// `p = (0, 0, −2)`; the edge at `z = −1`, half way, so that it projects doubled: `y = 0.3`,
+    /// `x` from −0.5 to 10⁶, whose part in the disk runs to `x = √0.91`. Compared through the
+    /// invariants of [`assert_same_chord`] (the disk's basis is any), to 10⁻⁵ — 160 ulps of binary32
+    /// at 1, none at the far end's scale.
+    #[test]
+    fn sphere_chord_of_an_edge_a_million_radii_long_from_either_end() {
+        use crate::gpu::shader_float::Fp32;
+        let (c, p) = (DVec3::ZERO, DVec3::new(0.0, 0.0, -2.0));
+        let (near, far) = (DVec3::new(-0.25, 0.15, -1.0), DVec3::new(5e5, 0.15, -1.0));
+        let (a, b) = (DVec2::new(-0.5, 0.3), DVec2::new(0.91f64.sqrt(), 0.3));
+        for (e0, e1, want) in [(near, far, [a, b]), (far, near, [b, a])] {
+            let got = shader_clip_to_light_cone::<Fp32>(c, 1.0, p, e0, e1)
+                .expect("a chord")
+                .map(SVec2::to_f64);
+            assert_same_chord(&format!("from {e0}"), got, want, 1e-5);
+        }
     }
 
     /// The chord of [`clip_to_light_cone`] is the projected edge inside the disk
@@ -1453,11 +1597,7 @@ mod tests {
     /// have one.
     #[test]
     fn sphere_chord_is_the_projected_edge_inside_the_disk() {
-        let mut k = 0u64;
-        let mut unit = || {
-            k += 1;
-            (crate::light::sampling::splitmix64(k) >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut unit = uniform_sequence();
         let mut chords = 0;
         for case in 0..3000 {
             let mut vec3 =
