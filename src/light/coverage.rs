@@ -375,9 +375,9 @@ pub fn shader_projected_edge_in_light<T: ShaderFloat>(
 /// coordinate of a point on a border ([`BorderPoint`]) is that border's ±1 exactly, the others
 /// are clamped to `[−1, 1]`; `None` for a point with `W ≤ 0` (a direction at infinity, left
 /// by a clip to the light square only as the zero vector, or from rounding) and for one on
-/// two opposite borders. A NaN `W` is not `None` but NaN coordinates, so that it shows in the
-/// coverage (one rule for the edge's two ends and the polygon's vertices, which kept a NaN
-/// `W` out of the polygon's area and so hid it). The point lies in the square, but where its `W` is at the rounding of
+/// two opposite borders. A NaN `W` gives NaN coordinates, not `None`, so that it shows in the
+/// coverage. One rule for the projected edge's two ends and the clipped polygon's vertices.
+/// The point lies in the square, but where its `W` is at the rounding of
 /// the coordinates it was interpolated from, dividing puts it anywhere (found by fuzzing: a
 /// receiver 6·10⁻⁹ from an edge lying at its own level, so that the whole projected edge is at
 /// infinity and its clipped ends have `W` ≈ 2·10⁻¹⁶, gave s = −1.118); the clamp and the snap
